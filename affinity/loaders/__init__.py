@@ -1,0 +1,1 @@
+"""Mesh loaders: ``load(path) -> Mesh`` dispatching on the file extension."""

@@ -1,0 +1,152 @@
+"""The polygon mesh model shared by every loader, measure and rule.
+
+Faces are kept exactly as the file wrote them: quads stay quads, triangles and
+n-gons are kept and counted, nothing is triangulated. Faces live in compressed
+("CSR") form: face ``f`` owns corners ``face_start[f]:face_start[f + 1]`` of the
+per-corner arrays. Texture coordinates and normals are indexed per corner,
+separately from positions (OBJ ``v/vt/vn`` style), so UV seams and mirrored UVs
+survive. Vertex colours are per position vertex, as OBJ and PLY store them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+class MeshError(Exception):
+    """A file that cannot be read as a mesh.
+
+    ``line`` is the 1-based source line the problem was found on, 0 when the
+    problem has no line (binary data, a missing file).
+    """
+
+    def __init__(self, path: str, line: int, reason: str):
+        super().__init__(f"{path}:{line}: {reason}")
+        self.path = str(path)
+        self.line = int(line)
+        self.reason = reason
+
+
+@dataclass(eq=False)
+class Mesh:
+    """A polygon mesh with per-corner attributes.
+
+    Attributes
+    ----------
+    path : str
+        The file the mesh was read from (as given).
+    positions : (V, 3) float64
+    face_start : (F + 1,) int64
+        Offsets of each face's corners into the corner arrays; ``face_start[0] == 0``.
+    corner_vertex : (C,) int64
+        0-based index into ``positions`` for every corner.
+    face_line : (F,) int64
+        1-based source line of every face; 0 where the format has no lines (binary PLY).
+    texcoords : (T, 2) float64 or None
+    corner_texcoord : (C,) int64 or None
+        Index into ``texcoords`` per corner, -1 for a corner without one.
+    normals : (N, 3) float64 or None
+    corner_normal : (C,) int64 or None
+        Index into ``normals`` per corner, -1 for a corner without one.
+    colors : (V, 3) float64 or None
+        Per-vertex RGB in [0, 1] (reached through ``corner_vertex``).
+    group_names : list of str
+        Group/object names; ``face_group`` indexes into it.
+    face_group : (F,) int32
+    material_names : list of str
+    face_material : (F,) int32
+        Index into ``material_names``, -1 for faces without ``usemtl``.
+    material_textures : dict of str to str
+        Material name to its ``map_Kd`` path (resolved against the .mtl file's folder).
+    """
+
+    path: str
+    positions: np.ndarray
+    face_start: np.ndarray
+    corner_vertex: np.ndarray
+    face_line: np.ndarray
+    texcoords: np.ndarray | None = None
+    corner_texcoord: np.ndarray | None = None
+    normals: np.ndarray | None = None
+    corner_normal: np.ndarray | None = None
+    colors: np.ndarray | None = None
+    group_names: list[str] = field(default_factory=lambda: [""])
+    face_group: np.ndarray | None = None
+    material_names: list[str] = field(default_factory=list)
+    face_material: np.ndarray | None = None
+    material_textures: dict[str, str] = field(default_factory=dict)
+
+    def __post_init__(self):
+        if self.face_group is None:
+            self.face_group = np.zeros(self.n_faces, dtype=np.int32)
+        if self.face_material is None:
+            self.face_material = np.full(self.n_faces, -1, dtype=np.int32)
+
+    @property
+    def n_faces(self) -> int:
+        return len(self.face_start) - 1
+
+    @property
+    def face_sizes(self) -> np.ndarray:
+        """(F,) int64 number of corners of every face."""
+        return np.diff(self.face_start)
+
+    def counts(self) -> dict[str, int]:
+        """Faces by size as read from the file: ``faces``, ``quads``, ``triangles``, ``ngons``."""
+        sizes = self.face_sizes
+        triangles = int(np.count_nonzero(sizes == 3))
+        quads = int(np.count_nonzero(sizes == 4))
+        return {
+            "faces": self.n_faces,
+            "quads": quads,
+            "triangles": triangles,
+            "ngons": self.n_faces - quads - triangles,
+        }
+
+    def faces_of_size(self, k: int) -> tuple[np.ndarray, np.ndarray]:
+        """Faces with exactly ``k`` corners.
+
+        Returns
+        -------
+        faces : (n,) int64
+            Their indices in file order.
+        corners : (n, k) int64
+            Their corner indices (into ``corner_vertex`` and the other corner arrays).
+        """
+        faces = np.flatnonzero(self.face_sizes == k)
+        corners = self.face_start[faces, None] + np.arange(k)
+        return faces, corners
+
+    def corner_attribute(self, name: str, corners: np.ndarray) -> np.ndarray | None:
+        """Gather an attribute at the given corners.
+
+        Parameters
+        ----------
+        name : {"positions", "texcoords", "normals", "colors"}
+        corners : (n, k) int64 corner indices, e.g. from :meth:`faces_of_size`.
+
+        Returns
+        -------
+        (n, k, D) float64, NaN for corners that lack the attribute, or None when
+        the mesh has no such attribute at all.
+        """
+        if name in ("positions", "colors"):
+            values = getattr(self, name)
+            return None if values is None else values[self.corner_vertex[corners]]
+        values = getattr(self, name)
+        index = getattr(self, "corner_" + name[:-1])
+        if values is None or index is None or len(values) == 0:
+            return None
+        picked = index[corners]
+        out = values[np.maximum(picked, 0)]
+        out[picked < 0] = np.nan
+        return out
+
+    def texture_path(self) -> str | None:
+        """The ``map_Kd`` path of the first material that has one, or None."""
+        for name in self.material_names:
+            if name in self.material_textures:
+                return self.material_textures[name]
+        return next(iter(self.material_textures.values()), None)
