@@ -29,6 +29,15 @@ class MeshError(Exception):
         self.reason = reason
 
 
+class SkippedFile(Exception):
+    """A file that is deliberately not checked (e.g. a Git LFS pointer); not an error."""
+
+    def __init__(self, path: str, reason: str):
+        super().__init__(f"{path}: skipped ({reason})")
+        self.path = str(path)
+        self.reason = reason
+
+
 @dataclass(eq=False)
 class Mesh:
     """A polygon mesh with per-corner attributes.
