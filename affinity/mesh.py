@@ -159,3 +159,44 @@ class Mesh:
             if name in self.material_textures:
                 return self.material_textures[name]
         return next(iter(self.material_textures.values()), None)
+
+
+
+def mesh_from_polygons(
+    path: str,
+    positions: np.ndarray,
+    faces: np.ndarray,
+    texcoords: np.ndarray | None = None,
+    normals: np.ndarray | None = None,
+    colors: np.ndarray | None = None,
+) -> Mesh:
+    """Build an in-memory mesh whose faces all have the same size, attributes per vertex.
+
+    Parameters
+    ----------
+    path : str, a name for messages (the mesh has no file, so ``face_line`` is 0)
+    positions : (V, 3) float
+    faces : (F, k) int, 0-based vertex indices
+    texcoords : (V, 2) float or None, indexed like positions
+    normals : (V, 3) float or None, indexed like positions
+    colors : (V, 3) float in [0, 1] or None
+    """
+    faces = np.asarray(faces, dtype=np.int64)
+    n_faces, k = faces.shape
+    corners = faces.reshape(-1)
+
+    def per_vertex(values, width):
+        return None if values is None else np.asarray(values, dtype=np.float64).reshape(-1, width)
+
+    return Mesh(
+        path=path,
+        positions=per_vertex(positions, 3),
+        face_start=np.arange(0, n_faces * k + 1, k, dtype=np.int64),
+        corner_vertex=corners,
+        face_line=np.zeros(n_faces, dtype=np.int64),
+        texcoords=per_vertex(texcoords, 2),
+        corner_texcoord=None if texcoords is None else corners.copy(),
+        normals=per_vertex(normals, 3),
+        corner_normal=None if normals is None else corners.copy(),
+        colors=per_vertex(colors, 3),
+    )
