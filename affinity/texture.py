@@ -1,0 +1,70 @@
+"""Textures for renders: a procedural checker, image files, and bilinear sampling.
+
+Texture coordinates follow OpenGL: ``(0, 0)`` is the bottom-left of the image,
+``v`` grows upward, and coordinates wrap (repeat) outside [0, 1].
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+CHECKS = 16
+
+
+def checker(size: int = 512, checks: int = CHECKS) -> np.ndarray:
+    """A checker with thin grid lines, so a bent diagonal stands out.
+
+    Returns
+    -------
+    (size, size, 3) float32 RGB in [0, 1].
+    """
+    cells = (np.arange(size) * checks) // size
+    parity = (cells[:, None] + cells[None, :]) % 2
+    light, dark = np.array([0.93, 0.90, 0.82]), np.array([0.22, 0.36, 0.55])
+    image = np.where(parity[..., None] == 0, light, dark)
+    period = size // checks
+    line = (np.arange(size) % period) < max(1, period // 16)
+    image[line, :] = image[:, line] = (0.85, 0.25, 0.15)
+    return image.astype(np.float32)
+
+
+class TextureError(Exception):
+    """A texture file that cannot be used."""
+
+
+def load_image(path: str) -> np.ndarray:
+    """Read an image file as (H, W, 3) float32 RGB in [0, 1] (Pillow, imported here)."""
+    from PIL import Image, UnidentifiedImageError
+
+    try:
+        with Image.open(path) as image:
+            return np.asarray(image.convert("RGB"), dtype=np.float32) / 255.0
+    except FileNotFoundError:
+        raise TextureError(f"{path}: no such texture file") from None
+    except (UnidentifiedImageError, OSError) as err:
+        raise TextureError(f"{path}: not a readable image ({err.__class__.__name__})") from None
+
+
+def sample_bilinear(image: np.ndarray, uv: np.ndarray) -> np.ndarray:
+    """Bilinear texture filtering with repeat wrapping.
+
+    Parameters
+    ----------
+    image : (H, W, C) float
+    uv : (N, 2) float, OpenGL texture coordinates
+
+    Returns
+    -------
+    (N, C) float32
+    """
+    height, width = image.shape[:2]
+    x = uv[:, 0] * width - 0.5
+    y = (1.0 - uv[:, 1]) * height - 0.5
+    x0, y0 = np.floor(x), np.floor(y)
+    fx, fy = (x - x0)[:, None], (y - y0)[:, None]
+    x0 = x0.astype(np.int64) % width
+    y0 = y0.astype(np.int64) % height
+    x1, y1 = (x0 + 1) % width, (y0 + 1) % height
+    top = image[y0, x0] * (1 - fx) + image[y0, x1] * fx
+    bottom = image[y1, x0] * (1 - fx) + image[y1, x1] * fx
+    return (top * (1 - fy) + bottom * fy).astype(np.float32)

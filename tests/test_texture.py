@@ -1,0 +1,37 @@
+import numpy as np
+import pytest
+
+from affinity.texture import TextureError, checker, load_image, sample_bilinear
+
+
+def test_sampling_at_texel_centres_returns_the_texels():
+    image = np.random.default_rng(1).random((4, 6, 3))
+    rows, cols = np.meshgrid(np.arange(4), np.arange(6), indexing="ij")
+    uv = np.stack([(cols + 0.5) / 6, 1 - (rows + 0.5) / 4], axis=-1).reshape(-1, 2)
+    np.testing.assert_allclose(sample_bilinear(image, uv), image.reshape(-1, 3), atol=1e-6)
+
+
+def test_sampling_between_texels_averages_and_wraps():
+    image = np.zeros((2, 2, 1))
+    image[0, 0] = 1.0  # top-left texel
+    # The corner uv = (0, 1) is the top-left image corner: halfway between the four
+    # texels around it once the texture repeats.
+    np.testing.assert_allclose(sample_bilinear(image, np.array([[0.0, 1.0], [1.0, 0.0], [2.0, -1.0]])), 0.25)
+    # Midway between texel centres (0, 0) and (0, 1) of the top row.
+    np.testing.assert_allclose(sample_bilinear(image, np.array([[0.5, 0.75]])), 0.5)
+
+
+def test_checker_alternates():
+    image = checker(64, checks=4)
+    assert image.shape == (64, 64, 3)
+    a, b = image[8, 8], image[8, 24]
+    assert not np.allclose(a, b) and np.allclose(image[24, 24], a)
+
+
+def test_unreadable_texture_is_a_texture_error(tmp_path):
+    with pytest.raises(TextureError, match="no such"):
+        load_image(str(tmp_path / "missing.png"))
+    junk = tmp_path / "junk.png"
+    junk.write_bytes(b"not an image")
+    with pytest.raises(TextureError, match="not a readable image"):
+        load_image(str(junk))
