@@ -1,0 +1,141 @@
+"""Turn a mesh into the renderer's clip-space quads, route them, and shade the result.
+
+``render`` takes quads only (design.md): quads pass as they are, triangles as
+quads with a repeated last corner, n-gons are fanned into triangles here.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .mesh import Mesh
+
+SHOW_MODES = ("uv", "color", "normal", "shaded")
+BACKGROUND = np.array([1.0, 1.0, 1.0], dtype=np.float32)
+OVERLAY_TINT = np.array([1.0, 0.1, 0.6], dtype=np.float32)
+
+
+def render_corners(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
+    """The mesh as renderable quads.
+
+    Returns
+    -------
+    faces : (R,) int64
+        The mesh face each render quad comes from.
+    corners : (R, 4) int64
+        Corner indices; a triangle repeats its last corner, an n-gon becomes
+        the fan (0, i, i+1, i+1) of triangles.
+    """
+    faces, corners = [], []
+    for size in np.unique(mesh.face_sizes).tolist():
+        of_size, face_corners = mesh.faces_of_size(size)
+        if size == 4:
+            quads = face_corners
+            owners = of_size
+        else:
+            fan = np.arange(1, size - 1)
+            quads = np.stack(
+                [np.repeat(face_corners[:, :1], len(fan), 1), face_corners[:, fan],
+                 face_corners[:, fan + 1], face_corners[:, fan + 1]], axis=-1,
+            ).reshape(-1, 4)
+            owners = np.repeat(of_size, len(fan))
+        faces.append(owners)
+        corners.append(quads)
+    if not faces:
+        return np.zeros(0, np.int64), np.zeros((0, 4), np.int64)
+    faces, corners = np.concatenate(faces), np.concatenate(corners)
+    order = np.argsort(faces, kind="stable")
+    return faces[order], corners[order]
+
+
+def flat_normals(positions: np.ndarray) -> np.ndarray:
+    """Unit normal of each quad from the cross product of its diagonals, (R,4,3) -> (R,4,3) (repeated per corner)."""
+    n = np.cross(positions[:, 2] - positions[:, 0], positions[:, 3] - positions[:, 1])
+    length = np.linalg.norm(n, axis=-1, keepdims=True)
+    n = np.divide(n, length, out=np.zeros_like(n), where=length > 0)
+    return np.repeat(n[:, None], 4, axis=1)
+
+
+@dataclass
+class ShadingInputs:
+    """Per-corner attributes handed to the rasterizer and how to read them back.
+
+    ``attrs`` is (R, 4, K): uv in columns ``uv`` (a slice or None), colours in
+    ``color``, normals in ``normal``.
+    """
+
+    attrs: np.ndarray
+    uv: slice | None
+    color: slice | None
+    normal: slice | None
+
+
+def shading_inputs(mesh: Mesh, corners: np.ndarray, show: str) -> ShadingInputs:
+    """Gather the attributes ``show`` needs; missing ones fall back (checker needs uv).
+
+    Raises ValueError when the mesh lacks what ``show`` needs and there is no fallback.
+    """
+    columns: list[np.ndarray] = []
+    slices: dict[str, slice | None] = {"uv": None, "color": None, "normal": None}
+
+    def add(name: str, values: np.ndarray) -> None:
+        start = sum(c.shape[-1] for c in columns)
+        columns.append(np.nan_to_num(values))
+        slices[name] = slice(start, start + values.shape[-1])
+
+    uv = mesh.corner_attribute("texcoords", corners)
+    if show in ("uv", "shaded") and uv is not None:
+        add("uv", uv)
+    if show == "uv" and uv is None:
+        raise ValueError("the mesh has no texture coordinates (try --show shaded or --show color)")
+    if show == "color":
+        colors = mesh.corner_attribute("colors", corners)
+        if colors is None:
+            raise ValueError("the mesh has no vertex colours (try --show shaded)")
+        add("color", colors)
+    if show in ("normal", "shaded"):
+        normals = mesh.corner_attribute("normals", corners)
+        positions = mesh.corner_attribute("positions", corners)
+        fallback = flat_normals(positions)
+        add("normal", fallback if normals is None else np.where(np.isnan(normals), fallback, normals))
+    return ShadingInputs(np.concatenate(columns, axis=-1), **slices)
+
+
+def shade(attrs: np.ndarray, covered: np.ndarray, inputs: ShadingInputs, show: str,
+          texture: np.ndarray | None, light: np.ndarray) -> np.ndarray:
+    """Colour every covered pixel from its interpolated attributes.
+
+    ``uv`` shows the texture, ``color`` the vertex colours, ``normal`` the unit
+    normal as RGB, ``shaded`` the texture (or grey without uv) lit by a
+    two-sided Lambert term.
+
+    Parameters
+    ----------
+    attrs : (H, W, K) float, the rasterizer's interpolated attributes
+    covered : (H, W) bool
+    show : one of SHOW_MODES
+    texture : (h, w, 3) float32, sampled where ``inputs.uv`` is set
+    light : (3,) unit vector toward the light
+
+    Returns
+    -------
+    (H, W, 3) float32 RGB in [0, 1], background where not covered.
+    """
+    from .texture import sample_bilinear
+
+    values = attrs[covered]
+    if show == "color":
+        colour = values[:, inputs.color]
+    elif inputs.uv is not None:
+        colour = sample_bilinear(texture, values[:, inputs.uv])
+    else:
+        colour = np.full((len(values), 3), 0.8)
+    if show in ("normal", "shaded"):
+        n = values[:, inputs.normal]
+        n = n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+        colour = 0.5 * (n + 1.0) if show == "normal" else colour * (0.15 + 0.85 * np.abs(n @ light))[:, None]
+    image = np.broadcast_to(BACKGROUND, covered.shape + (3,)).copy()
+    image[covered] = np.clip(colour, 0.0, 1.0)
+    return image
