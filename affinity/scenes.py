@@ -73,9 +73,14 @@ def color_squares() -> Mesh:
     return mesh_from_polygons("color_squares", positions, [[0, 1, 2, 3], [4, 5, 6, 7]], colors=colors)
 
 
+def demo_sphere() -> Mesh:
+    """The demo sphere: 16 x 8 quads, as coarse as Bloomenthal's Fig. 9."""
+    return latlong_sphere(16, 8)
+
+
 DEMO = {
     "trapezoid.obj": trapezoid,
-    "sphere.obj": lambda: latlong_sphere(32, 16),
+    "sphere.obj": demo_sphere,
     "color_squares.obj": color_squares,
 }
 

@@ -8,10 +8,10 @@ from __future__ import annotations
 
 import numpy as np
 
-CHECKS = 16
+CHECKS = 32
 
 
-def checker(size: int = 512, checks: int = CHECKS) -> np.ndarray:
+def checker(size: int = 1024, checks: int = CHECKS) -> np.ndarray:
     """A checker with thin grid lines, so a bent diagonal stands out.
 
     Returns

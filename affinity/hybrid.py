@@ -1,0 +1,196 @@
+"""The hybrid render: every quad drawn as two triangles, except those whose split error shows.
+
+``render_mesh`` loads a mesh, frames it, decides per quad between ``split`` and
+``mvc`` (``affinity.routing``), calls ``render.rasterize_quads`` with that
+per-quad method array, and shades the result.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from .mesh import Mesh
+from .rendering import OVERLAY_TINT, render_corners, shade, shading_inputs
+from .routing import MVC, SPLIT, route_by_view
+
+UP_AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
+#: Default view direction (from the target toward the eye) for each up axis: in front, to the right, above.
+VIEW_DIRECTIONS = {"x": (1.0, 0.6, 0.5), "y": (0.6, 0.5, 1.0), "z": (0.6, -1.0, 0.5)}
+#: The demo: the lat-long sphere (z up) seen from above the equator, the pole rows in view.
+DEMO_CAMERA = ((0.0, -2.9, 2.1), (0.0, 0.0, 0.05), 40.0)
+#: The lint rule that decides ``--route lint`` for each thing shown.
+LINT_RULE_OF_ATTRIBUTE = {"uv": "Q101", "color": "Q102", "normal": "Q103"}
+
+
+@dataclass
+class RenderOptions:
+    """How to render: see ``affinity render --help`` for each option's meaning."""
+
+    method: str = "hybrid"
+    route: str = "view"
+    pixel_tolerance: float = 0.5
+    width: int = 800
+    height: int = 600
+    camera: tuple | None = None
+    up: str | None = None
+    show: str | None = None
+    texture: str | None = None
+    overlay: bool = False
+    cull: bool = False
+
+
+@dataclass
+class RenderResult:
+    """A finished render.
+
+    Attributes
+    ----------
+    image : (H, W, 3) float32 RGB in [0, 1]
+    frame : render.Frame, ``face`` indexes the render quads
+    faces : (R,) int64, the mesh face of each render quad
+    methods : (R,) str, the method each render quad was drawn with
+    """
+
+    mesh: Mesh
+    image: np.ndarray
+    frame: object
+    faces: np.ndarray
+    methods: np.ndarray
+    method: str
+    seconds: float
+
+    def summary(self) -> str:
+        """One line: where the quads went and how long the render took."""
+        mvc = int(np.count_nonzero(self.methods == MVC))
+        return (f"{self.mesh.path}: {self.method}: {mvc} of {len(self.methods)} quads to mvc, "
+                f"{len(self.methods) - mvc} to split ({self.seconds:.2f} s)")
+
+    def save_png(self, path: str) -> None:
+        """Write the image as PNG, atomically (Pillow)."""
+        from PIL import Image
+
+        from .atomic import atomic_write
+
+        pixels = np.round(self.image * 255.0).astype(np.uint8)
+        with atomic_write(path, binary=True) as f:
+            Image.fromarray(pixels).save(f, format="PNG")
+
+
+def default_show(mesh: Mesh) -> str:
+    if mesh.texcoords is not None:
+        return "uv"
+    return "color" if mesh.colors is not None else "shaded"
+
+
+def camera_for(mesh: Mesh, options: RenderOptions, is_demo: bool):
+    """The camera of the options, or one that frames the mesh (the demo has its own)."""
+    from render.camera import Camera, frame_bounds
+
+    aspect = options.width / options.height
+    up_axis = options.up or ("z" if is_demo else "y")
+    up = UP_AXES[up_axis]
+    chosen = options.camera or (DEMO_CAMERA if is_demo else None)
+    if chosen is None:
+        used = np.unique(mesh.corner_vertex)
+        points = mesh.positions[used]
+        return frame_bounds(points.min(axis=0), points.max(axis=0), aspect=aspect, up=up,
+                            direction=VIEW_DIRECTIONS[up_axis])
+    eye, target, fov = chosen
+    distance = float(np.linalg.norm(np.subtract(eye, target)))
+    if not distance > 0:
+        raise ValueError("--camera: the eye and the target coincide")
+    extent = float(np.ptp(mesh.positions, axis=0).max()) if len(mesh.positions) else 1.0
+    far = distance + 2.0 * max(extent, distance)
+    return Camera(eye=tuple(eye), target=tuple(target), up=up, fov_y=fov, aspect=aspect,
+                  near=far * 1e-4, far=far)
+
+
+def choose_methods(mesh: Mesh, faces: np.ndarray, corners: np.ndarray, clip: np.ndarray,
+                   show: str, options: RenderOptions) -> np.ndarray:
+    """The method of every render quad: one name, or the hybrid's per-quad routing.
+
+    Routing by view uses the uv misplacement (along the renderer's diagonal
+    0-2) times the quad's on-screen scale; for colours and normals, and with
+    ``--route lint``, the lint rule of the attribute shown decides.
+    """
+    if options.method != "hybrid":
+        return np.full(len(faces), options.method)
+    routes_uv = show in ("uv", "shaded") and mesh.texcoords is not None
+    if options.route == "view" and routes_uv:
+        from .lint import quad_uv_misplacement
+
+        quad_faces, m = quad_uv_misplacement(mesh, diagonal="02")
+        per_face = np.zeros(mesh.n_faces)
+        per_face[quad_faces] = np.nan_to_num(m)
+        uv = np.nan_to_num(mesh.corner_attribute("texcoords", corners))
+        return route_by_view(per_face[faces], uv, clip, options.width, options.height,
+                             options.pixel_tolerance, options.cull)
+    from .lint import lint_mesh
+    from .settings import Settings
+
+    code = LINT_RULE_OF_ATTRIBUTE["uv" if routes_uv else ("color" if show == "color" else "normal")]
+    flagged = np.zeros(mesh.n_faces, dtype=bool)
+    for hits in lint_mesh(mesh, Settings(select=[code], diagonal="02")):
+        flagged[hits.faces] = True
+    return np.where(flagged[faces], MVC, SPLIT)
+
+
+def resolve_texture(mesh: Mesh, options: RenderOptions, warn: Callable[[str], None]) -> np.ndarray:
+    """The explicit ``--texture`` (errors are fatal), else map_Kd (a missing one warns), else the checker."""
+    from .texture import TextureError, checker, load_image
+
+    if options.texture:
+        return load_image(options.texture)
+    path = mesh.texture_path()
+    if path:
+        try:
+            return load_image(path)
+        except TextureError as err:
+            warn(f"{err}; using the checker texture")
+    return checker()
+
+
+def render_mesh(path: str | None, options: RenderOptions, warn: Callable[[str], None] = lambda line: None) -> RenderResult:
+    """Load (or build the demo), route, rasterize and shade.
+
+    Raises
+    ------
+    MeshError for an unreadable mesh; TextureError for an explicit texture that
+    cannot be read; ValueError for a mesh that cannot be rendered (no faces,
+    everything behind the camera, nothing of what ``show`` needs).
+    """
+    from render import rasterize_quads, to_clip
+
+    from .loaders import load
+    from .scenes import demo_sphere
+
+    mesh = demo_sphere() if path is None else load(path)
+    if mesh.n_faces == 0:
+        raise ValueError(f"{mesh.path}: the mesh has no faces to render")
+    show = options.show or default_show(mesh)
+    faces, corners = render_corners(mesh)
+    inputs = shading_inputs(mesh, corners, show)
+    camera = camera_for(mesh, options, is_demo=path is None)
+    clip = to_clip(mesh.positions, camera.matrix)[mesh.corner_vertex[corners]]
+    if not (clip[..., 3] > 0).any():
+        raise ValueError(f"{mesh.path}: all geometry is behind the camera")
+    texture = resolve_texture(mesh, options, warn) if inputs.uv is not None else None
+
+    start = time.perf_counter()
+    methods = choose_methods(mesh, faces, corners, clip, show, options)
+    frame = rasterize_quads(clip, inputs.attrs, options.width, options.height, method=methods,
+                            cull_backfaces=options.cull)
+    seconds = time.perf_counter() - start
+    covered = frame.face >= 0
+    if not covered.any():
+        warn(f"{mesh.path}: nothing is in view (try --camera)")
+    direction = np.subtract(camera.eye, camera.target)
+    image = shade(frame.attrs, covered, inputs, show, texture, direction / np.linalg.norm(direction))
+    if options.overlay:
+        routed = covered & (methods[np.maximum(frame.face, 0)] == MVC)
+        image[routed] = 0.55 * image[routed] + 0.45 * OVERLAY_TINT
+    return RenderResult(mesh, image, frame, faces, methods, options.method, seconds)
