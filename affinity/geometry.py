@@ -1,0 +1,330 @@
+"""Quad shape: each quad in its own plane, and the shape measures of rules Q201-Q204, Q301-Q302.
+
+Every function is vectorized over Q quads whose corners come in face order,
+``corners`` (Q, 4, D) float64 with D = 3 (positions) or D = 2 (texture
+coordinates). Tolerances are relative to the quad's size (its longest edge),
+never absolute, so a millimetre asset and a kilometre terrain are judged alike.
+
+The central quantities are the four triangle areas
+
+    T_i = 2 * signed area of the triangle (p_{i+1}, p_{i+2}, p_{i+3})   (indices mod 4),
+
+the triangle opposite corner i, in the quad's own plane (counter-clockwise
+positive around the plane normal). They are also the corner turns: the turn at
+corner k, cross(p_k - p_{k-1}, p_{k+1} - p_k), is T_{k+2}. T_0 + T_2 = T_1 + T_3
+is twice the quad's signed area. The affinity test (``affinity.measures``) and the
+shape rules here are all read off them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+
+#: A triangle or quad whose area is at most this fraction of the square of its
+#: quad's longest edge counts as degenerate (its barycentric coordinates are not
+#: used). The same figure is rule Q201's default threshold.
+DEGENERATE_AREA = 1e-9
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(..., D), (..., D) -> (...) dot products."""
+    return np.einsum("...d,...d->...", a, b)
+
+
+def lengths(vectors: np.ndarray) -> np.ndarray:
+    """(..., D) -> (...) Euclidean lengths (faster than ``np.linalg.norm`` on short vectors)."""
+    return np.sqrt(_dot(vectors, vectors))
+
+
+def _unit(vectors: np.ndarray) -> np.ndarray:
+    """(..., D) vectors scaled to length 1; zero vectors stay zero."""
+    length = lengths(vectors)[..., None]
+    return np.divide(vectors, length, out=np.zeros_like(vectors), where=length > 0)
+
+
+def _cross2(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(..., 2), (..., 2) -> (...) the z component of a x b."""
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def _corner_major(corners: np.ndarray) -> np.ndarray:
+    """(Q, 4, D) -> (4, Q, D) copy, so that each corner p_k is one contiguous block and
+    combining corners streams through memory."""
+    return np.ascontiguousarray(np.moveaxis(corners, 1, 0))
+
+
+# Corner-major helpers: ``p`` is (4, Q, D), p[k] the k-th corner of every quad.
+_NEXT, _OPPOSITE, _PREVIOUS = [1, 2, 3, 0], [2, 3, 0, 1], [3, 0, 1, 2]
+
+
+def _longest_edge(p: np.ndarray) -> np.ndarray:
+    """(Q,) length of the longest edge p_{k+1} - p_k."""
+    edges = p[_NEXT] - p
+    return np.sqrt(_dot(edges, edges).max(axis=0))
+
+
+def _diagonals_parallel(n: np.ndarray, d02: np.ndarray, d13: np.ndarray) -> np.ndarray:
+    """(Q,) bool: |d02 x d13| is at most the degenerate tolerance times |d02| |d13|
+    (the diagonals are parallel, or one of them has collapsed)."""
+    return lengths(n) <= DEGENERATE_AREA * lengths(d02) * lengths(d13)
+
+
+def _normals(p: np.ndarray) -> np.ndarray:
+    """(Q, 3) quad normals of 3-D corners; see ``quad_normals``."""
+    d02, d13 = p[2] - p[0], p[3] - p[1]
+    normals = np.cross(d02, d13)
+    weak = _diagonals_parallel(normals, d02, d13)
+    if weak.any():
+        quads = p[:, weak]
+        corner_normals = np.cross(quads - quads[_PREVIOUS], quads[_NEXT] - quads)
+        largest = lengths(corner_normals).argmax(axis=0)
+        normals[weak] = corner_normals[largest, np.arange(quads.shape[1])]
+    return normals
+
+
+def _orthonormal_basis(normal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Unit vectors e1, e2 (Q, 3) with e1 x e2 = normal, for unit normals (Q, 3).
+
+    Branchless construction of Duff et al., "Building an Orthonormal Basis,
+    Revisited", JCGT 6(1), 2017 (Listing 3). A zero normal gets e1 = x, e2 = y.
+    """
+    x, y, z = normal.T
+    sign = np.copysign(1.0, z)
+    a = -1.0 / (sign + z)
+    b = x * y * a
+    e1 = np.stack([1.0 + sign * x * x * a, sign * b, -sign * x], axis=1)
+    e2 = np.stack([b, sign + y * y * a, -y], axis=1)
+    return e1, e2
+
+
+def _plane_coordinates(p: np.ndarray) -> np.ndarray:
+    """(4, Q, 2) in-plane coordinates of 3-D corners; see ``plane_coordinates``."""
+    e1, e2 = _orthonormal_basis(_unit(_normals(p)))
+    # Offsets from corner 0 first, so coordinates far from the origin keep their digits.
+    offsets = p - p[0]
+    xy = np.stack([_dot(offsets, e1), _dot(offsets, e2)], axis=2)
+    xy -= xy.mean(axis=0)
+    return xy
+
+
+def _opposite_areas(xy: np.ndarray) -> np.ndarray:
+    """(Q, 4) T_i of 2-D corners (4, Q, 2): twice the signed area of the triangle
+    (p_{i+1}, p_{i+2}, p_{i+3})."""
+    first = xy[_NEXT]
+    return _cross2(xy[_OPPOSITE] - first, xy[_PREVIOUS] - first).T
+
+
+def quad_normals(corners: np.ndarray) -> np.ndarray:
+    """Normals of the quads' own planes, following the face winding (right-hand rule).
+
+    The normal is the cross product of the diagonals, n = (p2 - p0) x (p3 - p1),
+    twice the quad's vector area (design.md). Where the diagonals are parallel (a
+    symmetric bow-tie, whose two lobes cancel, or a collapsed diagonal) the
+    largest corner normal (p_k - p_{k-1}) x (p_{k+1} - p_k) stands in; it is zero
+    only when all four corners are collinear.
+
+    Parameters
+    ----------
+    corners : (Q, 4, 3) float64
+
+    Returns
+    -------
+    (Q, 3) float64, not normalized.
+    """
+    return _normals(_corner_major(corners))
+
+
+def plane_coordinates(corners: np.ndarray) -> np.ndarray:
+    """Project each quad onto its own plane: the plane through the centroid of its
+    corners with normal ``quad_normals(corners)``.
+
+    This replaces Listing 3's area sign taken from ``v.z`` (Bloomenthal 2022),
+    which is wrong for quads facing sideways: the in-plane basis (e1, e2) is
+    orthonormal with e1 x e2 = n / |n|, so 2-D signed areas are the 3-D vector
+    areas measured along the quad's own normal.
+
+    Parameters
+    ----------
+    corners : (Q, 4, 3) float64
+
+    Returns
+    -------
+    (Q, 4, 2) float64 in-plane coordinates, centroid at the origin; lengths and
+    angles are preserved for planar quads.
+    """
+    return np.moveaxis(_plane_coordinates(_corner_major(corners)), 0, 1)
+
+
+@dataclass(frozen=True)
+class PlanarQuads:
+    """Quads seen in their own planes, with what the measures share.
+
+    Attributes
+    ----------
+    xy : (Q, 4, 2) float64
+        In-plane corners.
+    areas : (Q, 4) float64
+        T_i, twice the signed area of the triangle (p_{i+1}, p_{i+2}, p_{i+3})
+        opposite corner i, counter-clockwise positive.
+    size : (Q,) float64
+        Longest edge, measured on the original corners.
+    diagonals : (Q, 2) float64
+        Lengths of the diagonals 0-2 and 1-3, measured on the original corners.
+    """
+
+    xy: np.ndarray
+    areas: np.ndarray
+    size: np.ndarray
+    diagonals: np.ndarray
+
+    @cached_property
+    def valid(self) -> np.ndarray:
+        """(Q, 4) bool: the triangle opposite corner i is not degenerate
+        (its area exceeds ``DEGENERATE_AREA`` times the squared longest edge)."""
+        return np.abs(self.areas) > self.tolerance[:, None]
+
+    @cached_property
+    def tolerance(self) -> np.ndarray:
+        """(Q,) float64: the largest T_i (twice an area) that counts as zero."""
+        return 2 * DEGENERATE_AREA * self.size**2
+
+    def take(self, rows) -> PlanarQuads:
+        """The quads selected by ``rows`` (an index array, a boolean mask or a slice)."""
+        return PlanarQuads(self.xy[rows], self.areas[rows], self.size[rows], self.diagonals[rows])
+
+    def __len__(self) -> int:
+        return len(self.areas)
+
+
+def planar_quads(corners: np.ndarray) -> PlanarQuads:
+    """Build :class:`PlanarQuads` from 3-D corners (projected with ``plane_coordinates``)
+    or 2-D corners (texture coordinates, used as they are).
+
+    Parameters
+    ----------
+    corners : (Q, 4, 3) or (Q, 4, 2) float64
+    """
+    p = _corner_major(np.asarray(corners, dtype=np.float64))
+    xy = _plane_coordinates(p) if p.shape[-1] == 3 else p
+    diagonals = np.stack([lengths(p[2] - p[0]), lengths(p[3] - p[1])], axis=1)
+    return PlanarQuads(np.moveaxis(xy, 0, 1), _opposite_areas(xy), _longest_edge(p), diagonals)
+
+
+def _relative(area: np.ndarray, size: np.ndarray) -> np.ndarray:
+    """area / size**2, and 0 where the size is 0."""
+    scale = size**2
+    return np.divide(area, scale, out=np.zeros_like(area), where=scale > 0)
+
+
+def degeneracy(quads: PlanarQuads) -> np.ndarray:
+    """Area of the smallest of the four split triangles, relative to the squared longest edge.
+
+    The triangles opposite the corners are the two triangles of either diagonal
+    split, so a repeated corner, a collapsed edge, three collinear corners or a
+    zero-area quad all give 0. Rule Q201 flags values at or below its threshold;
+    with the default threshold those are exactly the quads where the affinity test
+    skips a corner.
+
+    Returns
+    -------
+    (Q,) float64 in [0, ~0.5].
+    """
+    return _relative(np.abs(quads.areas).min(axis=1) / 2, quads.size)
+
+
+def relative_signed_area(quads: PlanarQuads) -> np.ndarray:
+    """The quads' signed area (T_0 + T_2) / 2 relative to the squared longest edge.
+
+    Meaningful for 2-D corners (texture coordinates: negative = clockwise, a
+    mirrored UV, rule Q302; near zero = rule Q301). For 3-D corners it is never
+    negative, since the plane's normal follows the diagonals.
+
+    Returns
+    -------
+    (Q,) float64, 0 for a quad collapsed to a point.
+    """
+    return _relative((quads.areas[:, 0] + quads.areas[:, 2]) / 2, quads.size)
+
+
+def nonplanarity(corners: np.ndarray) -> np.ndarray:
+    """Warp: distance between the two diagonals relative to their mean length.
+
+    w = |(p1 - p0) . n| / (|n| (|p2 - p0| + |p3 - p1|) / 2),  n = (p2 - p0) x (p3 - p1).
+
+    This is the absolute value of libigl's ``igl.quad_planarity`` (which keeps the
+    sign of the triple product, and guards |n| by an absolute 1e-8). Where the
+    diagonals are parallel (|n| <= ``DEGENERATE_AREA`` |p2 - p0| |p3 - p1|) the quad
+    lies in a plane and w = 0.
+
+    Parameters
+    ----------
+    corners : (Q, 4, 3) float64
+
+    Returns
+    -------
+    (Q,) float64, 0 for planar quads.
+    """
+    d02 = corners[:, 2] - corners[:, 0]
+    d13 = corners[:, 3] - corners[:, 1]
+    n = np.cross(d02, d13)
+    distance = np.abs(_dot(corners[:, 1] - corners[:, 0], n))
+    denominator = lengths(n) * (lengths(d02) + lengths(d13)) / 2
+    planar = _diagonals_parallel(n, d02, d13)
+    return np.divide(distance, denominator, out=np.zeros_like(distance), where=~planar)
+
+
+def _reflex(quads: PlanarQuads) -> np.ndarray:
+    """(Q, 4) bool: corner turns that go clockwise, beyond the degenerate tolerance."""
+    return quads.areas < -quads.tolerance[:, None]
+
+
+def is_bowtie(quads: PlanarQuads) -> np.ndarray:
+    """Quads that cross themselves in their own plane.
+
+    The plane's normal makes T_0 + T_2 = T_1 + T_3 >= 0, so at most one turn of
+    each opposite pair is clockwise: one clockwise turn is a reflex corner
+    (concave quad), two are the two sides of a crossing (bow-tie).
+
+    Returns
+    -------
+    (Q,) bool
+    """
+    return _reflex(quads).sum(axis=1) == 2
+
+
+def folded_fraction(quads: PlanarQuads) -> np.ndarray:
+    """Share of the corner-turn area that turns clockwise: sum of |T_i| over clockwise
+    turns / sum of |T_i|. In (0, 0.5] for a bow-tie (0.5 for a symmetric one),
+    0 for a convex quad.
+
+    Returns
+    -------
+    (Q,) float64
+    """
+    magnitude = np.abs(quads.areas)
+    folded = np.where(_reflex(quads), magnitude, 0).sum(axis=1)
+    total = magnitude.sum(axis=1)
+    return np.divide(folded, total, out=np.zeros_like(total), where=total > 0)
+
+
+def interior_angles(quads: PlanarQuads) -> np.ndarray:
+    """Interior angle at every corner in the quad's plane, in degrees.
+
+    angle_k = 180 - atan2(turn_k, e_in . e_out) in degrees, with e_in = p_k - p_{k-1},
+    e_out = p_{k+1} - p_k and turn_k = e_in x e_out; above 180 at a reflex corner.
+    Turns within the degenerate tolerance are taken as exactly 0, so three
+    collinear corners read 180, not a reflex 180 plus rounding. Meaningful for
+    simple (non-bow-tie) quads.
+
+    Returns
+    -------
+    (Q, 4) float64
+    """
+    e_out = np.roll(quads.xy, -1, axis=1) - quads.xy
+    e_in = np.roll(e_out, 1, axis=1)
+    turn = _cross2(e_in, e_out)
+    turn[np.abs(turn) <= quads.tolerance[:, None]] = 0.0
+    return 180.0 - np.degrees(np.arctan2(turn, np.einsum("qkd,qkd->qk", e_in, e_out)))

@@ -1,0 +1,143 @@
+"""Quad shape measures: own plane, warp (against libigl), degenerate, concave, bow-tie, UV area."""
+
+import numpy as np
+import pytest
+
+from affinity.geometry import (
+    DEGENERATE_AREA,
+    degeneracy,
+    folded_fraction,
+    interior_angles,
+    is_bowtie,
+    nonplanarity,
+    plane_coordinates,
+    planar_quads,
+    quad_normals,
+    relative_signed_area,
+)
+
+SQUARE = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
+DART = np.array([[0, 0], [2, 1], [4, 0], [2, 3]], float)  # reflex at corner 1
+BOWTIE = np.array([[0, 0], [1, 1], [1, 0], [0, 1]], float)  # symmetric: lobes cancel
+BOWTIE_SKEWED = np.array([[0, 0], [2, 0], [0, 1], [1, 1]], float)
+
+
+def random_rotation(rng):
+    q, r = np.linalg.qr(rng.normal(size=(3, 3)))
+    q *= np.sign(np.diag(r))
+    return q if np.linalg.det(q) > 0 else -q
+
+
+def lift(xy, rotation=np.eye(3), offset=(0, 0, 0)):
+    """(4, 2) plane corners -> (1, 4, 3) corners in 3-D: z = 0, then rotated and moved."""
+    corners = np.column_stack([xy, np.zeros(len(xy))])
+    return (corners @ rotation.T + offset)[None]
+
+
+def pairwise_distances(points):
+    return np.linalg.norm(points[..., :, None, :] - points[..., None, :, :], axis=-1)
+
+
+def test_plane_coordinates_keep_distances_and_orientation_of_planar_quads():
+    rng = np.random.default_rng(1)
+    for _ in range(20):
+        xy = rng.normal(size=(4, 2))
+        xy = xy[np.argsort(np.arctan2(*(xy - xy.mean(0)).T[::-1]))]  # counter-clockwise convex-ish
+        corners = lift(xy, random_rotation(rng), rng.normal(size=3) * 100)
+        projected = plane_coordinates(corners)
+        np.testing.assert_allclose(pairwise_distances(projected), pairwise_distances(xy[None]), atol=1e-9)
+        np.testing.assert_allclose(projected.mean(axis=1), 0, atol=1e-9)
+        # counter-clockwise in its plane, as the face is wound: positive shoelace area
+        x, y = projected[0].T
+        assert np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y) > 0
+
+
+def test_normal_follows_the_winding_also_for_quads_facing_sideways():
+    np.testing.assert_allclose(quad_normals(lift(SQUARE)), [[0, 0, 2]])
+    to_wall = np.array([[1, 0, 0], [0, 0, 1], [0, -1, 0]], float)  # z -> y: the x-z plane
+    wall = lift(SQUARE, to_wall)
+    np.testing.assert_allclose(quad_normals(wall), [to_wall @ [0, 0, 2]])
+    assert (planar_quads(wall).areas > 0).all()
+
+
+@pytest.mark.parametrize("scale", [1e-6, 1.0, 1e6])
+def test_warp_agrees_with_libigl_quad_planarity(scale):
+    igl = pytest.importorskip("igl")
+    rng = np.random.default_rng(2)
+    base = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], float)
+    corners = (base + rng.normal(scale=0.2, size=(200, 4, 3))) * scale
+    reference = igl.quad_planarity(corners.reshape(-1, 3), np.arange(800).reshape(-1, 4))
+    if scale < 1:  # libigl guards its denominator with an absolute 1e-8 and gives 0
+        assert (reference == 0).all()
+    else:
+        np.testing.assert_allclose(nonplanarity(corners), np.abs(reference), rtol=1e-9)
+    np.testing.assert_allclose(nonplanarity(corners), nonplanarity(corners / scale), rtol=1e-9)
+
+
+def test_warp_of_a_lifted_corner_is_the_diagonals_distance_over_their_mean_length():
+    h = 0.3
+    corners = lift(SQUARE)
+    corners[0, 2, 2] = h  # unit square with corner 2 lifted
+    p0, p1, p2, p3 = corners[0]
+    # closest points of the two diagonal lines p0 + s (p2 - p0) and p1 + t (p3 - p1)
+    (s, t), *_ = np.linalg.lstsq(np.column_stack([p2 - p0, p1 - p3]), p1 - p0, rcond=None)
+    distance = np.linalg.norm(p0 + s * (p2 - p0) - p1 - t * (p3 - p1))
+    expected = distance / ((np.linalg.norm(p2 - p0) + np.linalg.norm(p3 - p1)) / 2)
+    np.testing.assert_allclose(nonplanarity(corners), [expected])
+    assert 0 < expected < h
+    assert nonplanarity(lift(SQUARE, np.eye(3)[[2, 0, 1]]))[0] == 0
+
+
+@pytest.mark.parametrize("scale", [1e-6, 1.0, 1e6])
+def test_degeneracy(scale):
+    square = lift(SQUARE) * scale
+    pole = lift(np.array([[0, 0], [1, 0], [0.5, 1], [0.5, 1]])) * scale  # repeated corner
+    collapsed_edge = lift(np.array([[0, 0], [1, 0], [1, 1], [1, 1 + 1e-13]])) * scale
+    straight_corner = lift(np.array([[0, 0], [1, 0], [2, 0], [1, 1]])) * scale
+    segment = lift(np.array([[0, 0], [1, 0], [2, 0], [3, 0]])) * scale
+    point = np.zeros((1, 4, 3))
+    quads = planar_quads(np.concatenate([square, pole, collapsed_edge, straight_corner, segment, point]))
+    values = degeneracy(quads)
+    np.testing.assert_allclose(values[0], 0.5)  # smallest split triangle: half the unit square
+    assert (values[1:] <= DEGENERATE_AREA).all()
+    assert np.isfinite(values).all()
+
+
+def test_valid_corners_of_a_pole_quad_are_the_two_away_from_the_repeated_corner():
+    pole = lift(np.array([[0, 0], [1, 0], [0.5, 1], [0.5, 1]]))
+    np.testing.assert_array_equal(planar_quads(pole).valid, [[False, False, True, True]])
+
+
+def test_interior_angles():
+    angles = interior_angles(planar_quads(np.concatenate([lift(SQUARE), lift(DART)])))
+    np.testing.assert_allclose(angles[0], 90)
+    reflex = 360 - 2 * np.degrees(np.arctan2(2, 1))  # the dart's corner 1: two 1:2 slopes
+    np.testing.assert_allclose(angles[1, 1], reflex)
+    np.testing.assert_allclose(angles.sum(axis=1), 360)
+    straight = interior_angles(planar_quads(lift(np.array([[0, 0], [1, 0], [2, 0], [1, 1]]))))
+    np.testing.assert_allclose(straight[0, 1], 180)
+
+
+def test_concave_and_bowtie_are_told_apart_in_any_orientation():
+    rng = np.random.default_rng(3)
+    shapes = [SQUARE, DART, BOWTIE, BOWTIE_SKEWED, DART[::-1]]
+    wall = np.array([[1, 0, 0], [0, 0, 1], [0, 1, 0]], float)  # the x-z plane, facing sideways
+    for rotation in [np.eye(3), wall] + [random_rotation(rng) for _ in range(10)]:
+        offset = rng.normal(size=3)
+        quads = planar_quads(np.concatenate([lift(s, rotation, offset) for s in shapes]))
+        np.testing.assert_array_equal(is_bowtie(quads), [False, False, True, True, False])
+        reflex = interior_angles(quads).max(axis=1) > 180
+        np.testing.assert_array_equal(reflex[[0, 1, 4]], [False, True, True])
+
+
+def test_folded_fraction():
+    quads = planar_quads(np.concatenate([lift(SQUARE), lift(BOWTIE), lift(BOWTIE_SKEWED)]))
+    # skewed bow-tie turns: +2, +2, -1, -1 (twice the corner triangle areas)
+    np.testing.assert_allclose(folded_fraction(quads), [0, 0.5, 2 / 6])
+
+
+def test_relative_signed_area_of_uv_quads():
+    uv = np.stack([SQUARE, SQUARE[::-1], SQUARE * 1e-7 + 0.3, np.full((4, 2), 0.5), SQUARE * [1, 1e-12]])
+    area = relative_signed_area(planar_quads(uv))
+    np.testing.assert_allclose(area[:3], [1, -1, 1])
+    assert area[3] == 0 and abs(area[4]) <= DEGENERATE_AREA
