@@ -1,24 +1,43 @@
-"""Resolved lint settings (defaults here; files and flags layer on top)."""
+"""Resolved lint settings: defaults here; configuration files and flags layer on top.
+
+Layering (lowest first): the defaults of :class:`Settings`, the configuration
+file that governs a path (``affinity.toml`` or ``[tool.affinity]`` in
+``pyproject.toml``, see :mod:`affinity.config`), then the command-line flags.
+Each layer replaces the values it names; ``thresholds`` merge per rule, so a
+flag ``--threshold Q102=3`` keeps a configured Q101 threshold.
+
+Path globs (``exclude``, the keys of ``per_file_ignores``) are relative to
+``root``, the folder of the configuration file that set them, and match the
+file's path relative to it with ``/`` separators (:func:`glob_matches`).
+"""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import os
+from dataclasses import dataclass, field, replace
+from fnmatch import fnmatchcase
 
 from .rules import RULES
 
 #: The paper's own tolerance for the dimensionless barycentric reading.
 BARYCENTRIC_TOLERANCE = 0.01
 
+MEASURES = ("misplacement", "barycentric")
+DIAGONALS = ("both", "02", "13", "shortest")
+
 
 @dataclass
 class Settings:
-    """What ``affinity check`` measures and where it draws the line.
+    """What ``affinity check`` measures, where it draws the line, and which files it skips.
 
     ``thresholds`` maps rule codes to thresholds in the rule's unit; rules not in
     it use their default. ``measure`` picks the reading used for Q101-Q103:
     ``"misplacement"`` (attribute units) or ``"barycentric"`` (the paper's
-    dimensionless score; defined for uv only, so Q102/Q103 keep misplacement). ``diagonal`` picks which split the affinity
-    test measures: ``"both"``, ``"02"``, ``"13"`` or ``"shortest"``.
+    dimensionless score; defined for uv only, so Q102/Q103 keep misplacement).
+    ``diagonal`` picks which split the affinity test measures: ``"both"``,
+    ``"02"``, ``"13"`` or ``"shortest"``. ``exclude`` lists globs of files not
+    to check; ``per_file_ignores`` maps a glob to rule codes (or prefixes)
+    ignored in the files it matches; both are relative to ``root``.
     """
 
     select: list[str] | None = None
@@ -27,6 +46,9 @@ class Settings:
     measure: str = "misplacement"
     diagonal: str = "both"
     texture_size: int = 1024
+    exclude: list[str] = field(default_factory=list)
+    per_file_ignores: dict[str, list[str]] = field(default_factory=dict)
+    root: str | None = None
 
     def threshold(self, code: str) -> float | None:
         if code in self.thresholds:
@@ -34,3 +56,66 @@ class Settings:
         if self.measure == "barycentric" and code == "Q101":
             return BARYCENTRIC_TOLERANCE
         return RULES[code].default_threshold
+
+    def updated(self, options: dict) -> Settings:
+        """A copy with ``options`` (field name -> value) applied on top; thresholds merge per rule."""
+        thresholds = {**self.thresholds, **options.get("thresholds", {})}
+        return replace(self, **{**options, "thresholds": thresholds})
+
+    def relative(self, path: str) -> str | None:
+        """``path`` relative to ``root`` with ``/`` separators, or None when it lies outside."""
+        if self.root is None:
+            return None
+        rel = os.path.relpath(os.path.abspath(path), self.root)
+        return None if rel.startswith("..") else rel.replace(os.sep, "/")
+
+    def is_excluded(self, path: str) -> bool:
+        """Whether an ``exclude`` glob matches ``path``."""
+        rel = self.relative(path)
+        return rel is not None and any(glob_matches(pattern, rel) for pattern in self.exclude)
+
+    def for_file(self, path: str) -> Settings:
+        """The settings to lint ``path`` with: ``ignore`` extended by the matching per-file ignores."""
+        rel = self.relative(path)
+        extra = [
+            code
+            for pattern, codes in self.per_file_ignores.items()
+            if rel is not None and glob_matches(pattern, rel)
+            for code in codes
+        ]
+        return replace(self, ignore=[*(self.ignore or []), *extra]) if extra else self
+
+
+def glob_matches(pattern: str, rel: str) -> bool:
+    """Whether a path glob matches the relative path ``rel`` (``/``-separated).
+
+    A pattern without ``/`` matches any single component (``"*.ply"`` any PLY
+    file, ``"legacy"`` everything in a folder named legacy, at any depth). A
+    pattern with ``/`` is anchored at the root and matches the path or one of
+    its folders (``"assets/old"``, ``"assets/*/wip/*.obj"``); ``*`` crosses
+    folders and ``**/`` may also match no folder at all.
+
+    >>> glob_matches("*.ply", "a/b/c.ply"), glob_matches("legacy", "x/legacy/c.obj")
+    (True, True)
+    >>> glob_matches("assets/old", "assets/old/c.obj"), glob_matches("assets/old", "x/assets/old/c.obj")
+    (True, False)
+    >>> glob_matches("assets/**/c.obj", "assets/c.obj")
+    True
+    """
+    parts = rel.split("/")
+    pattern = pattern.strip("/")
+    if "/" not in pattern:
+        return any(fnmatchcase(part, pattern) for part in parts)
+    variants = {pattern, pattern.replace("**/", "")}
+    prefixes = ("/".join(parts[:i]) for i in range(1, len(parts) + 1))
+    return any(fnmatchcase(prefix, v) for prefix in prefixes for v in variants)
+
+
+def unknown_codes(prefixes: list[str]) -> list[str]:
+    """The entries of ``prefixes`` that select no rule (``"ALL"`` and any prefix of a code are fine)."""
+    return [p for p in prefixes if p != "ALL" and not any(code.startswith(p) for code in RULES)]
+
+
+def unthresholded_codes(codes: list[str]) -> list[str]:
+    """The entries of ``codes`` that are not rules with a threshold."""
+    return [c for c in codes if c not in RULES or RULES[c].default_threshold is None]

@@ -1,8 +1,15 @@
-"""``affinity check PATH...``: lint mesh files (see design.md for output and exit codes)."""
+"""``affinity check PATH...``: lint mesh files (see design.md for output and exit codes).
+
+Settings come from the configuration file governing each file (``affinity.toml``
+or ``[tool.affinity]`` in ``pyproject.toml``, see :mod:`affinity.config`);
+every flag given on the command line replaces the configured value of its key
+(thresholds per rule).
+"""
 
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 
 from ..check import UsageError
@@ -10,7 +17,13 @@ from . import EXIT_CLEAN, EXIT_ERROR, EXIT_FINDINGS
 
 
 def _codes(text: str) -> list[str]:
-    return [c.strip().upper() for c in text.split(",") if c.strip()]
+    from ..settings import unknown_codes
+
+    codes = [c.strip().upper() for c in text.split(",") if c.strip()]
+    unknown = unknown_codes(codes)
+    if unknown:
+        raise argparse.ArgumentTypeError(f"unknown rule {', '.join(unknown)}")
+    return codes
 
 
 def _threshold(text: str) -> tuple[str, float]:
@@ -22,80 +35,158 @@ def _threshold(text: str) -> tuple[str, float]:
         raise argparse.ArgumentTypeError(f"not a threshold: {text!r} (use 0.8 or Q102=3)") from None
 
 
+def _jobs(text: str) -> int:
+    if not text.isdigit() or int(text) < 1:
+        raise argparse.ArgumentTypeError(f"not a number of processes: {text!r}")
+    return int(text)
+
+
 def add_parser(sub) -> None:
+    from ..output import FORMATS
+    from ..settings import DIAGONALS, MEASURES
+
     p = sub.add_parser(
         "check", help="lint mesh files for quad affinity and shape problems",
-        description="Lint .obj/.ply/.off files (directories are searched recursively).",
+        description="Lint .obj/.ply/.off files (directories are searched recursively). "
+                    "Settings come from affinity.toml or [tool.affinity] in pyproject.toml, found by "
+                    "walking up from each file; flags given here win.",
     )
     p.add_argument("paths", nargs="*", metavar="PATH")
     p.add_argument("--demo", action="store_true", help="also check the bundled demo meshes")
-    p.add_argument("--format", choices=["text", "json"], default="text")
+    p.add_argument("--format", choices=FORMATS, default="text",
+                   help="text (default), json, sarif (code scanning), github (workflow annotations), junit")
     p.add_argument("--select", type=_codes, help="rule codes or prefixes to enable, e.g. Q1,Q201")
     p.add_argument("--ignore", type=_codes, help="rule codes or prefixes to disable")
     p.add_argument(
         "--threshold", type=_threshold, action="append", default=[], metavar="[CODE=]VALUE",
         help="flag above VALUE: a bare number sets Q101 (uv); repeat CODE=VALUE for other rules",
     )
-    p.add_argument(
-        "--measure", choices=["misplacement", "barycentric"], default="misplacement",
-        help="Q101 reading: misplacement in texels (default) or the paper's barycentric score",
-    )
-    p.add_argument("--diagonal", choices=["both", "02", "13", "shortest"], default="both",
+    p.add_argument("--measure", choices=MEASURES,
+                   help="Q101 reading: misplacement in texels (default) or the paper's barycentric score")
+    p.add_argument("--diagonal", choices=DIAGONALS,
                    help="which split diagonal the affinity test measures (default: both)")
-    p.add_argument("--texture-size", type=int, default=1024, metavar="PX",
-                   help="texture size for texel units when the mesh names no readable map_Kd")
+    p.add_argument("--texture-size", type=int, metavar="PX",
+                   help="texture size for texel units when the mesh names no readable map_Kd (default 1024)")
+    p.add_argument("--config", metavar="FILE",
+                   help="use this affinity.toml/pyproject.toml for every file instead of searching")
+    p.add_argument("--isolated", action="store_true", help="ignore configuration files")
+    p.add_argument("--show-settings", action="store_true",
+                   help="print the resolved settings (and the file they came from) and exit")
+    p.add_argument("--baseline", metavar="FILE", help="report only findings not recorded in this baseline")
+    p.add_argument("--write-baseline", metavar="FILE",
+                   help="record every current finding in FILE (counts per file, group and rule) and exit")
+    p.add_argument("-j", "--jobs", type=_jobs, metavar="N",
+                   help="check files in N processes (default: all CPUs, fewer when the files are small)")
     p.add_argument("--statistics", action="store_true", help="print counts per rule instead of findings")
     p.add_argument("--verbose", action="store_true", help="show every finding in text output")
     p.add_argument("-q", "--quiet", action="store_true", help="print findings and nothing else")
     p.set_defaults(run=run)
 
 
-def _settings(args):
-    from ..rules import RULES
-    from ..settings import Settings
+def _overrides(args) -> dict:
+    """Settings field -> value for every setting flag given on the command line."""
+    from ..settings import unthresholded_codes
 
     thresholds = dict(args.threshold)
-    unknown = sorted(set(thresholds) - set(RULES))
-    if unknown:
-        raise UsageError(f"--threshold: unknown rule {', '.join(unknown)}")
-    if args.texture_size <= 0:
+    bad = unthresholded_codes(list(thresholds))
+    if bad:
+        raise UsageError(f"--threshold: {', '.join(bad)} is not a rule with a threshold")
+    if args.texture_size is not None and args.texture_size <= 0:
         raise UsageError("--texture-size must be a positive number of pixels")
-    return Settings(
-        select=args.select, ignore=args.ignore, thresholds=thresholds,
-        measure=args.measure, diagonal=args.diagonal, texture_size=args.texture_size,
-    )
+    given = {
+        "select": args.select, "ignore": args.ignore, "measure": args.measure,
+        "diagonal": args.diagonal, "texture_size": args.texture_size,
+    }
+    return {"thresholds": thresholds, **{k: v for k, v in given.items() if v is not None}}
+
+
+def _report_problems(reports, quiet: bool) -> None:
+    """Unreadable files (always) and skipped files (unless quiet), one line each on stderr."""
+    for report in reports:
+        if report.error is not None:
+            sys.stderr.write(f"{report.path}:{report.error_line}: Q901 unreadable: {report.error}\n")
+        elif report.skipped is not None and not quiet:
+            sys.stderr.write(f"{report.path}: skipped ({report.skipped})\n")
+
+
+def _progress_bar():
+    """A tqdm wrapper for the stream of reports; imported only when stderr is a terminal."""
+    from tqdm import tqdm
+
+    def progress(reports, total):
+        return tqdm(reports, total=total, unit="file", delay=1.0, leave=False, file=sys.stderr)
+
+    return progress
+
+
+def _tasks(resolver, paths: list[str]) -> list:
+    """``(file, settings)`` for every mesh file to check: excluded files dropped, per-file ignores applied."""
+    from ..check import collect_paths
+
+    return [
+        (path, settings.for_file(path))
+        for path in collect_paths(paths)
+        if not (settings := resolver.resolve(path).settings).is_excluded(path)
+    ]
+
+
+def _write_baseline(reports, path: str, quiet: bool) -> None:
+    from .. import baseline
+
+    recorded = baseline.record(reports, path)
+    baseline.write(recorded, path)
+    if not quiet:
+        files = len({key[0] for key in recorded.counts})
+        sys.stderr.write(f"Wrote {sum(recorded.counts.values())} findings in {files} files to the baseline {path}.\n")
 
 
 def run(args) -> int:
-    from ..check import check_paths, collect_paths
-    from ..output import text
+    from ..check import check_files
+    from ..config import Resolver
+    from ..output import CheckRun
 
-    settings = _settings(args)
+    if args.baseline and args.write_baseline:
+        raise UsageError("--baseline and --write-baseline exclude each other")
+    resolver = Resolver(_overrides(args), config=args.config, isolated=args.isolated)
     paths = list(args.paths)
     if args.demo:
         from ..scenes import demo_paths
 
         paths += demo_paths()
+    if args.show_settings:
+        from ..output.show_settings import write_settings
+
+        write_settings(resolver, paths or [os.curdir], sys.stdout)
+        return EXIT_CLEAN
     if not paths:
         raise UsageError("no PATH given (name files or directories, or use --demo)")
-    reports = check_paths(collect_paths(paths), settings)
-    for report in reports:
-        if report.error is not None:
-            sys.stderr.write(f"{report.path}:{report.error_line}: Q901 unreadable: {report.error}\n")
-        elif report.skipped is not None and not args.quiet:
-            sys.stderr.write(f"{report.path}: skipped ({report.skipped})\n")
+    if args.baseline:
+        from .. import baseline
 
-    if args.format == "json":
-        from ..output import json as json_output
+        known = baseline.read(args.baseline)  # before the check: a bad baseline fails fast
 
-        json_output.write(reports, settings, sys.stdout)
-    elif args.statistics:
-        text.write_statistics(reports, sys.stdout)
-    else:
-        text.write(reports, sys.stdout, verbose=args.verbose)
-    if args.format == "text" and not args.quiet:
-        text.write_summary(reports, sys.stdout)
+    tasks = _tasks(resolver, paths)
+    progress = _progress_bar() if len(tasks) > 1 and sys.stderr.isatty() else None
+    reports = check_files(tasks, args.jobs, progress)
+    _report_problems(reports, args.quiet)
+    failed = any(r.error is not None for r in reports)
+    if args.write_baseline:
+        _write_baseline(reports, args.write_baseline, args.quiet)
+        return EXIT_ERROR if failed else EXIT_CLEAN
 
-    if any(r.error is not None for r in reports):
+    check_run = CheckRun(reports, resolver.resolve(os.curdir).settings)
+    if args.baseline:
+        check_run.reports, check_run.baselined = baseline.apply(reports, known)
+    _write_output(check_run, args)
+    if failed:
         return EXIT_ERROR
-    return EXIT_FINDINGS if any(r.n_findings for r in reports) else EXIT_CLEAN
+    return EXIT_FINDINGS if any(r.n_findings for r in check_run.reports) else EXIT_CLEAN
+
+
+def _write_output(check_run, args) -> None:
+    from ..output import text, writer
+
+    if args.format == "text":
+        text.write(check_run, sys.stdout, verbose=args.verbose, statistics=args.statistics, summary=not args.quiet)
+    else:
+        writer(args.format)(check_run, sys.stdout)

@@ -1,13 +1,51 @@
-"""Output formats for ``affinity check``. Each module formats a list of FileReport."""
+"""Output formats for ``affinity check``: one module per format, each with ``write(run, out)``.
+
+``text`` (ruff-style lines), ``json`` (the documented schema), ``sarif`` (SARIF
+2.1.0 for code scanning), ``github`` (workflow annotations) and ``junit`` (XML
+for CI test reports). This package holds what they share: the flat
+:class:`Finding` rows and how a finding is described.
+"""
 
 from __future__ import annotations
 
+import importlib
+import os
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..findings import FileReport, RuleHits
-from ..rules import RULES
+from ..rules import RULES, with_unit
+from ..settings import Settings
+
+FORMATS = ("text", "json", "sarif", "github", "junit")
+
+
+@dataclass
+class CheckRun:
+    """Everything a format writes: the reports (in file order) and how they were produced.
+
+    ``settings`` are the resolved settings for the working directory (files
+    governed by another configuration file have their own); ``baselined`` maps a
+    path to the number of its findings a baseline hid (None: no baseline was used).
+    """
+
+    reports: list[FileReport]
+    settings: Settings
+    baselined: dict[str, int] | None = None
+
+    def tally(self) -> dict[str, int]:
+        """Counts for a summary: ``files``, ``checked``, ``unreadable``, ``skipped``, ``findings``, ``baselined``."""
+        unreadable = sum(r.error is not None for r in self.reports)
+        skipped = sum(r.skipped is not None for r in self.reports)
+        return {
+            "files": len(self.reports),
+            "checked": len(self.reports) - unreadable - skipped,
+            "unreadable": unreadable,
+            "skipped": skipped,
+            "findings": sum(r.n_findings for r in self.reports),
+            "baselined": sum((self.baselined or {}).values()),
+        }
 
 
 @dataclass(frozen=True)
@@ -26,9 +64,20 @@ class Finding:
     message: str
 
 
+def writer(name: str):
+    """The ``write(run, out)`` function of a format, imported only when asked for."""
+    return importlib.import_module(f".{name}", __name__).write
+
+
+def group_name(report: FileReport, index: int) -> str:
+    """The name of group ``index`` of a report's mesh ("" when it has none)."""
+    return report.group_names[index] if 0 <= index < len(report.group_names) else ""
+
+
 def _rows(report: FileReport, hits: RuleHits, take: np.ndarray) -> list[Finding]:
     rule = RULES[hits.code]
-    groups = report.group_names
+    # Rules without a threshold (Q204, Q205, Q302) measure something else; no limit to report.
+    threshold = None if rule.default_threshold is None else hits.threshold
     return [
         Finding(
             path=report.path,
@@ -38,8 +87,8 @@ def _rows(report: FileReport, hits: RuleHits, take: np.ndarray) -> list[Finding]
             name=rule.name,
             face=int(face),
             value=float(value),
-            threshold=hits.threshold,
-            group=groups[g] if 0 <= g < len(groups) else "",
+            threshold=threshold,
+            group=group_name(report, g),
             message=rule.summary,
         )
         for face, line, value, g in zip(
@@ -87,3 +136,47 @@ def rule_counts(reports: list[FileReport]) -> dict[str, int]:
 def format_value(value: float) -> str:
     """A measured value for humans: 4 significant digits, no exponent for everyday sizes."""
     return f"{value:.4g}"
+
+
+def describe(f: Finding) -> str:
+    """The message with the measurement: ``... (3.2 vs 0.5 texels)``."""
+    measured = format_value(f.value)
+    if f.threshold is not None:
+        measured += " vs " + with_unit(format_value(f.threshold), RULES[f.code].unit)
+    return f"{f.message} ({measured})"
+
+
+def face_label(f: Finding) -> str:
+    """``"face 12"``; ``""`` for file-level findings (Q205 has face -1)."""
+    return f"face {f.face}" if f.face >= 0 else ""
+
+
+def located(f: Finding) -> str:
+    """:func:`describe` naming the face, for formats without a text line: ``..., face 12``."""
+    return ", ".join(filter(None, [describe(f), face_label(f)]))
+
+
+def text_line(f: Finding) -> str:
+    """The ruff-style line ``path:line:col: CODE name: message (value vs threshold)``."""
+    return f"{f.path}:{f.line}:{f.column}: {f.code} {f.name}: {describe(f)}"
+
+
+def working_relative(path: str) -> str | None:
+    """``path`` relative to the working directory with ``/`` separators, None when outside it.
+
+    CI annotations and SARIF locations name files relative to the checkout,
+    which is the working directory of a CI step.
+    """
+    rel = os.path.relpath(os.path.abspath(path), os.getcwd())
+    return None if rel.startswith("..") else rel.replace(os.sep, "/")
+
+
+def value_token(value: float) -> str:
+    """A measured value rounded to 6 significant digits: equal for the same quad on every run.
+
+    The per-face measures do not depend on the face's position in the file, so
+    this token (with rule, file and group) identifies a finding across face
+    reordering and edits elsewhere in the file (baseline, SARIF fingerprints).
+    """
+    return f"{value:.6g}"
+

@@ -10,12 +10,16 @@ Document layout::
       "findings": [{"path", "line", "column", "code", "name", "face", "value",
                     "threshold", "group", "message"}],
       "summary": {"files", "checked", "unreadable", "skipped", "findings",
-                  "by_rule": {"Q101": n, ...}}
+                  "baselined", "by_rule": {"Q101": n, ...}}
     }
 
 ``face`` is the 0-based index of the face in file order counting every face;
 ``line`` its 1-based source line (0 in binary PLY); ``value`` the measured score
-in the rule's unit, ``threshold`` the limit it exceeded.
+in the rule's unit, ``threshold`` the limit it exceeded. ``settings`` are the
+resolved settings for the working directory (a file governed by another
+configuration file was checked with that file's settings; ``affinity check
+--show-settings PATH`` prints them). With ``--baseline``, ``findings`` holds
+only the new findings and ``summary.baselined`` counts those the baseline hid.
 """
 
 from __future__ import annotations
@@ -25,8 +29,7 @@ import json
 from typing import TextIO
 
 from ..findings import FileReport
-from ..settings import Settings
-from . import file_findings, rule_counts
+from . import CheckRun, file_findings, rule_counts
 
 SCHEMA = "quad-affinity-check"
 VERSION = 1
@@ -40,28 +43,19 @@ def _file_entry(report: FileReport) -> dict:
     return {"path": report.path, **report.counts, "findings": report.n_findings}
 
 
-def document(reports: list[FileReport], settings: Settings) -> dict:
+def document(run: CheckRun) -> dict:
     """The whole JSON document as Python objects."""
-    findings = [dataclasses.asdict(f) for r in reports for f in file_findings(r)[0]]
-    unreadable = sum(r.error is not None for r in reports)
-    skipped = sum(r.skipped is not None for r in reports)
+    findings = [dataclasses.asdict(f) for r in run.reports for f in file_findings(r)[0]]
     return {
         "schema": SCHEMA,
         "version": VERSION,
-        "settings": dataclasses.asdict(settings),
-        "files": [_file_entry(r) for r in reports],
+        "settings": dataclasses.asdict(run.settings),
+        "files": [_file_entry(r) for r in run.reports],
         "findings": findings,
-        "summary": {
-            "files": len(reports),
-            "checked": len(reports) - unreadable - skipped,
-            "unreadable": unreadable,
-            "skipped": skipped,
-            "findings": len(findings),
-            "by_rule": rule_counts(reports),
-        },
+        "summary": {**run.tally(), "by_rule": rule_counts(run.reports)},
     }
 
 
-def write(reports: list[FileReport], settings: Settings, out: TextIO) -> None:
-    json.dump(document(reports, settings), out, indent=1)
+def write(run: CheckRun, out: TextIO) -> None:
+    json.dump(document(run), out, indent=1)
     out.write("\n")

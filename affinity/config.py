@@ -1,0 +1,215 @@
+"""Configuration files: find the one that governs a path, read and validate it.
+
+A folder's configuration is ``affinity.toml`` (keys at the top level) or the
+``[tool.affinity]`` table of ``pyproject.toml``; when a folder has both,
+``affinity.toml`` wins. The file that governs a mesh is the first one found
+walking up from the mesh's folder; a ``pyproject.toml`` without a
+``[tool.affinity]`` table does not count, so the search goes on above it.
+
+Keys (kebab-case, as in ruff)::
+
+    select = ["Q1", "Q201"]          # rule codes or prefixes, "ALL"
+    ignore = ["Q202"]
+    threshold = 0.8                  # shorthand for thresholds.Q101
+    measure = "misplacement"         # or "barycentric"
+    diagonal = "both"                # "02", "13", "shortest"
+    texture-size = 2048
+    exclude = ["legacy", "wip/*.ply"]
+    [thresholds]                     # [tool.affinity.thresholds] in pyproject.toml
+    Q102 = 3
+    [per-file-ignores]
+    "scans/*" = ["Q202", "Q203"]
+
+Globs are relative to the configuration file's folder (see
+:func:`affinity.settings.glob_matches`).
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+from .check import UsageError
+from .settings import DIAGONALS, MEASURES, Settings, unknown_codes, unthresholded_codes
+
+CONFIG_NAMES = ("affinity.toml", "pyproject.toml")
+
+
+class ConfigError(UsageError):
+    """A configuration file that cannot be read or says something invalid (exit 2)."""
+
+
+@dataclass(frozen=True)
+class Resolved:
+    """The settings for a path and the configuration file they came from (None: defaults only)."""
+
+    settings: Settings
+    source: Path | None
+
+
+def _read_text(path: Path) -> str:
+    try:
+        return path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as err:
+        raise ConfigError(f"{path}: cannot read configuration: {err}") from None
+
+
+def _parse_toml(path: Path, text: str) -> dict:
+    try:
+        import tomllib
+    except ModuleNotFoundError:  # Python 3.10
+        import tomli as tomllib
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise ConfigError(f"{path}: invalid TOML: {err}") from None
+
+
+def _table(path: Path) -> dict | None:
+    """The affinity table of a configuration file, or None when a pyproject.toml has none."""
+    text = _read_text(path)
+    if path.name != "pyproject.toml":
+        return _parse_toml(path, text)
+    if "affinity" not in text:
+        return None  # cheap pre-check: most pyproject files never mention us
+    table = _parse_toml(path, text).get("tool", {}).get("affinity")
+    return table if isinstance(table, dict) else None
+
+
+def find_config(folder: Path) -> Path | None:
+    """The configuration file governing ``folder``: the nearest one at or above it."""
+    for candidate in (folder, *folder.parents):
+        for name in CONFIG_NAMES:
+            path = candidate / name
+            if path.is_file() and _table(path) is not None:
+                return path
+    return None
+
+
+def _codes(value, where: str) -> list[str]:
+    if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
+        raise ConfigError(f"{where}: expected a list of rule codes, e.g. [\"Q101\"]")
+    codes = [v.strip().upper() for v in value]
+    unknown = unknown_codes(codes)
+    if unknown:
+        raise ConfigError(f"{where}: unknown rule {', '.join(unknown)}")
+    return codes
+
+
+def _number(value, where: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ConfigError(f"{where}: expected a number")
+    return float(value)
+
+
+def _choice(value, choices: tuple[str, ...], where: str) -> str:
+    if value not in choices:
+        raise ConfigError(f"{where}: expected one of {', '.join(map(repr, choices))}")
+    return value
+
+
+def _thresholds(value, where: str) -> dict[str, float]:
+    if not isinstance(value, dict):
+        raise ConfigError(f"{where}: expected a table of rule code = number")
+    thresholds = {str(code).upper(): _number(v, f"{where}.{code}") for code, v in value.items()}
+    bad = unthresholded_codes(list(thresholds))
+    if bad:
+        raise ConfigError(f"{where}: {', '.join(bad)} is not a rule with a threshold")
+    return thresholds
+
+
+def _texture_size(value, where: str) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or value <= 0:
+        raise ConfigError(f"{where}: expected a positive number of pixels")
+    return value
+
+
+def _globs(value, where: str) -> list[str]:
+    if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
+        raise ConfigError(f"{where}: expected a list of path globs")
+    return list(value)
+
+
+def _per_file_ignores(value, where: str) -> dict[str, list[str]]:
+    if not isinstance(value, dict):
+        raise ConfigError(f"{where}: expected a table of glob = [rule codes]")
+    return {glob: _codes(codes, f"{where}.{glob!r}") for glob, codes in value.items()}
+
+
+#: TOML key -> (Settings field, validator(value, where)).
+_KEYS = {
+    "select": ("select", _codes),
+    "ignore": ("ignore", _codes),
+    "thresholds": ("thresholds", _thresholds),
+    "measure": ("measure", lambda v, where: _choice(v, MEASURES, where)),
+    "diagonal": ("diagonal", lambda v, where: _choice(v, DIAGONALS, where)),
+    "texture-size": ("texture_size", _texture_size),
+    "exclude": ("exclude", _globs),
+    "per-file-ignores": ("per_file_ignores", _per_file_ignores),
+}
+
+
+def read_config(path: Path) -> dict:
+    """The validated options of a configuration file as Settings field names -> values.
+
+    ``root`` is the file's folder; ``threshold`` becomes ``thresholds["Q101"]``.
+    """
+    table = _table(path)
+    if table is None:
+        raise ConfigError(f"{path}: no [tool.affinity] table")
+    prefix = f"{path}: " + ("[tool.affinity] " if path.name == "pyproject.toml" else "")
+    options: dict = {"root": os.path.abspath(path.parent)}
+    for key, value in table.items():
+        if key == "threshold":
+            continue
+        if key not in _KEYS:
+            raise ConfigError(f"{prefix}unknown key {key!r} (known: threshold, {', '.join(_KEYS)})")
+        name, validate = _KEYS[key]
+        options[name] = validate(value, prefix + key)
+    if "threshold" in table:
+        if "Q101" in options.get("thresholds", {}):
+            raise ConfigError(f"{prefix}threshold and thresholds.Q101 both set the Q101 threshold")
+        options.setdefault("thresholds", {})["Q101"] = _number(table["threshold"], prefix + "threshold")
+    return options
+
+
+class Resolver:
+    """Settings per path: defaults, then the governing configuration file, then the flags.
+
+    Parameters
+    ----------
+    overrides : dict
+        Settings field name -> value for every flag given on the command line.
+    config : path or None
+        Use this file for every path instead of searching (``--config``).
+    isolated : bool
+        Ignore configuration files altogether (``--isolated``).
+    """
+
+    def __init__(self, overrides: dict, config: str | None = None, isolated: bool = False):
+        self._overrides = overrides
+        self._explicit = None if config is None else Path(config)
+        self._isolated = isolated
+        self._by_folder: dict[Path, Path | None] = {}
+        self._by_source: dict[Path | None, Resolved] = {}
+        if self._explicit is not None and not self._explicit.is_file():
+            raise ConfigError(f"{config}: no such configuration file")
+
+    def _source(self, folder: Path) -> Path | None:
+        if self._isolated:
+            return None
+        if self._explicit is not None:
+            return self._explicit
+        if folder not in self._by_folder:
+            self._by_folder[folder] = find_config(folder)
+        return self._by_folder[folder]
+
+    def resolve(self, path: str) -> Resolved:
+        """The settings governing ``path`` (a file, or a folder for everything in it)."""
+        absolute = Path(os.path.abspath(path))
+        source = self._source(absolute if absolute.is_dir() else absolute.parent)
+        if source not in self._by_source:
+            settings = Settings() if source is None else Settings().updated(read_config(source))
+            self._by_source[source] = Resolved(settings.updated(self._overrides), source)
+        return self._by_source[source]

@@ -1,0 +1,153 @@
+"""SARIF 2.1.0 output, for GitHub code scanning and other SARIF viewers.
+
+One run whose ``tool.driver.rules`` is the whole rule table (``ruleIndex`` is a
+rule's position in it), with descriptions and help from the same source as
+``affinity rule``. Each finding is a result located by a physical location —
+the file's URI relative to the working directory (``uriBaseId`` ``%SRCROOT%``)
+and, when the format has source lines, ``region.startLine`` = the face's line
+(binary PLY has none, so there the region is left out) — and by a logical
+location naming the face. ``properties`` carry face, value, threshold and group.
+
+``partialFingerprints["quadAffinity/v1"]`` identifies a finding across runs: a
+hash of rule, file, group and the measured value rounded to 6 significant
+digits (:func:`affinity.output.value_token`; it does not change when faces are
+reordered or other parts of the file are edited), plus the ordinal among
+findings that share all four, in file order. It changes when the quad itself
+changes, which makes it a new finding.
+
+Unreadable (Q901) and skipped files are not results: they are tool execution
+notifications of the run's invocation, and an unreadable file makes
+``executionSuccessful`` false.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from pathlib import Path
+from typing import TextIO
+from urllib.parse import quote
+
+from .. import __version__
+from ..findings import FileReport
+from ..rules import RULES, UNREADABLE, rule_page
+from . import CheckRun, face_label, file_findings, located, value_token, working_relative
+
+SARIF_VERSION = "2.1.0"
+SARIF_SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
+SRCROOT = "%SRCROOT%"
+FINGERPRINT = "quadAffinity/v1"
+_RULE_INDEX = {code: i for i, code in enumerate(RULES)}
+
+
+def _descriptor(rule) -> dict:
+    return {
+        "id": rule.code,
+        "name": rule.name,
+        "shortDescription": {"text": rule.summary},
+        "fullDescription": {"text": rule.what},
+        "help": {"text": rule_page(rule), "markdown": rule_page(rule, markdown=True)},
+        "defaultConfiguration": {"level": rule.level},
+        "properties": {"unit": rule.unit, "defaultThreshold": rule.default_threshold},
+    }
+
+
+def artifact_location(path: str) -> dict:
+    """Relative to the working directory under ``%SRCROOT%``; an absolute file URI outside it."""
+    rel = working_relative(path)
+    if rel is None:
+        return {"uri": Path(path).resolve().as_uri()}
+    return {"uri": quote(rel), "uriBaseId": SRCROOT}
+
+
+def _physical(location: dict, line: int, column: int = 0) -> dict:
+    physical: dict = {"artifactLocation": location}
+    if line > 0:  # SARIF lines start at 1; binary PLY has none
+        physical["region"] = {"startLine": line, **({"startColumn": column} if column > 0 else {})}
+    return physical
+
+
+def fingerprint(code: str, uri: str, group: str, value: float, ordinal: int) -> str:
+    """The stable identity of a finding (see the module docstring)."""
+    text = "\0".join((code, uri, group, value_token(value), str(ordinal)))
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()[:32]
+
+
+def _results(report: FileReport) -> list[dict]:
+    location = artifact_location(report.path)
+    seen: dict[tuple, int] = {}
+    results = []
+    for f in file_findings(report)[0]:
+        identity = (f.code, f.group, value_token(f.value))
+        seen[identity] = ordinal = seen.get(identity, -1) + 1
+        result_location: dict = {"physicalLocation": _physical(location, f.line, f.column)}
+        if face_label(f):
+            qualified = "/".join(filter(None, [f.group, face_label(f)]))
+            result_location["logicalLocations"] = [
+                {"name": face_label(f), "fullyQualifiedName": qualified, "kind": "element"}]
+        results.append({
+            "ruleId": f.code,
+            "ruleIndex": _RULE_INDEX[f.code],
+            "level": RULES[f.code].level,
+            "message": {"text": located(f)},
+            "locations": [result_location],
+            "partialFingerprints": {FINGERPRINT: fingerprint(f.code, location["uri"], f.group, f.value, ordinal)},
+            "properties": {"name": f.name, "face": f.face, "value": f.value,
+                           "threshold": f.threshold, "group": f.group},
+        })
+    return results
+
+
+def _notifications(reports: list[FileReport]) -> list[dict]:
+    notes = []
+    for report in reports:
+        if report.error is not None:
+            notes.append({
+                "level": "error",
+                "message": {"text": f"{UNREADABLE.code} {UNREADABLE.name}: {report.error}"},
+                "descriptor": {"id": UNREADABLE.code, "index": 0},
+                "locations": [{"physicalLocation": _physical(artifact_location(report.path), report.error_line)}],
+            })
+        elif report.skipped is not None:
+            notes.append({
+                "level": "note",
+                "message": {"text": f"skipped ({report.skipped})"},
+                "locations": [{"physicalLocation": _physical(artifact_location(report.path), 0)}],
+            })
+    return notes
+
+
+def _folder_uri(folder: Path) -> str:
+    uri = folder.as_uri()
+    return uri if uri.endswith("/") else uri + "/"
+
+
+def document(run: CheckRun) -> dict:
+    """The SARIF log as Python objects."""
+    return {
+        "$schema": SARIF_SCHEMA,
+        "version": SARIF_VERSION,
+        "runs": [{
+            "tool": {"driver": {
+                "name": "quad-affinity",
+                "version": __version__,
+                "rules": [_descriptor(rule) for rule in RULES.values()],
+                "notifications": [{
+                    "id": UNREADABLE.code, "name": UNREADABLE.name,
+                    "shortDescription": {"text": UNREADABLE.summary},
+                }],
+            }},
+            "invocations": [{
+                "executionSuccessful": all(r.error is None for r in run.reports),
+                "toolExecutionNotifications": _notifications(run.reports),
+            }],
+            "originalUriBaseIds": {SRCROOT: {"uri": _folder_uri(Path.cwd())}},
+            "columnKind": "unicodeCodePoints",
+            "results": [result for report in run.reports for result in _results(report)],
+        }],
+    }
+
+
+def write(run: CheckRun, out: TextIO) -> None:
+    json.dump(document(run), out, indent=1)
+    out.write("\n")

@@ -1,0 +1,195 @@
+"""Output formats (text, json, github, junit) on reports with known findings.
+
+Unit tests build FileReport/RuleHits by hand; end-to-end tests run ``affinity
+check`` on a trapezoid carrying a unit-square uv (Q101: the split moves the
+texture at its centre by a quarter of its width, 256 texels at 1024) next to
+a square with affine uv (clean).
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+import pytest
+from test_cli_check import run
+
+from affinity.findings import FileReport, RuleHits
+from affinity.output import CheckRun, github, junit, text
+from affinity.output import json as json_output
+from affinity.settings import Settings
+
+SQUARE = [(0, 0), (1, 0), (1, 1), (0, 1)]
+UNIT_UV = [(0, 0), (1, 0), (1, 1), (0, 1)]
+
+
+def trapezoid(top: float = 1.0, x: float = 0.0) -> list[tuple[float, float]]:
+    """Bottom 2 wide, top ``top`` wide, height 1, shifted by ``x``."""
+    return [(x - 1, 0), (x + 1, 0), (x + top / 2, 1), (x - top / 2, 1)]
+
+
+def quad_obj(quads, groups: list[str] | None = None, header: str = "") -> str:
+    """OBJ text of separate quads, each ``(corners xy, uv)``; optionally a ``g`` line before each face."""
+    vertices, faces = [header] if header else [], []
+    for i, (corners, uv) in enumerate(quads):
+        vertices += [f"v {x} {y} 0" for x, y in corners] + [f"vt {u} {v}" for u, v in uv]
+        if groups:
+            faces.append(f"g {groups[i]}")
+        faces.append("f " + " ".join(f"{4 * i + k}/{4 * i + k}" for k in range(1, 5)))
+    return "\n".join(vertices + faces) + "\n"
+
+
+def hits(code: str, faces, lines, values, threshold: float = 0.5, groups=None) -> RuleHits:
+    n = len(faces)
+    return RuleHits(code, np.array(faces), np.array(lines), np.array(values, dtype=float), threshold,
+                    np.zeros(n, dtype=np.int32) if groups is None else np.array(groups, dtype=np.int32))
+
+
+def sample_run() -> CheckRun:
+    """A flagged file (two Q101, one Q204 error), a clean file, an unreadable and a skipped one."""
+    counts = {"faces": 3, "quads": 3, "triangles": 0, "ngons": 0}
+    return CheckRun(
+        [
+            FileReport("a, b:c.obj", counts=counts, group_names=["body"],
+                       hits=[hits("Q101", [2, 0], [12, 10], [256.0, 3.5]), hits("Q204", [1], [11], [0.3], 0.0)]),
+            FileReport("clean.obj", counts=counts, group_names=[""]),
+            FileReport("broken.obj", error="face index 9 out of range\r\n(1 based)", error_line=4),
+            FileReport("big.obj", skipped="lfs-pointer"),
+        ],
+        Settings(),
+    )
+
+
+def render(module, run_: CheckRun) -> str:
+    out = io.StringIO()
+    module.write(run_, out)
+    return out.getvalue()
+
+
+def test_text_lines_and_summary():
+    out = io.StringIO()
+    text.write(sample_run(), out)
+    assert out.getvalue().splitlines() == [
+        "a, b:c.obj:10:1: Q101 uv-disaffine: texture coordinates are not an affine image of the positions "
+        "(3.5 vs 0.5 texels)",
+        "a, b:c.obj:11:1: Q204 bowtie-quad: the quad crosses itself (0.3)",
+        "a, b:c.obj:12:1: Q101 uv-disaffine: texture coordinates are not an affine image of the positions "
+        "(256 vs 0.5 texels)",
+        "Found 3 findings (2 files checked, 1 unreadable, 1 skipped).",
+    ]
+
+
+def test_text_summary_counts_baselined_findings():
+    run_ = sample_run()
+    run_.baselined = {"a, b:c.obj": 4}
+    assert render(text, run_).splitlines()[-1] == (
+        "Found 3 new findings (2 files checked, 1 unreadable, 1 skipped, 4 baselined)."
+    )
+
+
+def test_github_annotations_escape_and_levels():
+    lines = render(github, sample_run()).splitlines()
+    assert lines == [
+        "::warning file=a%2C b%3Ac.obj,line=10,col=1,title=Q101 uv-disaffine::texture coordinates are not "
+        "an affine image of the positions (3.5 vs 0.5 texels), face 0",
+        "::error file=a%2C b%3Ac.obj,line=11,col=1,title=Q204 bowtie-quad::the quad crosses itself (0.3), face 1",
+        "::warning file=a%2C b%3Ac.obj,line=12,col=1,title=Q101 uv-disaffine::texture coordinates are not "
+        "an affine image of the positions (256 vs 0.5 texels), face 2",
+        "::error file=broken.obj,line=4,title=Q901 unreadable::face index 9 out of range%0D%0A(1 based)",
+        "::notice file=big.obj,title=skipped::skipped (lfs-pointer)",
+    ]
+
+
+def test_github_leaves_out_line_zero_and_escapes_percent():
+    run_ = CheckRun([FileReport("50%.ply", hits=[hits("Q101", [7], [0], [2.0])])], Settings())
+    (line,) = render(github, run_).splitlines()
+    assert line.startswith("::warning file=50%25.ply,title=Q101 uv-disaffine::")
+
+
+def test_file_level_finding_names_no_face():
+    run_ = CheckRun([FileReport("points.obj", hits=[hits("Q205", [-1], [1], [2.0], 0.0)])], Settings())
+    assert render(github, run_).splitlines() == [
+        "::warning file=points.obj,line=1,col=1,title=Q205 no-faces::the mesh has vertices but no faces (2)"]
+    assert ET.fromstring(render(junit, run_)).find("testsuite/testcase").get("name") == "Q205 no-faces"
+
+
+def test_junit_is_valid_xml_with_failures_errors_and_skips():
+    root = ET.fromstring(render(junit, sample_run()))
+    assert root.tag == "testsuites"
+    assert {k: root.get(k) for k in ("tests", "failures", "errors", "skipped")} == {
+        "tests": "6", "failures": "3", "errors": "1", "skipped": "1"}
+    suites = {s.get("name"): s for s in root.findall("testsuite")}
+    assert list(suites) == ["a, b:c.obj", "clean.obj", "broken.obj", "big.obj"]
+    flagged = suites["a, b:c.obj"].findall("testcase")
+    assert [c.find("failure").get("type") for c in flagged] == ["Q101", "Q204", "Q101"]
+    props = {p.get("name"): p.get("value") for p in flagged[2].find("properties")}
+    assert props["face"] == "2" and float(props["value"]) == 256.0 and float(props["threshold"]) == 0.5
+    assert props["line"] == "12" and props["group"] == "body"
+    (clean,) = suites["clean.obj"].findall("testcase")
+    assert list(clean) == []  # a passing testcase
+    assert suites["broken.obj"].find("testcase/error").get("type") == "Q901"
+    assert suites["big.obj"].find("testcase/skipped") is not None
+
+
+def test_junit_survives_characters_xml_cannot_carry():
+    run_ = CheckRun([FileReport("junk.obj", error="binary junk \x00\x07 at byte 3")], Settings())
+    error = ET.fromstring(render(junit, run_)).find("testsuite/testcase/error")
+    assert error.get("message") == "binary junk \ufffd\ufffd at byte 3"
+
+
+def test_json_summary_and_thresholdless_rules():
+    doc = json.loads(render(json_output, sample_run()))
+    assert doc["summary"] == {"files": 4, "checked": 2, "unreadable": 1, "skipped": 1, "findings": 3,
+                              "baselined": 0, "by_rule": {"Q101": 2, "Q204": 1}}
+    bowtie = next(f for f in doc["findings"] if f["code"] == "Q204")
+    assert bowtie["threshold"] is None and bowtie["group"] == "body"
+
+
+# End to end: the CLI on real files.
+
+@pytest.fixture
+def meshes(tmp_path: Path) -> Path:
+    (tmp_path / "bad.obj").write_text(quad_obj([(trapezoid(), UNIT_UV)], header="# trapezoid"))
+    (tmp_path / "good.obj").write_text(quad_obj([(SQUARE, UNIT_UV)]))
+    return tmp_path
+
+
+def test_github_format_end_to_end(meshes):
+    result = run("check", "--format", "github", "bad.obj", "good.obj", cwd=meshes)
+    assert result.returncode == 1, result.stderr
+    assert result.stdout.splitlines() == [
+        "::warning file=bad.obj,line=10,col=1,title=Q101 uv-disaffine::texture coordinates are not an affine "
+        "image of the positions (256 vs 0.5 texels), face 0",
+    ]
+
+
+def test_junit_format_end_to_end(meshes):
+    result = run("check", "--format", "junit", "bad.obj", "good.obj", cwd=meshes)
+    assert result.returncode == 1, result.stderr
+    root = ET.fromstring(result.stdout)
+    assert (root.get("tests"), root.get("failures"), root.get("errors")) == ("2", "1", "0")
+    failure = root.find("testsuite[@name='bad.obj']/testcase/failure")
+    assert failure.get("type") == "Q101" and failure.text.startswith("bad.obj:10:1: Q101 uv-disaffine:")
+    assert root.find("testsuite[@name='good.obj']/testcase/failure") is None
+
+
+def test_json_format_end_to_end(meshes):
+    result = run("check", "--format", "json", "bad.obj", "good.obj", cwd=meshes)
+    assert result.returncode == 1, result.stderr
+    doc = json.loads(result.stdout)
+    (finding,) = doc["findings"]
+    assert {k: finding[k] for k in ("path", "line", "column", "code", "name", "face")} == {
+        "path": "bad.obj", "line": 10, "column": 1, "code": "Q101", "name": "uv-disaffine", "face": 0}
+    assert finding["value"] == pytest.approx(256.0) and finding["threshold"] == 0.5
+    assert [f["findings"] for f in doc["files"]] == [1, 0]
+
+
+def test_unreadable_file_in_structured_formats_exits_2(meshes):
+    (meshes / "broken.obj").write_text("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 9\n")
+    result = run("check", "--format", "github", "broken.obj", "bad.obj", cwd=meshes)
+    assert result.returncode == 2
+    assert result.stdout.startswith("::error file=broken.obj,line=4,title=Q901 unreadable::")
+    assert result.stderr.startswith("broken.obj:4: Q901 unreadable:")
