@@ -1,0 +1,103 @@
+"""``affinity report [MESH...] [-o report.html]``: the HTML report, the product's main job.
+
+Without MESH it reports on the built-in demo scenes. The page is one
+self-contained file (pictures embedded, no network). An unreadable mesh is a
+failed row in the report and a ``Q901`` line on stderr, and the exit code is 2;
+otherwise 0 (findings are the report's content, not a failure). A report that
+cannot be written is an error (exit 2) and leaves no partial file.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+
+from ..check import UsageError
+from . import EXIT_CLEAN, EXIT_ERROR
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser(
+        "report", help="write the HTML report: findings, renders, affinity scores",
+        description="Lint, score and render MESH files (directories are searched; default: the built-in demo "
+                    "scenes) into one self-contained HTML page.",
+        epilog="Exit codes: 0 the report was written; 2 a usage error, an output that cannot be written (nothing "
+               "is written), or an unreadable mesh (the report is still written, with the failed row).",
+    )
+    p.add_argument("meshes", nargs="*", metavar="MESH", help=".obj/.ply/.off files or directories")
+    p.add_argument("-o", "--output", default="report.html", metavar="HTML",
+                   help="where to write the report (default: report.html)")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no result line")
+    p.set_defaults(run=run)
+
+
+def _check_writable(path: str) -> None:
+    """Fail before the work, with a clear line, when ``path`` cannot be written."""
+    folder = os.path.dirname(os.path.abspath(path))
+    if os.path.isdir(path):
+        raise UsageError(f"{path}: is a directory (name the HTML file to write)")
+    if not os.path.isdir(folder):
+        raise UsageError(f"{path}: cannot write the report: no such directory {folder}")
+    if not os.access(folder, os.W_OK):
+        raise UsageError(f"{path}: cannot write the report: the directory {folder} is not writable")
+
+
+def _inputs(paths: list[str], resolver) -> list:
+    from ..check import collect_paths
+    from ..report.demo import MeshInput, demo_inputs
+
+    if not paths:
+        return demo_inputs()
+    found = [MeshInput(path, path) for path in collect_paths(paths)
+             if not resolver.resolve(path).settings.is_excluded(path)]
+    if not found:
+        raise UsageError("every MESH given is excluded by the configuration")
+    return found
+
+
+def _write(path: str, html: str) -> None:
+    from ..atomic import atomic_write
+
+    try:
+        with atomic_write(path) as out:
+            out.write(html)
+    except OSError as err:
+        raise UsageError(f"{path}: cannot write the report ({err.strerror or err})") from None
+
+
+def _check_report_extra() -> None:
+    """The report's libraries are the ``report`` extra; say how to get them rather than fail on an import."""
+    import importlib.util
+
+    missing = [name for name in ("PIL", "jinja2", "matplotlib") if importlib.util.find_spec(name) is None]
+    if missing:
+        raise UsageError(f"needs {', '.join(missing)}, the report extra: pip install 'quad-affinity[report]'")
+
+
+def run(args) -> int:
+    from tqdm import tqdm
+
+    from ..config import Resolver
+    from ..report.build import collect_run
+    from ..report.page import render_page
+
+    _check_report_extra()
+    _check_writable(args.output)
+    resolver = Resolver({})
+    inputs = _inputs(args.meshes, resolver)
+    with tqdm(total=len(inputs), unit="file", file=sys.stderr, leave=False, delay=1.0,
+              disable=args.quiet or not sys.stderr.isatty()) as bar:
+        report = collect_run(inputs, lambda path: resolver.resolve(path).settings.for_file(path),
+                             resolver.resolve(os.curdir).settings, bar)
+        bar.set_postfix_str("writing the page")
+        html = render_page(report)
+    _write(args.output, html)
+
+    failed = [result.file for result in report.meshes if result.file.error is not None]
+    for file in failed:
+        sys.stderr.write(f"{file.path}:{file.error_line}: Q901 unreadable: {file.error}\n")
+    if not args.quiet:
+        unreadable = f", {len(failed)} unreadable" if failed else ""
+        sys.stderr.write(f"affinity report: wrote {args.output} ({len(inputs)} files{unreadable}, "
+                         f"{len(html.encode()) / 1e6:.1f} MB, {report.seconds:.1f} s)\n")
+    return EXIT_ERROR if failed else EXIT_CLEAN

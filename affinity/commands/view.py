@@ -1,0 +1,71 @@
+"""``affinity view MESH``: the mesh in 3-D, coloured by affinity score, flagged quads outlined (pyvista).
+
+Needs the ``view`` extra. ``--screenshot`` renders off-screen to a PNG instead
+of opening a window (the report's overview picture is the same scene).
+"""
+
+from __future__ import annotations
+
+from ..check import UsageError
+from . import EXIT_CLEAN
+
+ATTRIBUTES = ("uv", "colour", "normal")
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser(
+        "view", help="show a mesh in 3-D coloured by affinity score (needs the view extra: pyvista)",
+        description="Open MESH in a window, coloured by every quad's affinity score, flagged quads outlined.",
+    )
+    p.add_argument("mesh", metavar="MESH")
+    p.add_argument("--attribute", choices=ATTRIBUTES,
+                   help="the score to colour by (default: uv, else colour, else normal)")
+    p.add_argument("--up", choices=["x", "y", "z"], help="world up axis")
+    p.add_argument("--screenshot", metavar="PNG", help="render off-screen into PNG instead of opening a window")
+    p.set_defaults(run=run)
+
+
+def _scores(mesh, path: str, attribute: str | None):
+    """The chosen attribute's scores under the file's configuration, None when the mesh has nothing to score."""
+    from ..config import Resolver
+    from ..report.scores import SCORED_ATTRIBUTES, quad_scores, scored_codes, shown_code
+
+    if attribute is None:
+        code = shown_code(mesh)
+    else:
+        code = next(c for c, (name, _) in SCORED_ATTRIBUTES.items() if name == attribute)
+        if code not in scored_codes(mesh):
+            raise UsageError(f"{path}: the mesh has no {attribute} attribute to score")
+    if code is None:
+        return None
+    return quad_scores(mesh, Resolver({}).resolve(path).settings.for_file(path), code)
+
+
+def run(args) -> int:
+    from ..loaders import load
+    from ..mesh import MeshError, SkippedFile
+    from ..view import INSTALL_HINT, overview_image, pyvista_installed, show
+
+    if not pyvista_installed():
+        raise UsageError(f"needs pyvista, the view extra: {INSTALL_HINT}")
+    try:
+        mesh = load(args.mesh)
+    except MeshError as err:
+        raise UsageError(f"{err.path}:{err.line}: {err.reason}") from None
+    except SkippedFile as skip:
+        raise UsageError(f"{skip.path}: skipped ({skip.reason})") from None
+    scores = _scores(mesh, args.mesh, args.attribute)
+    if args.screenshot is None:
+        show(mesh, scores, args.up)
+        return EXIT_CLEAN
+    from PIL import Image
+
+    from ..atomic import atomic_write
+
+    pixels = overview_image(mesh, scores, None, args.up, (800, 600))
+    try:
+        with atomic_write(args.screenshot, binary=True) as out:
+            Image.fromarray(pixels).save(out, format="PNG")
+    except OSError as err:
+        raise UsageError(f"{args.screenshot}: cannot write ({err.strerror or err})") from None
+    return EXIT_CLEAN

@@ -1,0 +1,105 @@
+"""The 3-D view (pyvista, the ``view`` extra): the mesh coloured by affinity score, flagged quads outlined.
+
+``affinity view MESH`` opens it in a window; the report renders the same scene
+off-screen as its overview picture. pyvista is imported here only, never on
+``affinity check``'s path.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+
+import numpy as np
+
+from .mesh import Mesh
+from .report.charts import FLAG_COLOUR
+from .report.scores import QuadScores
+
+INSTALL_HINT = "pip install 'quad-affinity[view]'"
+UP_VECTORS = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
+SURFACE_GREY = "#d1d5db"
+
+
+def pyvista_installed() -> bool:
+    """Whether the ``view`` extra (pyvista) can be imported."""
+    return importlib.util.find_spec("pyvista") is not None
+
+
+def polydata(mesh: Mesh):
+    """The mesh as a ``pyvista.PolyData``, every face kept as the polygon it is.
+
+    VTK's face array is ``[n, v0 .. v(n-1), n, ...]``: each face's corner list
+    preceded by its size, built here without a loop over faces.
+    """
+    import pyvista as pv
+
+    sizes = mesh.face_sizes
+    flat = np.empty(len(mesh.corner_vertex) + mesh.n_faces, dtype=np.int64)
+    markers = mesh.face_start[:-1] + np.arange(mesh.n_faces)
+    is_marker = np.zeros(len(flat), dtype=bool)
+    is_marker[markers] = True
+    flat[markers] = sizes
+    flat[~is_marker] = mesh.corner_vertex
+    return pv.PolyData(mesh.positions, flat)
+
+
+def build_scene(plotter, mesh: Mesh, scores: QuadScores | None) -> None:
+    """Add the mesh to ``plotter``: coloured by ``scores`` (log scale, grey where unscored), flagged quads outlined."""
+    surface = polydata(mesh)
+    if scores is None or len(scores.faces) == 0:
+        plotter.add_mesh(surface, color=SURFACE_GREY, show_edges=True, edge_color="#6b7280")
+        return
+    # The colour range spans the scores and a decade either side of the threshold; a log
+    # scale cannot show 0, so affine quads (score 0 up to rounding) take the lowest colour.
+    low = min(scores.threshold / 10, max(float(scores.values.min()), scores.threshold * 1e-3))
+    top = max(float(scores.values[np.isfinite(scores.values)].max(initial=low)), scores.threshold * 10)
+    per_face = np.full(mesh.n_faces, np.nan)
+    per_face[scores.faces] = np.clip(scores.values, low, top)
+    surface.cell_data[scores.unit] = per_face
+    plotter.add_mesh(surface, scalars=scores.unit, cmap="viridis", log_scale=True, clim=(low, top),
+                     nan_color=SURFACE_GREY, show_edges=True, edge_color="#374151",
+                     scalar_bar_args={"title": f"{scores.attribute} ({scores.unit})\n", "fmt": "%.2g", "vertical": True,
+                                      "position_x": 0.86, "position_y": 0.1, "height": 0.75, "width": 0.06,
+                                      "title_font_size": 14, "label_font_size": 12, "color": "#1f2937"})
+    flagged = scores.faces[scores.flagged]
+    if len(flagged):
+        plotter.add_mesh(surface.extract_cells(flagged).extract_all_edges(), color=FLAG_COLOUR, line_width=3)
+
+
+def place_camera(plotter, camera: tuple | None, up: str | None) -> None:
+    """``camera`` (eye, target, vertical fov) as in ``RenderOptions``, or pyvista's framing with ``up``."""
+    if camera is None:
+        plotter.view_isometric()
+        if up is not None:
+            plotter.set_viewup(UP_VECTORS[up])
+        return
+    eye, target, fov = camera
+    plotter.camera_position = [tuple(eye), tuple(target), UP_VECTORS[up or "y"]]
+    plotter.camera.view_angle = fov
+
+
+def overview_image(mesh: Mesh, scores: QuadScores | None, camera: tuple | None, up: str | None,
+                   size: tuple[int, int]) -> np.ndarray:
+    """The scene rendered off-screen: (H, W, 3) uint8."""
+    import pyvista as pv
+
+    pv.vtk_verbosity("off")  # VTK logs to stderr when it falls back from X to an off-screen context
+    plotter = pv.Plotter(off_screen=True, window_size=list(size))
+    try:
+        plotter.set_background("white")
+        build_scene(plotter, mesh, scores)
+        place_camera(plotter, camera, up)
+        return np.asarray(plotter.screenshot(return_img=True))[..., :3]
+    finally:
+        plotter.close()
+
+
+def show(mesh: Mesh, scores: QuadScores | None, up: str | None) -> None:
+    """Open the interactive window (blocks until it is closed)."""
+    import pyvista as pv
+
+    plotter = pv.Plotter(title=f"affinity view: {mesh.path}")
+    plotter.set_background("white")
+    build_scene(plotter, mesh, scores)
+    place_camera(plotter, None, up)
+    plotter.show()

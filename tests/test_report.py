@@ -1,0 +1,293 @@
+"""`affinity report` as a user runs it, and the sections' decisions to appear or be left out.
+
+The HTML is read back with the standard library's parser into a small tree, so
+assertions are about elements and text, not about substrings of markup.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from html.parser import HTMLParser
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from affinity.mesh import mesh_from_polygons
+from affinity.objwriter import write_obj
+from affinity.scenes import color_squares
+
+TRAPEZOID = "v -1 0 0\nv 1 0 0\nv 0.5 1 0\nv -0.5 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n"
+VOID_ELEMENTS = frozenset({"area", "base", "br", "col", "embed", "hr", "img", "input", "link", "meta", "source", "wbr"})
+
+
+def run_report(*args: str, cwd: Path) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "affinity.cli", "report", *args],
+                          capture_output=True, text=True, cwd=cwd, timeout=300)
+
+
+class Node:
+    """An element of the parsed page: tag, attributes, children (nodes and text)."""
+
+    def __init__(self, tag: str, attrs: dict, parent: Node | None):
+        self.tag, self.attrs, self.parent, self.children = tag, attrs, parent, []
+
+    def text(self) -> str:
+        return " ".join(c.text() if isinstance(c, Node) else c for c in self.children)
+
+    def classes(self) -> set[str]:
+        return set((self.attrs.get("class") or "").split())
+
+    def find_all(self, tag: str, cls: str | None = None) -> list[Node]:
+        found = []
+        for child in self.children:
+            if isinstance(child, Node):
+                if child.tag == tag and (cls is None or cls in child.classes()):
+                    found.append(child)
+                found += child.find_all(tag, cls)
+        return found
+
+
+class TreeBuilder(HTMLParser):
+    def __init__(self):
+        super().__init__(convert_charrefs=True)
+        self.root = self.current = Node("#document", {}, None)
+
+    def handle_starttag(self, tag, attrs):
+        node = Node(tag, dict(attrs), self.current)
+        self.current.children.append(node)
+        if tag not in VOID_ELEMENTS:
+            self.current = node
+
+    def handle_endtag(self, tag):
+        node = self.current
+        while node.parent is not None and node.tag != tag:
+            node = node.parent
+        if node.parent is not None:
+            self.current = node.parent
+
+    def handle_data(self, data):
+        self.current.children.append(data)
+
+
+def parse(path: Path) -> Node:
+    builder = TreeBuilder()
+    builder.feed(path.read_text(encoding="utf-8"))
+    return builder.root
+
+
+def mesh_article(doc: Node, label_part: str) -> Node:
+    (article,) = [a for a in doc.find_all("article", "mesh") if label_part in a.find_all("h2")[0].text()]
+    return article
+
+
+def section(article: Node, key: str) -> Node:
+    (found,) = article.find_all("section", key)
+    return found
+
+
+def left_out(node: Node) -> str | None:
+    lines = node.find_all("p", "left-out")
+    return lines[0].text() if lines else None
+
+
+def image_alts(node: Node) -> list[str]:
+    return [img.attrs.get("alt", "") for img in node.find_all("img")]
+
+
+@pytest.fixture(scope="module")
+def demo(tmp_path_factory) -> tuple[subprocess.CompletedProcess, Path]:
+    """The demo report, written with no arguments at all: the built-in scenes into ./report.html."""
+    folder = tmp_path_factory.mktemp("demo")
+    result = run_report(cwd=folder)
+    return result, folder / "report.html"
+
+
+def test_demo_report_builds_with_every_scene(demo):
+    result, path = demo
+    assert result.returncode == 0, result.stderr
+    assert "wrote report.html" in result.stderr.splitlines()[-1]
+    assert path.stat().st_size < 5_000_000
+    doc = parse(path)
+    labels = [a.find_all("h2")[0].text() for a in doc.find_all("article", "mesh")]
+    assert [label.split()[0] for label in labels] == ["trapezoid.obj", "sphere.obj", "color_squares.obj"]
+    files = section(doc, "summary").find_all("table", "files")[0].find_all("tr")
+    assert len(files) == 1 + 3  # header and one row per scene
+
+    trapezoid = mesh_article(doc, "trapezoid.obj")
+    renders = section(trapezoid, "renders")
+    assert {"split render", "hybrid render", "mvc render"} <= set(image_alts(renders))
+    assert "mvc, face 0" in image_alts(renders)  # the zoomed crop on the one flagged quad
+    assert "exact left out" in renders.text()  # until render has the exact reference
+    assert "flagged-quads overlay" in image_alts(section(trapezoid, "overlay"))
+    assert "uv score histogram" in image_alts(section(trapezoid, "scores"))
+    for key in ("study", "stability"):
+        assert "not built yet" in left_out(section(doc, key))
+
+
+def test_demo_report_references_nothing_outside_itself(demo):
+    _, path = demo
+    doc = parse(path)
+    references = [node.attrs[name] for tag in ("img", "link", "script", "a", "iframe", "source")
+                  for node in doc.find_all(tag) for name in ("src", "href") if name in node.attrs]
+    assert references, "the report has pictures and links"
+    assert all(ref.startswith(("data:", "#")) for ref in references), [r[:40] for r in references]
+    text = path.read_text(encoding="utf-8")
+    assert "http://" not in text and "https://" not in text
+
+
+def _affine_square() -> object:
+    """A parallelogram whose uv is an affine image of its positions: nothing to flag."""
+    positions = np.array([[0, 0, 0], [2, 0, 0], [2.5, 1, 0], [0.5, 1, 0]], dtype=float)
+    uv = np.stack([0.25 * positions[:, 0] + 0.1, 0.5 * positions[:, 1] + 0.05 * positions[:, 0]], axis=1)
+    return mesh_from_polygons("affine", positions, [[0, 1, 2, 3]], texcoords=uv)
+
+
+def test_sections_a_mesh_lacks_are_left_out_and_the_others_remain(tmp_path):
+    write_obj(color_squares(), tmp_path / "colours.obj")
+    write_obj(_affine_square(), tmp_path / "affine.obj")
+    result = run_report("colours.obj", "affine.obj", "-o", "out.html", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    doc = parse(tmp_path / "out.html")
+
+    colours = mesh_article(doc, "colours.obj")  # no texture coordinates
+    scores = section(colours, "scores")
+    assert left_out(scores) is None
+    assert "uv (no texture coordinates)" in scores.text()
+    assert "colour score histogram" in image_alts(scores) and "uv score histogram" not in image_alts(scores)
+    renders = section(colours, "renders")
+    assert "vertex colours" in renders.text()
+    assert {"split render", "hybrid render", "mvc render"} <= set(image_alts(renders))
+    assert "Q102" in section(colours, "findings").text()
+
+    affine = mesh_article(doc, "affine.obj")  # nothing flagged
+    assert "nothing flagged" in left_out(section(affine, "findings"))
+    renders = section(affine, "renders")
+    assert left_out(renders) is None
+    assert image_alts(renders) == ["hybrid render"]
+    assert "nothing needed mvc" in renders.text()
+    assert "nothing was sent to mvc" in left_out(section(affine, "overlay"))
+    assert "affine up to rounding" in left_out(section(affine, "scores"))
+    files = section(doc, "summary").find_all("table", "files")[0].find_all("tr")[1:]
+    statuses = [row.find_all("span", "status")[0].text() for row in files]
+    assert statuses == ["findings", "clean"]
+
+
+def test_file_and_group_named_like_markup_render_as_text(tmp_path):
+    name = "<script>alert(1)</script>.obj"  # the "/" makes "<script>alert(1)<" a folder
+    (tmp_path / "<script>alert(1)<").mkdir()
+    (tmp_path / name).write_text("g <script>alert(1)</script>\n" + TRAPEZOID)
+    result = run_report(name, "-o", "out.html", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    doc = parse(tmp_path / "out.html")
+    scripts = doc.find_all("script")
+    assert len(scripts) == 1 and "alert" not in scripts[0].text()  # only the page's own table sorter
+    article = mesh_article(doc, name)
+    assert name in article.find_all("h2")[0].text()
+    assert "<script>alert(1)</script>" in section(article, "findings").text()  # the group of the flagged quad
+
+
+def test_unreadable_mesh_is_a_failed_row_and_the_others_still_report(tmp_path):
+    (tmp_path / "bad.obj").write_text("v 0 0 0\nf 1 2 3 4\n")
+    (tmp_path / "good.obj").write_text(TRAPEZOID)
+    result = run_report("bad.obj", "good.obj", "-o", "out.html", cwd=tmp_path)
+    assert result.returncode == 2
+    assert "bad.obj:2: Q901 unreadable" in result.stderr
+    doc = parse(tmp_path / "out.html")
+    (row,) = [r for r in section(doc, "summary").find_all("table", "files")[0].find_all("tr") if "bad.obj" in r.text()]
+    assert "failed" in row.text() and "line 2" in row.text()
+    bad = mesh_article(doc, "bad.obj")
+    assert bad.find_all("section") == [] and "Q901 unreadable" in bad.text()
+    assert left_out(section(mesh_article(doc, "good.obj"), "renders")) is None
+
+
+def test_output_into_a_missing_directory_is_an_error_and_writes_nothing(tmp_path):
+    result = run_report("-o", "missing/report.html", cwd=tmp_path)
+    assert result.returncode == 2
+    (line,) = result.stderr.splitlines()
+    assert line.startswith("affinity report: error: missing/report.html: cannot write the report")
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.skipif(not os.path.isdir("/proc/self"), reason="needs Linux /proc, a place no one may write to")
+def test_output_into_an_unwritable_place_is_an_error_and_writes_nothing(tmp_path):
+    (tmp_path / "good.obj").write_text(TRAPEZOID)
+    result = run_report("good.obj", "-o", "/proc/report.html", cwd=tmp_path)
+    assert result.returncode == 2
+    assert "cannot write the report" in result.stderr
+    assert not os.path.exists("/proc/report.html")
+    assert [p.name for p in tmp_path.iterdir()] == ["good.obj"]
+
+
+def test_scores_are_the_lint_rule_values_for_every_quad():
+    from affinity.lint import lint_mesh
+    from affinity.report.scores import quad_scores
+    from affinity.scenes import demo_sphere
+    from affinity.settings import Settings
+
+    sphere = demo_sphere()
+    scores = quad_scores(sphere, Settings(), "Q101")
+    assert len(scores.faces) == sphere.n_faces  # every quad, not just the flagged ones
+    (hits,) = lint_mesh(sphere, Settings(select=["Q101"]))
+    np.testing.assert_array_equal(scores.faces[scores.flagged], hits.faces)
+    np.testing.assert_array_equal(scores.values[scores.flagged], hits.values)
+
+
+def test_crop_window_is_square_holds_the_quad_and_stays_in_the_image():
+    from affinity.report.images import MIN_CROP, crop_box
+
+    mask = np.zeros((120, 160), dtype=bool)
+    mask[50:54, 100:104] = True
+    top, bottom, left, right = crop_box(mask)
+    assert bottom - top == right - left == MIN_CROP
+    assert top <= 50 and bottom >= 54 and left <= 100 and right >= 104
+    mask[:] = False
+    mask[0:3, 155:160] = True  # in the corner: the window shifts inside
+    top, bottom, left, right = crop_box(mask)
+    assert (top, right) == (0, 160) and bottom - top == MIN_CROP
+    assert crop_box(np.zeros((4, 4), dtype=bool)) is None
+
+
+def test_error_heatmaps_appear_once_render_has_exact(monkeypatch):
+    """With an exact reference (here faked by mvc) the section shows split, hybrid and mvc against it."""
+    import affinity.hybrid
+    from affinity.report.build import collect_mesh
+    from affinity.report.demo import demo_inputs
+    from affinity.report.sections import error_heatmaps_section, renders_section
+    from affinity.settings import Settings
+
+    real = affinity.hybrid.render_mesh
+
+    def with_exact(path, options, warn=lambda line: None):
+        if options.method == "exact":
+            options = affinity.hybrid.RenderOptions(**{**vars(options), "method": "mvc"})
+        return real(path, options, warn)
+
+    monkeypatch.setattr(affinity.hybrid, "render_mesh", with_exact)
+    trapezoid = next(item for item in demo_inputs() if "trapezoid" in item.path)
+    result = collect_mesh(trapezoid, Settings())
+    assert "exact" in result.renders and not result.missing
+    section = error_heatmaps_section(result)
+    assert section.left_out is None
+    figures = {figure["method"]: figure for figure in section.data["figures"]}
+    assert figures["mvc"]["max"] == "0 texels"  # mvc against itself
+    assert float(figures["split"]["max"].split()[0]) > 10  # the trapezoid's crease, in texels
+    assert [f["method"] for f in renders_section(result).data["figures"]] == ["split", "hybrid", "mvc", "exact"]
+
+
+def test_view_screenshot_outlines_the_flagged_quads(tmp_path):
+    pytest.importorskip("pyvista")
+    from PIL import Image
+
+    from affinity.report.charts import FLAG_COLOUR
+    from affinity.scenes import demo_paths
+
+    out = tmp_path / "view.png"
+    result = subprocess.run([sys.executable, "-m", "affinity.cli", "view", demo_paths()[0], "--screenshot", str(out)],
+                            capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr
+    pixels = np.asarray(Image.open(out).convert("RGB")).reshape(-1, 3).astype(int)
+    flag = np.array([int(FLAG_COLOUR[i:i + 2], 16) for i in (1, 3, 5)])
+    assert (np.abs(pixels - flag).max(axis=1) < 40).sum() > 100  # the trapezoid's magenta outline
