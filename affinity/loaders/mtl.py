@@ -1,0 +1,66 @@
+"""Wavefront material (.mtl) files: only what the linter needs, the ``map_Kd`` texture per material."""
+
+from __future__ import annotations
+
+import os
+
+#: ``map_Kd`` options with a fixed number of arguments.
+_FIXED_ARGUMENTS = {
+    "-blendu": 1, "-blendv": 1, "-bm": 1, "-boost": 1, "-cc": 1, "-clamp": 1,
+    "-imfchan": 1, "-mm": 2, "-texres": 1, "-type": 1,
+}  # fmt: skip
+#: ``map_Kd`` options followed by one to three numbers.
+_VECTOR_OPTIONS = ("-o", "-s", "-t")
+
+
+def read_material_textures(path) -> dict[str, str]:
+    """Material name -> ``map_Kd`` path (resolved against the .mtl's folder).
+
+    A missing or unreadable file gives an empty dict: materials are optional.
+    """
+    try:
+        with open(path, "rb") as fh:
+            text = fh.read().decode("utf-8", "replace")
+    except OSError:
+        return {}
+    folder = os.path.dirname(os.fspath(path))
+    textures: dict[str, str] = {}
+    material = None
+    for line in text.splitlines():
+        words = line.split()
+        words = words[: next((k for k, w in enumerate(words) if w.startswith("#")), len(words))]
+        if len(words) < 2:
+            continue
+        if words[0] == "newmtl":
+            material = " ".join(words[1:])
+        elif words[0] == "map_Kd" and material is not None:
+            name = texture_file_name(words[1:])
+            textures[material] = os.path.normpath(os.path.join(folder, name.replace("\\", "/")))
+    return textures
+
+
+def texture_file_name(arguments: list[str]) -> str:
+    """The file name of a ``map_Kd`` statement after its options.
+
+    >>> texture_file_name(["-s", "1", "1", "1", "-clamp", "on", "wood grain.png"])
+    'wood grain.png'
+    """
+    k = 0
+    while k < len(arguments) - 1 and (arguments[k] in _FIXED_ARGUMENTS or arguments[k] in _VECTOR_OPTIONS):
+        option = arguments[k]
+        k += 1
+        if option in _FIXED_ARGUMENTS:
+            k += _FIXED_ARGUMENTS[option]
+            continue
+        for _ in range(3):
+            if k < len(arguments) - 1 and _is_number(arguments[k]):
+                k += 1
+    return " ".join(arguments[k:])
+
+
+def _is_number(word: str) -> bool:
+    try:
+        float(word)
+    except ValueError:
+        return False
+    return True

@@ -1,0 +1,237 @@
+"""Chunked reading and tokenizing of line-oriented text meshes (OBJ, OFF, ASCII PLY).
+
+A file is read in chunks of whole lines, so memory stays bounded whatever the
+file size; each chunk is split into tokens with one vectorized pass (a token is
+a run of bytes that are not whitespace, nor '/' where asked), and every line
+knows its first token and its 1-based number in the file.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..mesh import MeshError
+from .numbers import PAD, parse_floats
+
+#: Bytes read per chunk: large enough that per-chunk overhead vanishes, small
+#: enough that the per-token temporaries stay in cache-friendly sizes.
+CHUNK_BYTES = 1 << 19
+
+_NEWLINE, _CR, _SLASH, _HASH, _BACKSLASH = (ord(c) for c in "\n\r/#\\")
+
+
+@dataclass
+class Chunk:
+    """Whole lines of a text file.
+
+    buf : (n,) uint8
+        :data:`PAD` spaces, then the lines, the last one ending with '\\n'.
+    first_line : int
+        1-based number of the chunk's first line.
+    joined : (j,) int64
+        Sorted offsets in ``buf`` of newlines removed by a '\\' continuation.
+    """
+
+    buf: np.ndarray
+    first_line: int
+    joined: np.ndarray
+
+
+def read_chunks(fh, first_line: int = 1, continuations: bool = False, size: int = CHUNK_BYTES):
+    """Yield :class:`Chunk` s of whole lines from the binary file object ``fh``.
+
+    With ``continuations`` a '\\' right before a line break joins the two lines
+    (the backslash and the break become spaces, so byte offsets and line
+    numbers still point into the file). The last line gets a '\\n' if it lacks one.
+    """
+    carry = b""
+    line = first_line
+    while True:
+        buf = bytearray(PAD + len(carry) + size)
+        buf[:PAD] = b" " * PAD
+        buf[PAD : PAD + len(carry)] = carry
+        end = PAD + len(carry) + fh.readinto(memoryview(buf)[PAD + len(carry) :])
+        if end == PAD + len(carry):  # end of file
+            if not carry:
+                return
+            buf[end : end + 1] = b"\n"
+            cut = end + 1
+        else:
+            cut = _last_line_break(buf, end, continuations)
+            if cut == 0:  # one line longer than the chunk: read on
+                carry = bytes(buf[PAD:end])
+                continue
+        carry = bytes(buf[cut:end])
+        array = np.frombuffer(buf, dtype=np.uint8, count=cut)
+        joined = _join_continuations(array) if continuations and buf.find(b"\\", PAD, cut) >= 0 else np.zeros(0, np.int64)
+        yield Chunk(array, line, joined)
+        line += buf.count(b"\n", PAD, cut) + len(joined)
+
+
+def _last_line_break(buf: bytearray, end: int, continuations: bool) -> int:
+    """Offset just past the last '\\n' before ``end`` that ends a statement (0: none)."""
+    cut = buf.rfind(b"\n", PAD, end) + 1
+    while continuations and cut and _continued(buf, cut - 1):
+        cut = buf.rfind(b"\n", PAD, cut - 1) + 1
+    return cut
+
+
+def _continued(buf: bytearray, newline: int) -> bool:
+    """The line break at ``newline`` follows a '\\' (optionally with '\\r' between)."""
+    before = newline - 1 - (buf[newline - 1] == _CR)
+    return before >= PAD and buf[before] == _BACKSLASH
+
+
+def _join_continuations(buf: np.ndarray) -> np.ndarray:
+    """Blank out '\\' + line break in place; return the removed newlines' offsets.
+
+    A '\\' before the chunk's last line break (the end of the file) joins
+    nothing: it is blanked and the break kept.
+    """
+    slash = np.flatnonzero(buf[:-1] == _BACKSLASH)
+    crlf = (buf[slash + 1] == _CR) & (buf[np.minimum(slash + 2, len(buf) - 1)] == _NEWLINE)
+    newline = np.where(crlf, slash + 2, slash + 1)
+    hit = buf[newline] == _NEWLINE
+    joined = hit & (newline < len(buf) - 1)
+    for offset in (0, 1, 2):
+        blank = slash[hit & (offset <= newline - slash - (~joined))] + offset
+        buf[blank] = ord(" ")
+    return newline[joined]
+
+
+class _Ragged:
+    """Rows stored as offsets ``first`` (R + 1,) into a flat array."""
+
+    first: np.ndarray
+
+    @property
+    def counts(self) -> np.ndarray:
+        """(R,) int64 items per row."""
+        return np.diff(self.first)
+
+
+@dataclass
+class Tokens(_Ragged):
+    """The tokens and lines of one :class:`Chunk`.
+
+    starts, ends : (K,) int64
+        Byte offsets of every token in ``buf`` (comments already removed).
+    first : (L + 1,) int64
+        Index of the first token of every line; line ``i`` owns tokens
+        ``first[i]:first[i + 1]``.
+    number : (L,) int64
+        1-based line number in the file of every line.
+    begin, end : (L,) int64
+        Byte offsets of every line's first byte and of its '\\n'.
+    """
+
+    buf: np.ndarray
+    starts: np.ndarray
+    ends: np.ndarray
+    first: np.ndarray
+    number: np.ndarray
+    begin: np.ndarray
+    end: np.ndarray
+
+    def line_of_byte(self, offset) -> int:
+        return int(self.number[np.searchsorted(self.end, offset)])
+
+    def line_of_token(self, token) -> int:
+        return int(self.number[np.searchsorted(self.first, token, side="right") - 1])
+
+    def text(self, token) -> str:
+        return bytes(self.buf[self.starts[token] : self.ends[token]]).decode("utf-8", "backslashreplace")
+
+
+def tokenize(chunk: Chunk, path, slash: bool = False) -> Tokens:
+    """Split a chunk into tokens at whitespace (and '/' when ``slash``).
+
+    A token starting with '#' comments out the rest of its line. Control bytes
+    other than tab, line feed, vertical tab, form feed and carriage return mean
+    the file is not text: :class:`MeshError` naming their line.
+    """
+    buf = chunk.buf
+    end = np.flatnonzero(buf == _NEWLINE)
+    begin = np.concatenate(([PAD], end[:-1] + 1))
+    number = chunk.first_line + np.arange(len(end))
+    if len(chunk.joined):
+        number += np.searchsorted(chunk.joined, begin)
+    separator = buf <= 32
+    if slash:
+        separator |= buf == _SLASH
+    edges = np.flatnonzero(separator[1:] != separator[:-1]) + 1
+    starts, ends = edges[0::2], edges[1::2]
+    tokens = Tokens(buf, starts, ends, np.zeros(0, np.int64), number, begin, end)
+    _reject_control_bytes(tokens, path)
+    if _HASH in buf:
+        tokens.starts, tokens.ends = _drop_comments(buf, starts, ends, end)
+    tokens.first = np.append(np.searchsorted(tokens.starts, begin), len(tokens.starts))
+    return tokens
+
+
+def _reject_control_bytes(tokens: Tokens, path) -> None:
+    text = tokens.buf[PAD:]
+    control = ((text < 32) & (text - np.uint8(9) > 4)) | (text == 127)
+    if control.any():
+        offset = PAD + int(np.argmax(control))
+        byte = int(tokens.buf[offset])
+        raise MeshError(path, tokens.line_of_byte(offset), f"binary data (byte 0x{byte:02x}): not a text mesh")
+
+
+def _drop_comments(buf, starts, ends, line_end):
+    """Remove every token from one starting with '#' to the end of its line."""
+    hashes = np.flatnonzero(buf[starts] == _HASH)
+    if len(hashes) == 0:
+        return starts, ends
+    stop = np.searchsorted(starts, line_end[np.searchsorted(line_end, starts[hashes])])
+    depth = np.zeros(len(starts) + 1, dtype=np.int32)
+    np.add.at(depth, hashes, 1)
+    np.add.at(depth, stop, -1)
+    keep = np.cumsum(depth[:-1]) == 0
+    return starts[keep], ends[keep]
+
+
+def floats_or_raise(tokens: Tokens, path, which: np.ndarray, finite: bool = False) -> np.ndarray:
+    """(n,) float64 values of the tokens ``which``; MeshError on the first that is
+    not a number (or, with ``finite``, not a finite one)."""
+    values, bad = parse_floats(tokens.buf, tokens.starts[which], tokens.ends[which], finite)
+    if len(bad):
+        token = which[bad[0]]
+        kind = "a number" if np.isnan(values[bad[0]]) and "nan" not in tokens.text(token).lower() else "a finite number"
+        raise MeshError(path, tokens.line_of_token(token), f"not {kind}: {tokens.text(token)!r}")
+    return values
+
+
+@dataclass
+class Rows(_Ragged):
+    """Every non-empty line of a text section as a row of numbers.
+
+    number : (R,) int64
+        1-based line number of every row.
+    first : (R + 1,) int64
+        Row ``r`` owns ``values[first[r]:first[r + 1]]``.
+    values : (T,) float64
+    """
+
+    number: np.ndarray
+    first: np.ndarray
+    values: np.ndarray
+
+
+def read_rows(fh, path, first_line: int) -> Rows:
+    """Read the rest of ``fh`` as rows of whitespace-separated numbers ('#' comments allowed)."""
+    numbers, counts, values = [], [], []
+    for chunk in read_chunks(fh, first_line):
+        tokens = tokenize(chunk, path)
+        per_line = tokens.counts
+        numbers.append(tokens.number[per_line > 0])
+        counts.append(per_line[per_line > 0])
+        values.append(floats_or_raise(tokens, path, np.arange(len(tokens.starts))))
+    counts = np.concatenate(counts) if counts else np.zeros(0, np.int64)
+    return Rows(
+        number=np.concatenate(numbers) if numbers else np.zeros(0, np.int64),
+        first=np.concatenate(([0], np.cumsum(counts))),
+        values=np.concatenate(values) if values else np.zeros(0),
+    )

@@ -1,0 +1,146 @@
+"""PLY loader: ASCII, binary little- and big-endian give the same mesh; attributes; skipping."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from affinity.loaders import load
+
+DATA = Path(__file__).parent / "data" / "loaders"
+FORMATS = ["ascii", "binary_little_endian", "binary_big_endian"]
+
+
+def write_ply(path, fmt, elements):
+    """Write a PLY file with our own minimal writer.
+
+    elements: list of (name, properties, rows); properties are ("type", name) or
+    ("list", count type, item type, name); rows are tuples (lists for list properties).
+    """
+    header = ["ply", f"format {fmt} 1.0", "comment written by tests/test_loaders_ply.py"]
+    for name, properties, rows in elements:
+        header.append(f"element {name} {len(rows)}")
+        header += [f"property {' '.join(p)}" for p in properties]
+    header.append("end_header")
+    body = bytearray()
+    order = ">" if fmt == "binary_big_endian" else "<"
+    codes = {"char": "i1", "uchar": "u1", "short": "i2", "ushort": "u2", "int": "i4", "uint": "u4", "float": "f4", "double": "f8"}
+    text_rows = []
+    for _, properties, rows in elements:
+        for row in rows:
+            words = []
+            for prop, value in zip(properties, row):
+                if prop[0] == "list":
+                    words += [str(len(value))] + [repr(v) for v in value]
+                    body += np.array([len(value)], order + codes[prop[1]]).tobytes()
+                    body += np.array(value, order + codes[prop[2]]).tobytes()
+                else:
+                    words.append(repr(value))
+                    body += np.array([value], order + codes[prop[0]]).tobytes()
+            text_rows.append(" ".join(words))
+    with open(path, "wb") as fh:
+        fh.write(("\n".join(header) + "\n").encode())
+        fh.write(("\n".join(text_rows) + "\n").encode() if fmt == "ascii" else bytes(body))
+    return path
+
+
+VERTEX = [("float", "x"), ("float", "y"), ("float", "z"), ("float", "nx"), ("float", "ny"), ("float", "nz"),
+          ("uchar", "red"), ("uchar", "green"), ("uchar", "blue"), ("uchar", "alpha"), ("float", "s"), ("float", "t")]  # fmt: skip
+VERTEX_ROWS = [
+    (0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 255, 0, 0, 255, 0.0, 0.0),
+    (1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0, 255, 0, 255, 1.0, 0.0),
+    (1.0, 1.0, 0.5, 0.0, 0.6, 0.8, 0, 0, 255, 255, 1.0, 1.0),
+    (0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 51, 102, 153, 255, 0.0, 1.0),
+    (2.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0, 0, 0, 0, 0.5, 0.25),
+]
+FACE = [("list", "uchar", "int", "vertex_indices"), ("int", "flags")]
+FACE_ROWS = [([0, 1, 2, 3], 7), ([1, 4, 2], 8), ([0, 1, 4, 2, 3], 9)]
+EDGE = [("int", "vertex1"), ("int", "vertex2"), ("list", "ushort", "double", "weights")]
+EDGE_ROWS = [(0, 1, [0.5, 0.25, 1.0]), (1, 2, [])]
+
+
+def sample(tmp_path, fmt):
+    elements = [("vertex", VERTEX, VERTEX_ROWS), ("edge", EDGE, EDGE_ROWS), ("face", FACE, FACE_ROWS)]
+    return load(write_ply(tmp_path / f"{fmt}.ply", fmt, elements))
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_attributes(tmp_path, fmt):
+    mesh = sample(tmp_path, fmt)
+    np.testing.assert_array_equal(mesh.positions, [r[:3] for r in VERTEX_ROWS])
+    np.testing.assert_allclose(mesh.normals, [r[3:6] for r in VERTEX_ROWS], rtol=1e-7)
+    np.testing.assert_allclose(mesh.colors, np.array([r[6:9] for r in VERTEX_ROWS]) / 255)
+    np.testing.assert_array_equal(mesh.texcoords, [r[10:] for r in VERTEX_ROWS])
+    assert mesh.corner_vertex.tolist() == [0, 1, 2, 3, 1, 4, 2, 0, 1, 4, 2, 3]
+    assert mesh.face_sizes.tolist() == [4, 3, 5]
+    assert mesh.corner_texcoord.tolist() == mesh.corner_vertex.tolist()
+    assert mesh.corner_normal.tolist() == mesh.corner_vertex.tolist()
+
+
+def test_three_encodings_give_identical_arrays(tmp_path):
+    meshes = [sample(tmp_path, fmt) for fmt in FORMATS]
+    for name in ("positions", "normals", "colors", "texcoords", "face_start", "corner_vertex", "corner_texcoord"):
+        for other in meshes[1:]:
+            np.testing.assert_array_equal(getattr(meshes[0], name), getattr(other, name))
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_face_lines(tmp_path, fmt):
+    # header: ply, format, comment, then each element line with its property lines, end_header;
+    # the ASCII face rows follow the 5 vertex and 2 edge rows
+    mesh = sample(tmp_path, fmt)
+    header_lines = 3 + 1 + len(VERTEX) + 1 + len(EDGE) + 1 + len(FACE) + 1
+    expected = [header_lines + 5 + 2 + k + 1 for k in range(3)] if fmt == "ascii" else [0, 0, 0]
+    assert mesh.face_line.tolist() == expected
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_per_face_texcoord_lists(tmp_path, fmt):
+    vertex = [("double", "x"), ("double", "y"), ("double", "z")]
+    face = [("list", "int", "uint", "vertex_index"), ("list", "uchar", "float", "texcoord")]
+    rows = [([0, 1, 2, 3], [0, 0, 0.5, 0, 0.5, 0.5, 0, 0.5]), ([1, 4, 2], [0.5, 0, 1, 0, 1, 0.5])]
+    path = write_ply(tmp_path / "uv.ply", fmt, [("vertex", vertex, [r[:3] for r in VERTEX_ROWS]), ("face", face, rows)])
+    mesh = load(path)
+    np.testing.assert_array_equal(mesh.texcoords, np.array(rows[0][1] + rows[1][1]).reshape(-1, 2))
+    assert mesh.corner_texcoord.tolist() == list(range(7))
+    assert mesh.corner_vertex.tolist() == [0, 1, 2, 3, 1, 4, 2]
+    assert mesh.colors is None and mesh.normals is None
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+@pytest.mark.parametrize("names", [("u", "v"), ("texture_u", "texture_v"), ("texture_s", "texture_t")])
+def test_vertex_texcoord_names(tmp_path, fmt, names):
+    vertex = [("float", "x"), ("float", "y"), ("float", "z"), ("float", names[0]), ("float", names[1])]
+    rows = [(0.0, 0.0, 0.0, 0.25, 0.5), (1.0, 0.0, 0.0, 0.75, 0.5), (0.0, 1.0, 0.0, 0.25, 1.0)]
+    mesh = load(write_ply(tmp_path / "v.ply", fmt, [("vertex", vertex, rows), ("face", FACE[:1], [([0, 1, 2],)])]))
+    np.testing.assert_array_equal(mesh.texcoords, [r[3:] for r in rows])
+
+
+def test_float_colours_are_kept(tmp_path):
+    vertex = [("float", "x"), ("float", "y"), ("float", "z"), ("float", "red"), ("float", "green"), ("float", "blue")]
+    rows = [(0.0, 0.0, 0.0, 0.25, 0.5, 1.0), (1.0, 0.0, 0.0, 0.0, 0.0, 0.0), (0.0, 1.0, 0.0, 1.0, 1.0, 1.0)]
+    mesh = load(write_ply(tmp_path / "c.ply", "binary_little_endian", [("vertex", vertex, rows), ("face", FACE[:1], [([0, 1, 2],)])]))
+    np.testing.assert_array_equal(mesh.colors, [r[3:] for r in rows])
+
+
+@pytest.mark.parametrize("fmt", FORMATS[1:])
+def test_binary_runs_of_mixed_face_sizes(tmp_path, fmt):
+    rng = np.random.default_rng(7)
+    sizes = np.concatenate([np.full(3000, 4), rng.integers(3, 7, 500), np.full(2000, 3), [5, 4, 3] * 100])
+    faces = [(list(rng.integers(0, 5, s)),) for s in sizes]
+    mesh = load(write_ply(tmp_path / "runs.ply", fmt, [("vertex", VERTEX[:3], [r[:3] for r in VERTEX_ROWS]), ("face", FACE[:1], faces)]))
+    assert mesh.face_sizes.tolist() == sizes.tolist()
+    assert mesh.corner_vertex.tolist() == [i for (f,) in faces for i in f]
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_vertices_without_faces(tmp_path, fmt):
+    points = [("vertex", VERTEX[:3], [r[:3] for r in VERTEX_ROWS])]
+    for elements in (points, points + [("face", FACE, [])]):
+        mesh = load(write_ply(tmp_path / "points.ply", fmt, elements))
+        assert mesh.n_faces == 0 and len(mesh.positions) == 5
+
+
+def test_fixture():
+    square = load(DATA / "square.ply")
+    assert square.face_sizes.tolist() == [4, 3] and square.face_line.tolist() == [16, 17]
