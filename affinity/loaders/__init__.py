@@ -1,1 +1,54 @@
-"""Mesh loaders: ``load(path) -> Mesh`` dispatching on the file extension."""
+"""Mesh loaders: ``load(path) -> Mesh`` dispatching on the file extension.
+
+Supported: Wavefront OBJ (``.obj``), PLY (``.ply``; ASCII and binary) and OFF
+(``.off``; with the C/N/ST prefixes). Every problem with the input is a
+:class:`~affinity.mesh.MeshError` naming the file and line; a Git LFS pointer
+is a :class:`~affinity.mesh.SkippedFile`. Only NumPy is imported.
+"""
+
+from __future__ import annotations
+
+import os
+
+from ..mesh import Mesh, MeshError, SkippedFile
+from .obj import load_obj
+from .off import load_off
+from .ply import load_ply
+
+LOADERS = {".obj": load_obj, ".ply": load_ply, ".off": load_off}
+
+_LFS_POINTER = b"version https://git-lfs.github.com/spec/"
+
+
+def load(path) -> Mesh:
+    """Read the mesh at ``path``, choosing the reader by its extension (case-insensitive).
+
+    Raises
+    ------
+    MeshError
+        Unknown extension, missing/unreadable file, directory, empty file or any
+        content that is not a valid mesh (with the 1-based line where there is one).
+    SkippedFile
+        The file is a Git LFS pointer, not the mesh itself.
+    """
+    extension = os.path.splitext(os.fspath(path))[1].lower()
+    if extension not in LOADERS:
+        raise MeshError(path, 0, f"unknown mesh format {extension or '(no extension)'!r}; expected one of .obj, .ply, .off")
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(len(_LFS_POINTER))
+    except IsADirectoryError:
+        raise MeshError(path, 0, "is a directory, not a mesh file") from None
+    except OSError as error:
+        raise MeshError(path, 0, f"cannot read: {error.strerror or error}") from None
+    if not head:
+        raise MeshError(path, 0, "empty file")
+    if head == _LFS_POINTER:
+        raise SkippedFile(path, "lfs-pointer")
+    try:
+        return LOADERS[extension](path)
+    except OSError as error:  # e.g. the file vanished or became unreadable while reading
+        raise MeshError(path, 0, f"cannot read: {error.strerror or error}") from None
+
+
+__all__ = ["LOADERS", "load"]
