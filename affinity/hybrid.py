@@ -7,6 +7,7 @@ per-quad method array, and shades the result.
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -154,8 +155,9 @@ def resolve_texture(mesh: Mesh, options: RenderOptions, warn: Callable[[str], No
     return checker()
 
 
-def render_mesh(path: str | None, options: RenderOptions, warn: Callable[[str], None] = lambda line: None) -> RenderResult:
-    """Load (or build the demo), route, rasterize and shade.
+def render_mesh(source: str | Mesh | None, options: RenderOptions,
+                warn: Callable[[str], None] = lambda line: None) -> RenderResult:
+    """Route, rasterize and shade a mesh: a path to load, a loaded Mesh, or None for the demo.
 
     Raises
     ------
@@ -168,13 +170,14 @@ def render_mesh(path: str | None, options: RenderOptions, warn: Callable[[str], 
     from .loaders import load
     from .scenes import demo_sphere
 
-    mesh = demo_sphere() if path is None else load(path)
+    is_demo = source is None
+    mesh = demo_sphere() if is_demo else load(source) if isinstance(source, (str, os.PathLike)) else source
     if mesh.n_faces == 0:
         raise ValueError(f"{mesh.path}: the mesh has no faces to render")
     show = options.show or default_show(mesh)
     faces, corners = render_corners(mesh)
     inputs = shading_inputs(mesh, corners, show)
-    camera = camera_for(mesh, options, is_demo=path is None)
+    camera = camera_for(mesh, options, is_demo=is_demo)
     clip = to_clip(mesh.positions, camera.matrix)[mesh.corner_vertex[corners]]
     if not (clip[..., 3] > 0).any():
         raise ValueError(f"{mesh.path}: all geometry is behind the camera")

@@ -109,7 +109,7 @@ def _render(result: MeshResult, texture: str | None, step: Callable[[str], None]
     def draw(warn=lambda line: None, **options):
         chosen = RenderOptions(width=RENDER_SIZE[0], height=RENDER_SIZE[1], camera=view.camera, up=view.up,
                                texture=texture, **options)
-        return render_mesh(result.input.path, chosen, warn)
+        return render_mesh(result.mesh, chosen, warn)
 
     step("render hybrid")
     try:
