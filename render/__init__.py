@@ -1,4 +1,34 @@
 """A NumPy quad rasterizer: clip-space quads in, images out.
 
-Knows nothing of meshes or files. See ``rasterize_quads``.
+Knows nothing of meshes or files. ``rasterize_quads`` draws quads given by
+their clip-space corners with one of several attribute interpolation methods
+(``split``, ``mvc``, ``bilinear``, ``projective``, or one per quad: the
+hybrid); ``render.coords`` holds the quad coordinate functions
+(``mean_value``, ``inverse_bilinear``) and ``render.camera`` the
+view/projection matrices that take points to clip space.
 """
+
+from render import camera, coords
+from render.camera import (
+    Camera,
+    frame_bounds,
+    look_at,
+    orthographic,
+    perspective,
+    to_clip,
+)
+from render.frame import Frame
+from render.raster import rasterize_quads
+
+__all__ = [
+    "Camera",
+    "Frame",
+    "camera",
+    "coords",
+    "frame_bounds",
+    "look_at",
+    "orthographic",
+    "perspective",
+    "rasterize_quads",
+    "to_clip",
+]

@@ -1,0 +1,109 @@
+"""The interpolation methods, and the corner weights of those that need them.
+
+- ``split``: the two triangles (0, 1, 2) and (0, 2, 3), with perspective-correct
+  attributes (a/w over 1/w) from the triangle's interpolation planes
+  (``render.planes``); no per-pixel weights.
+- ``mvc``: Hormann & Tarini's mean value coordinates with the perspective
+  terms of eq. 10 and 11, computed by ``coords.mean_value_terms`` and
+  ``coords.mean_value_from_terms`` on the homogeneous offsets
+  s~_i = X_i - p W_i of the pixel centre p (NDC) from the clip-space corners
+  (X_i, Y_i, W_i) -- that is w_i (q_i - p) for a corner in front of the eye,
+  finite for a corner on the eye plane (W_i = 0) and signed for one behind
+  it. On edge i it gives exactly the perspective-correct linear weights
+  |s~_{i+1}| : |s~_i|, the same as split, so mvc and split quads agree along
+  shared edges.
+- ``bilinear``: the inverse bilinear map of the *screen* quad (Bloomenthal
+  section 3.3), deliberately not perspective-correct. A quad with a corner on
+  or behind the eye plane has no screen quad; its pixels use mvc weights.
+- ``projective``: the two triangles of the split, interpolating (q a, q)
+  linearly in screen space and dividing, with per-corner q from the
+  intersection of the screen quad's diagonals (``projective_corner_weights``).
+  This reproduces a parallelogram of attributes mapped projectively onto the
+  screen quad (a planar parallelogram in perspective), not every affine field
+  on a trapezoid. It is the split's plane machinery with the per-corner
+  weights rho_i = w_i q_i in place of 1.
+
+``exact`` (ray / bilinear-patch intersection, which needs world-space corners)
+is a reserved name. A new weight method is one more entry in ``WEIGHTS`` (and
+in ``QUAD_COVERAGE`` if it fills the quad rather than its two triangles);
+``exact`` would also need the world-space corners passed through
+``rasterize_quads``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from render.coords import (
+    NEXT,
+    bilinear_parameters,
+    bilinear_weights,
+    mean_value_from_terms,
+    mean_value_terms,
+)
+
+
+def mvc_weights(corners, px, py) -> np.ndarray:
+    """Perspective mean value weights (HT04 eq. 8, 10, 11) of pixels in their quads.
+
+    corners : (3, 4, N) float64 clip x, y, w; px, py : (N,). Returns (4, N) float64.
+    """
+    X, Y, W = corners
+    sx, sy = X - px * W, Y - py * W  # s~_i = X_i - p W_i
+    dW = W[NEXT] - W
+    # Homogeneous edge vectors s~_{i+1} - s~_i, formed from the corners.
+    ex = (X[NEXT] - X) - px * dW
+    ey = (Y[NEXT] - Y) - py * dW
+    return mean_value_from_terms(*mean_value_terms(sx, sy, ex, ey))
+
+
+def bilinear_screen_weights(corners, px, py) -> np.ndarray:
+    """Weights of the inverse bilinear map of the screen quad (not perspective-correct).
+
+    corners : (3, 4, N) float64 clip x, y, w; px, py : (N,). Returns (4, N)
+    float64. Pixels of quads with a corner at W <= 0 get ``mvc_weights`` instead.
+    """
+    X, Y, W = corners
+    projectable = (W > 0).all(axis=0)
+    if projectable.all():
+        return bilinear_weights(*bilinear_parameters(px, py, X / W, Y / W))
+    lam = mvc_weights(corners, px, py)
+    ok = np.flatnonzero(projectable)
+    lam[:, ok] = bilinear_screen_weights(np.take(corners, ok, axis=2), px[ok], py[ok])
+    return lam
+
+
+def projective_corner_weights(clip) -> np.ndarray:
+    """Per-corner weights rho_i = w_i q_i (Q, 4) of the projective method.
+
+    clip : (Q, 4, 4) clip-space corners. With c the intersection of the screen
+    diagonals, c = q0 + s (q2 - q0) = q1 + t (q3 - q1), and d_i = |q_i - c|,
+    q_i = (d_i + d_{i+2}) / d_{i+2}, i.e. q = (1 / (1 - s), 1 / (1 - t), 1 / s,
+    1 / t). Interpolating rho a and rho with the homogeneous barycentrics c_k of
+    a split triangle (for which the screen-space barycentrics are c_k w_k) is
+    interpolating q a and q linearly on the screen. Quads that are not
+    strictly convex on screen, or have a corner at w <= 0, have no such q:
+    they get rho = 1, the plain perspective-correct split.
+    """
+    W = clip[..., 3]
+    projectable = (W > 0).all(axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        x, y = clip[..., 0] / W, clip[..., 1] / W
+        e = (x[:, 2] - x[:, 0], y[:, 2] - y[:, 0])
+        f = (x[:, 3] - x[:, 1], y[:, 3] - y[:, 1])
+        g = (x[:, 1] - x[:, 0], y[:, 1] - y[:, 0])
+        ef = e[0] * f[1] - e[1] * f[0]
+        s = (g[0] * f[1] - g[1] * f[0]) / ef
+        t = (g[0] * e[1] - g[1] * e[0]) / ef
+        rho = W * np.stack([1 / (1 - s), 1 / (1 - t), 1 / s, 1 / t], axis=1)
+    convex = projectable & (s > 0) & (s < 1) & (t > 0) & (t < 1)
+    return np.where(convex[:, None], rho, 1.0)
+
+
+METHODS = ("split", "mvc", "bilinear", "projective")
+PLANE_METHODS = frozenset({"split", "projective"})
+WEIGHTS = {"mvc": mvc_weights, "bilinear": bilinear_screen_weights}
+QUAD_COVERAGE = frozenset({"mvc", "bilinear"})
+RESERVED = {
+    "exact": "the 3-D ray / bilinear-patch intersection needs world-space corners and is not implemented yet",
+}
