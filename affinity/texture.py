@@ -6,17 +6,20 @@ Texture coordinates follow OpenGL: ``(0, 0)`` is the bottom-left of the image,
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 CHECKS = 32
 
 
+@functools.lru_cache(maxsize=4)
 def checker(size: int = 1024, checks: int = CHECKS) -> np.ndarray:
     """A checker with thin grid lines, so a bent diagonal stands out.
 
     Returns
     -------
-    (size, size, 3) float32 RGB in [0, 1].
+    (size, size, 3) float32 RGB in [0, 1], read-only (cached: every render shares it).
     """
     cells = (np.arange(size) * checks) // size
     parity = (cells[:, None] + cells[None, :]) % 2
@@ -25,7 +28,9 @@ def checker(size: int = 1024, checks: int = CHECKS) -> np.ndarray:
     period = size // checks
     line = (np.arange(size) % period) < max(1, period // 16)
     image[line, :] = image[:, line] = (0.85, 0.25, 0.15)
-    return image.astype(np.float32)
+    image = image.astype(np.float32)
+    image.flags.writeable = False
+    return image
 
 
 class TextureError(Exception):

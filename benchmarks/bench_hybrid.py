@@ -1,0 +1,72 @@
+"""Where the hybrid sends quads, and what it costs, on real meshes seen whole.
+
+For every mesh of ``../shared/meshes`` (skipped when absent) and the demo sphere,
+render at SIZE x SIZE with a camera framing the whole mesh, once per method
+(split, hybrid, mvc), and print a markdown table: quads, share routed to mvc,
+covered fragments, best-of-N time per method and hybrid / split. Routing (the
+lint misplacement and the on-screen scale) is inside the hybrid's time.
+
+    python benchmarks/bench_hybrid.py [--size 1024] [--repeat 3] [MESH ...]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+
+from affinity.hybrid import RenderOptions, render_mesh
+from affinity.loaders import load
+from affinity.scenes import demo_sphere
+
+SHARED = Path(__file__).resolve().parents[2] / "shared" / "meshes"
+METHODS = ("split", "hybrid", "mvc")
+
+
+def up_axis(name: str) -> str:
+    """The manifest's notes say which meshes are z-up; everything else is y-up."""
+    manifest = SHARED / "MANIFEST.json"
+    if manifest.exists():
+        for entry in json.loads(manifest.read_text()):
+            if entry["file"] == name:
+                return "z" if "z-up" in entry["notes"] else "y"
+    return "y"
+
+
+def best_time(mesh, options: RenderOptions, repeat: int):
+    best, result = np.inf, None
+    for _ in range(repeat):
+        start = time.perf_counter()
+        result = render_mesh(mesh, options)
+        best = min(best, time.perf_counter() - start)
+    return best, result
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("meshes", nargs="*")
+    parser.add_argument("--size", type=int, default=1024)
+    parser.add_argument("--repeat", type=int, default=3)
+    args = parser.parse_args()
+    paths = args.meshes or (sorted(str(p) for p in SHARED.glob("*.obj")) if SHARED.exists() else [])
+    scenes = [("demo sphere 16x8", demo_sphere(), "z")] + [(Path(p).name, load(p), up_axis(Path(p).name)) for p in paths]
+
+    print(f"| mesh ({args.size}x{args.size}) | quads | to mvc | fragments | split s | hybrid s | mvc s | hybrid / split |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|")
+    for name, mesh, up in scenes:
+        times = {}
+        for method in METHODS:
+            options = RenderOptions(method=method, width=args.size, height=args.size, up=up, show="shaded")
+            times[method], result = best_time(mesh, options, args.repeat)
+            if method == "hybrid":
+                share = float(np.mean(result.methods == "mvc"))
+                fragments = int(result.frame.fragments)
+        print(f"| {name} | {mesh.counts()['quads']:,} | {share:.1%} | {fragments:,} | {times['split']:.3f} | "
+              f"{times['hybrid']:.3f} | {times['mvc']:.3f} | {times['hybrid'] / times['split']:.2f} |")
+
+
+if __name__ == "__main__":
+    main()
