@@ -10,13 +10,14 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable, Iterable, Iterator
+from functools import partial
 from pathlib import Path
 
 from .findings import FileReport
 from .mesh import MeshError, SkippedFile
 from .settings import Settings
 
-MESH_SUFFIXES = (".obj", ".ply", ".off")
+MESH_SUFFIXES = (".obj", ".ply", ".off", ".usd", ".usda", ".usdc", ".usdz")
 
 
 class UsageError(Exception):
@@ -38,7 +39,7 @@ def collect_paths(paths: list[str]) -> list[str]:
                 if p.suffix.lower() in MESH_SUFFIXES and p.is_file()
             )
             if not found:
-                raise UsageError(f"{given}: no .obj, .ply or .off files in this directory")
+                raise UsageError(f"{given}: no mesh files ({', '.join(MESH_SUFFIXES)}) in this directory")
             files.extend(found)
         elif os.path.exists(given):
             files.append(given)
@@ -47,13 +48,16 @@ def collect_paths(paths: list[str]) -> list[str]:
     return list(dict.fromkeys(files))
 
 
-def check_file(path: str, settings: Settings) -> FileReport:
-    """Load and lint one file; never raises for bad input."""
+def check_file(path: str, settings: Settings, usd=None) -> FileReport:
+    """Load and lint one file; never raises for bad input.
+
+    ``usd`` (:class:`affinity.loaders.usd.UsdOptions`) says how to read USD stages.
+    """
     from .lint import lint_mesh
     from .loaders import load
 
     try:
-        mesh = load(path)
+        mesh = load(path, usd)
     except SkippedFile as skip:
         return FileReport(path, skipped=skip.reason)
     except MeshError as err:
@@ -63,6 +67,10 @@ def check_file(path: str, settings: Settings) -> FileReport:
         counts=mesh.counts(),
         hits=lint_mesh(mesh, settings),
         group_names=list(mesh.group_names),
+        prim_face_start=mesh.prim_face_start,
+        up_axis=mesh.up_axis,
+        meters_per_unit=mesh.meters_per_unit,
+        notes=list(mesh.notes),
     )
 
 
@@ -94,18 +102,21 @@ def check_files(
     tasks: list[tuple[str, Settings]],
     jobs: int | None = None,
     progress: Callable[[Iterable[FileReport], int], Iterator[FileReport]] | None = None,
+    usd=None,
 ) -> list[FileReport]:
     """Check ``(path, settings)`` pairs with up to ``jobs`` processes; reports in task order.
 
     ``jobs`` None picks :func:`auto_jobs`. One file or one job stays in this
     process (no pool start-up). ``progress``, when given, wraps the stream of
     finished reports (e.g. a progress bar) and receives the number of tasks.
+    ``usd`` is passed on to :func:`check_file`.
     """
     paths = [path for path, _ in tasks]
     settings = [s for _, s in tasks]
+    check = partial(check_file, usd=usd)
     workers = min(auto_jobs(paths) if jobs is None else jobs, len(tasks))
     if workers <= 1:
-        return list(_tracked(map(check_file, paths, settings), len(tasks), progress))
+        return list(_tracked(map(check, paths, settings), len(tasks), progress))
 
     from concurrent.futures import ProcessPoolExecutor
 
@@ -114,7 +125,7 @@ def check_files(
     # Small chunks balance uneven file sizes; a few per worker keep the pickling overhead low.
     chunksize = max(1, len(tasks) // (workers * 8))
     with ProcessPoolExecutor(max_workers=workers) as pool:
-        reports = pool.map(check_file, paths, settings, chunksize=chunksize)
+        reports = pool.map(check, paths, settings, chunksize=chunksize)
         return list(_tracked(reports, len(tasks), progress))
 
 

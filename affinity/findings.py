@@ -45,6 +45,12 @@ class FileReport:
     Exactly one of three things holds: ``error`` is set (the file is unreadable,
     Q901), ``skipped`` is set (e.g. ``"lfs-pointer"``), or the file was checked
     and ``hits`` holds its findings (possibly none).
+
+    For a USD stage, ``group_names`` are the mesh prims' paths and
+    ``prim_face_start`` (P + 1,) int64 their first faces (see
+    :class:`affinity.mesh.Mesh`), so findings can name the prim and count faces
+    within it; ``up_axis`` and ``meters_per_unit`` are the stage's. ``notes``
+    are the loader's remarks on what it did not check.
     """
 
     path: str
@@ -54,6 +60,10 @@ class FileReport:
     error: str | None = None
     error_line: int = 0
     skipped: str | None = None
+    prim_face_start: np.ndarray | None = None
+    up_axis: str | None = None
+    meters_per_unit: float | None = None
+    notes: list[str] = field(default_factory=list)
 
     @property
     def n_findings(self) -> int:

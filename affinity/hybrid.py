@@ -92,7 +92,7 @@ def camera_for(mesh: Mesh, options: RenderOptions, is_demo: bool):
     from render.camera import Camera, frame_bounds
 
     aspect = options.width / options.height
-    up_axis = options.up or ("z" if is_demo else "y")
+    up_axis = options.up or ("z" if is_demo else (mesh.up_axis or "y").lower())
     up = UP_AXES[up_axis]
     chosen = options.camera or (DEMO_CAMERA if is_demo else None)
     if chosen is None:

@@ -52,7 +52,7 @@ class Mesh:
     corner_vertex : (C,) int64
         0-based index into ``positions`` for every corner.
     face_line : (F,) int64
-        1-based source line of every face; 0 where the format has no lines (binary PLY).
+        1-based source line of every face; 0 where the format has no lines (binary PLY, USD).
     texcoords : (T, 2) float64 or None
     corner_texcoord : (C,) int64 or None
         Index into ``texcoords`` per corner, -1 for a corner without one.
@@ -60,15 +60,27 @@ class Mesh:
     corner_normal : (C,) int64 or None
         Index into ``normals`` per corner, -1 for a corner without one.
     colors : (V, 3) float64 or None
-        Per-vertex RGB in [0, 1] (reached through ``corner_vertex``).
+        Per-vertex RGB in [0, 1] (reached through ``corner_vertex``); NaN rows for
+        vertices without a colour (USD prims without ``displayColor``).
     group_names : list of str
-        Group/object names; ``face_group`` indexes into it.
+        Group/object names; ``face_group`` indexes into it. In a USD stage, one
+        group per mesh prim, named by its prim path.
     face_group : (F,) int32
     material_names : list of str
     face_material : (F,) int32
         Index into ``material_names``, -1 for faces without ``usemtl``.
     material_textures : dict of str to str
         Material name to its ``map_Kd`` path (resolved against the .mtl file's folder).
+    prim_face_start : (P + 1,) int64 or None
+        USD only: the faces of mesh prim ``p`` (group ``p``) are
+        ``prim_face_start[p]:prim_face_start[p + 1]``. None for other formats.
+    up_axis : str or None
+        USD only: the stage's ``upAxis`` (``"Y"`` or ``"Z"``).
+    meters_per_unit : float or None
+        USD only: the stage's ``metersPerUnit``.
+    notes : list of str
+        What the loader read but did not represent, for the user (e.g. USD
+        PointInstancer copies that were not expanded).
     """
 
     path: str
@@ -86,6 +98,10 @@ class Mesh:
     material_names: list[str] = field(default_factory=list)
     face_material: np.ndarray | None = None
     material_textures: dict[str, str] = field(default_factory=dict)
+    prim_face_start: np.ndarray | None = None
+    up_axis: str | None = None
+    meters_per_unit: float | None = None
+    notes: list[str] = field(default_factory=list)
 
     def __post_init__(self):
         if self.face_group is None:

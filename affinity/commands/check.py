@@ -9,6 +9,7 @@ every flag given on the command line replaces the configured value of its key
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
 
@@ -41,13 +42,24 @@ def _jobs(text: str) -> int:
     return int(text)
 
 
+def _time(text: str) -> float:
+    try:
+        time = float(text)
+    except ValueError:
+        time = float("nan")
+    if not math.isfinite(time):
+        raise argparse.ArgumentTypeError(f"not a time code: {text!r}")
+    return time
+
+
 def add_parser(sub) -> None:
     from ..output import FORMATS
     from ..settings import DIAGONALS, MEASURES
 
     p = sub.add_parser(
         "check", help="lint mesh files for quad affinity and shape problems",
-        description="Lint .obj/.ply/.off files (directories are searched recursively). "
+        description="Lint .obj/.ply/.off and USD (.usd/.usda/.usdc/.usdz, with the usd extra) files "
+                    "(directories are searched recursively). "
                     "Settings come from affinity.toml or [tool.affinity] in pyproject.toml, found by "
                     "walking up from each file; flags given here win.",
     )
@@ -67,6 +79,10 @@ def add_parser(sub) -> None:
                    help="which split diagonal the affinity test measures (default: both)")
     p.add_argument("--texture-size", type=int, metavar="PX",
                    help="texture size for texel units when the mesh names no readable map_Kd (default 1024)")
+    p.add_argument("--time", type=_time, metavar="T",
+                   help="USD: read the stage at time code T (default: the earliest time sample)")
+    p.add_argument("--uv-primvar", metavar="NAME",
+                   help="USD: texture coordinates from primvar NAME (default: st, else the first texCoord2f primvar)")
     p.add_argument("--config", metavar="FILE",
                    help="use this affinity.toml/pyproject.toml for every file instead of searching")
     p.add_argument("--isolated", action="store_true", help="ignore configuration files")
@@ -101,12 +117,14 @@ def _overrides(args) -> dict:
 
 
 def _report_problems(reports, quiet: bool) -> None:
-    """Unreadable files (always) and skipped files (unless quiet), one line each on stderr."""
+    """Unreadable files (always), skipped files and the loader's notes (unless quiet), one line each on stderr."""
     for report in reports:
         if report.error is not None:
             sys.stderr.write(f"{report.path}:{report.error_line}: Q901 unreadable: {report.error}\n")
         elif report.skipped is not None and not quiet:
             sys.stderr.write(f"{report.path}: skipped ({report.skipped})\n")
+        for note in [] if quiet else report.notes:
+            sys.stderr.write(f"{report.path}: note: {note}\n")
 
 
 def _progress_bar():
@@ -143,6 +161,7 @@ def _write_baseline(reports, path: str, quiet: bool) -> None:
 def run(args) -> int:
     from ..check import check_files
     from ..config import Resolver
+    from ..loaders.usd import UsdOptions
     from ..output import CheckRun
 
     if args.baseline and args.write_baseline:
@@ -167,7 +186,7 @@ def run(args) -> int:
 
     tasks = _tasks(resolver, paths)
     progress = _progress_bar() if len(tasks) > 1 and sys.stderr.isatty() else None
-    reports = check_files(tasks, args.jobs, progress)
+    reports = check_files(tasks, args.jobs, progress, usd=UsdOptions(args.time, args.uv_primvar))
     _report_problems(reports, args.quiet)
     failed = any(r.error is not None for r in reports)
     if args.write_baseline:

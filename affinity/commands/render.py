@@ -50,7 +50,7 @@ def add_parser(sub) -> None:
                    help="route a quad to mvc when the split moves its texture by more than PX pixels")
     p.add_argument("--size", type=_size, default=(800, 600), metavar="WxH")
     p.add_argument("--camera", type=_camera, metavar="EX,EY,EZ,TX,TY,TZ,FOV")
-    p.add_argument("--up", choices=["x", "y", "z"], default=None, help="world up axis (default: y, z for the demo)")
+    p.add_argument("--up", choices=["x", "y", "z"], default=None, help="world up axis (default: the stage's upAxis for USD, else y; z for the demo)")
     p.add_argument("--show", choices=["uv", "color", "normal", "shaded"],
                    help="what to draw (default: uv when the mesh has it, else color, else shaded)")
     p.add_argument("--texture", metavar="IMAGE", help="texture image for uv (default: map_Kd, else a checker)")

@@ -1,9 +1,11 @@
 """Mesh loaders: ``load(path) -> Mesh`` dispatching on the file extension.
 
 Supported: Wavefront OBJ (``.obj``), PLY (``.ply``; ASCII and binary) and OFF
-(``.off``; with the C/N/ST prefixes). Every problem with the input is a
+(``.off``; with the C/N/ST prefixes), and USD stages (``.usd``, ``.usda``, ``.usdc``,
+``.usdz``) when usd-core is installed (see :mod:`affinity.loaders.usd`). Every problem with the input is a
 :class:`~affinity.mesh.MeshError` naming the file and line; a Git LFS pointer
-is a :class:`~affinity.mesh.SkippedFile`. Only NumPy is imported.
+is a :class:`~affinity.mesh.SkippedFile`. Only NumPy is imported (``pxr`` when a
+USD file is read).
 """
 
 from __future__ import annotations
@@ -14,14 +16,17 @@ from ..mesh import Mesh, MeshError, SkippedFile
 from .obj import load_obj
 from .off import load_off
 from .ply import load_ply
+from .usd import USD_SUFFIXES, UsdOptions, load_usd
 
-LOADERS = {".obj": load_obj, ".ply": load_ply, ".off": load_off}
+LOADERS = {".obj": load_obj, ".ply": load_ply, ".off": load_off, **dict.fromkeys(USD_SUFFIXES, load_usd)}
 
 _LFS_POINTER = b"version https://git-lfs.github.com/spec/"
 
 
-def load(path) -> Mesh:
+def load(path, usd: UsdOptions | None = None) -> Mesh:
     """Read the mesh at ``path``, choosing the reader by its extension (case-insensitive).
+
+    ``usd`` says how to read a USD stage (time, uv primvar); other formats ignore it.
 
     Raises
     ------
@@ -33,7 +38,8 @@ def load(path) -> Mesh:
     """
     extension = os.path.splitext(os.fspath(path))[1].lower()
     if extension not in LOADERS:
-        raise MeshError(path, 0, f"unknown mesh format {extension or '(no extension)'!r}; expected one of .obj, .ply, .off")
+        known = ", ".join(LOADERS)
+        raise MeshError(path, 0, f"unknown mesh format {extension or '(no extension)'!r}; expected one of {known}")
     try:
         with open(path, "rb") as fh:
             head = fh.read(len(_LFS_POINTER))
@@ -46,6 +52,8 @@ def load(path) -> Mesh:
     if head == _LFS_POINTER:
         raise SkippedFile(path, "lfs-pointer")
     try:
+        if extension in USD_SUFFIXES:
+            return load_usd(path, usd)
         return LOADERS[extension](path)
     except OSError as error:  # e.g. the file vanished or became unreadable while reading
         raise MeshError(path, 0, f"cannot read: {error.strerror or error}") from None

@@ -50,7 +50,12 @@ class CheckRun:
 
 @dataclass(frozen=True)
 class Finding:
-    """One finding, as every structured format carries it (design.md, "Rule codes")."""
+    """One finding, as every structured format carries it (design.md, "Rule codes").
+
+    In a USD stage, ``prim`` is the mesh prim's path, ``face`` counts within that
+    prim, and ``line``/``column`` are 0; ``prim`` is None in other formats and for
+    file-level findings.
+    """
 
     path: str
     line: int
@@ -62,6 +67,7 @@ class Finding:
     threshold: float | None
     group: str
     message: str
+    prim: str | None = None
 
 
 def writer(name: str):
@@ -74,12 +80,17 @@ def group_name(report: FileReport, index: int) -> str:
     return report.group_names[index] if 0 <= index < len(report.group_names) else ""
 
 
-def _rows(report: FileReport, hits: RuleHits, take: np.ndarray) -> list[Finding]:
+def _rows(report: FileReport, hits: RuleHits, take: np.ndarray) -> list[tuple[int, Finding]]:
+    """``(face in file order, finding)`` for the hits at ``take``."""
     rule = RULES[hits.code]
     # Rules without a threshold (Q204, Q205, Q302) measure something else; no limit to report.
     threshold = None if rule.default_threshold is None else hits.threshold
+    faces, groups, lines = hits.faces[take], hits.groups[take], hits.lines[take]
+    usd = report.prim_face_start is not None
+    if usd:  # no lines; faces count within their prim (the file-level face -1 stays -1)
+        faces, lines = faces - report.prim_face_start[groups], np.zeros_like(lines)
     return [
-        Finding(
+        (order, Finding(
             path=report.path,
             line=int(line),
             column=1 if line > 0 else 0,
@@ -90,10 +101,11 @@ def _rows(report: FileReport, hits: RuleHits, take: np.ndarray) -> list[Finding]
             threshold=threshold,
             group=group_name(report, g),
             message=rule.summary,
-        )
-        for face, line, value, g in zip(
-            hits.faces[take].tolist(), hits.lines[take].tolist(),
-            hits.values[take].tolist(), hits.groups[take].tolist(),
+            prim=group_name(report, g) if usd and order >= 0 else None,
+        ))
+        for order, face, line, value, g in zip(
+            hits.faces[take].tolist(), faces.tolist(), lines.tolist(),
+            hits.values[take].tolist(), groups.tolist(),
         )
     ]
 
@@ -109,10 +121,10 @@ def file_findings(report: FileReport, limit: int | None = None) -> tuple[list[Fi
 
     Returns
     -------
-    findings : list of Finding, sorted by (line, face, code)
+    findings : list of Finding, sorted by (line, face in file order, code)
     omitted : dict of rule code to the number of findings beyond ``limit``
     """
-    rows: list[Finding] = []
+    rows: list[tuple[int, Finding]] = []
     omitted: dict[str, int] = {}
     for hits in report.hits:
         order = np.argsort(hits.faces, kind="stable")
@@ -120,8 +132,8 @@ def file_findings(report: FileReport, limit: int | None = None) -> tuple[list[Fi
             omitted[hits.code] = len(order) - limit
             order = order[:limit]
         rows.extend(_rows(report, hits, order))
-    rows.sort(key=lambda f: (f.line, f.face, f.code))
-    return rows, omitted
+    rows.sort(key=lambda row: (row[1].line, row[0], row[1].code))
+    return [f for _, f in rows], omitted
 
 
 def rule_counts(reports: list[FileReport]) -> dict[str, int]:
@@ -147,8 +159,10 @@ def describe(f: Finding) -> str:
 
 
 def face_label(f: Finding) -> str:
-    """``"face 12"``; ``""`` for file-level findings (Q205 has face -1)."""
-    return f"face {f.face}" if f.face >= 0 else ""
+    """``"face 12"``, ``"/World/Crate face 12"`` in USD; ``""`` for file-level findings (Q205 has face -1)."""
+    if f.face < 0:
+        return ""
+    return f"face {f.face}" if f.prim is None else f"{f.prim} face {f.face}"
 
 
 def located(f: Finding) -> str:
@@ -157,8 +171,10 @@ def located(f: Finding) -> str:
 
 
 def text_line(f: Finding) -> str:
-    """The ruff-style line ``path:line:col: CODE name: message (value vs threshold)``."""
-    return f"{f.path}:{f.line}:{f.column}: {f.code} {f.name}: {describe(f)}"
+    """The ruff-style line ``path:line:col: CODE name: message (value vs threshold)``;
+    ``path:prim:face N: ...`` in USD."""
+    where = f"{f.line}:{f.column}" if f.prim is None else f"{f.prim}:face {f.face}"
+    return f"{f.path}:{where}: {f.code} {f.name}: {describe(f)}"
 
 
 def working_relative(path: str) -> str | None:

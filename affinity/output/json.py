@@ -5,20 +5,22 @@ Document layout::
     {
       "schema": "quad-affinity-check", "version": 1,
       "settings": {...resolved settings...},
-      "files": [{"path", "faces", "quads", "triangles", "ngons", "findings"}
+      "files": [{"path", "faces", "quads", "triangles", "ngons", "findings",
+                 USD only: "up_axis", "meters_per_unit", "notes"}
                 | {"path", "error", "line"} | {"path", "skipped"}],
       "findings": [{"path", "line", "column", "code", "name", "face", "value",
-                    "threshold", "group", "message"}],
+                    "threshold", "group", "message", USD only: "prim"}],
       "summary": {"files", "checked", "unreadable", "skipped", "findings",
                   "baselined", "by_rule": {"Q101": n, ...}}
     }
 
 ``face`` is the 0-based index of the face in file order counting every face;
 ``line`` its 1-based source line (0 in binary PLY); ``value`` the measured score
-in the rule's unit, ``threshold`` the limit it exceeded. ``settings`` are the
-resolved settings for the working directory (a file governed by another
-configuration file was checked with that file's settings; ``affinity check
---show-settings PATH`` prints them). With ``--baseline``, ``findings`` holds
+in the rule's unit, ``threshold`` the limit it exceeded. In a USD stage,
+``prim`` is the mesh prim's path, ``face`` counts within that prim and ``line``
+is 0. ``settings`` are the resolved settings for the working directory (a file
+governed by another configuration file was checked with that file's settings;
+``affinity check --show-settings PATH`` prints them). With ``--baseline``, ``findings`` holds
 only the new findings and ``summary.baselined`` counts those the baseline hid.
 """
 
@@ -29,7 +31,7 @@ import json
 from typing import TextIO
 
 from ..findings import FileReport
-from . import CheckRun, file_findings, rule_counts
+from . import CheckRun, Finding, file_findings, rule_counts
 
 SCHEMA = "quad-affinity-check"
 VERSION = 1
@@ -40,12 +42,22 @@ def _file_entry(report: FileReport) -> dict:
         return {"path": report.path, "error": report.error, "line": report.error_line}
     if report.skipped is not None:
         return {"path": report.path, "skipped": report.skipped}
-    return {"path": report.path, **report.counts, "findings": report.n_findings}
+    entry = {"path": report.path, **report.counts, "findings": report.n_findings}
+    if report.prim_face_start is not None:
+        entry.update(up_axis=report.up_axis, meters_per_unit=report.meters_per_unit, notes=report.notes)
+    return entry
+
+
+def _finding_entry(f: Finding) -> dict:
+    entry = dataclasses.asdict(f)
+    if f.prim is None:
+        del entry["prim"]
+    return entry
 
 
 def document(run: CheckRun) -> dict:
     """The whole JSON document as Python objects."""
-    findings = [dataclasses.asdict(f) for r in run.reports for f in file_findings(r)[0]]
+    findings = [_finding_entry(f) for r in run.reports for f in file_findings(r)[0]]
     return {
         "schema": SCHEMA,
         "version": VERSION,

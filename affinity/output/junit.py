@@ -2,9 +2,9 @@
 
 One ``<testsuite>`` per file, one ``<testcase>`` per finding with a
 ``<failure>`` (type = rule code, body = the text line, properties face, value,
-threshold, line, column, code, name, group); a clean file gets one passing
-testcase, an unreadable file one testcase with an ``<error>`` (type Q901), a
-skipped file one with ``<skipped>``.
+threshold, line, column, code, name, group, and prim in USD); a clean file gets
+one passing testcase, an unreadable file one testcase with an ``<error>`` (type
+Q901), a skipped file one with ``<skipped>``.
 """
 
 from __future__ import annotations
@@ -34,7 +34,8 @@ def _finding_case(suite: ET.Element, f: Finding) -> None:
     name = " ".join(filter(None, [f.code, f.name, face_label(f)]))
     case = ET.SubElement(suite, "testcase", classname=f.path, name=name, file=f.path, line=str(f.line))
     props = ET.SubElement(case, "properties")
-    for key in ("face", "value", "threshold", "line", "column", "code", "name", "group"):
+    keys = ("face", "value", "threshold", "line", "column", "code", "name", "group") + ("prim",) * (f.prim is not None)
+    for key in keys:
         ET.SubElement(props, "property", name=key, value=str(getattr(f, key)))
     failure = ET.SubElement(case, "failure", type=f.code, message=describe(f))
     failure.text = text_line(f)

@@ -5,8 +5,10 @@ rule's position in it), with descriptions and help from the same source as
 ``affinity rule``. Each finding is a result located by a physical location —
 the file's URI relative to the working directory (``uriBaseId`` ``%SRCROOT%``)
 and, when the format has source lines, ``region.startLine`` = the face's line
-(binary PLY has none, so there the region is left out) — and by a logical
-location naming the face. ``properties`` carry face, value, threshold and group.
+(binary PLY and USD have none, so there the region is left out) — and by a
+logical location: the face, or in a USD stage the mesh prim (kind ``object``,
+its path as fully qualified name; the face within it is in the message and the
+properties). ``properties`` carry face, value, threshold, group and, in USD, prim.
 
 ``partialFingerprints["quadAffinity/v1"]`` identifies a finding across runs: a
 hash of rule, file, group and the measured value rounded to 6 significant
@@ -31,7 +33,7 @@ from urllib.parse import quote
 from .. import __version__
 from ..findings import FileReport
 from ..rules import RULES, UNREADABLE, rule_page
-from . import CheckRun, face_label, file_findings, located, value_token, working_relative
+from . import CheckRun, Finding, face_label, file_findings, located, value_token, working_relative
 
 SARIF_VERSION = "2.1.0"
 SARIF_SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
@@ -81,10 +83,9 @@ def _results(report: FileReport) -> list[dict]:
         identity = (f.code, f.group, value_token(f.value))
         seen[identity] = ordinal = seen.get(identity, -1) + 1
         result_location: dict = {"physicalLocation": _physical(location, f.line, f.column)}
-        if face_label(f):
-            qualified = "/".join(filter(None, [f.group, face_label(f)]))
-            result_location["logicalLocations"] = [
-                {"name": face_label(f), "fullyQualifiedName": qualified, "kind": "element"}]
+        logical = _logical_location(f)
+        if logical:
+            result_location["logicalLocations"] = [logical]
         results.append({
             "ruleId": f.code,
             "ruleIndex": _RULE_INDEX[f.code],
@@ -93,9 +94,20 @@ def _results(report: FileReport) -> list[dict]:
             "locations": [result_location],
             "partialFingerprints": {FINGERPRINT: fingerprint(f.code, location["uri"], f.group, f.value, ordinal)},
             "properties": {"name": f.name, "face": f.face, "value": f.value,
-                           "threshold": f.threshold, "group": f.group},
+                           "threshold": f.threshold, "group": f.group,
+                           **({} if f.prim is None else {"prim": f.prim})},
         })
     return results
+
+
+def _logical_location(f: Finding) -> dict | None:
+    """The USD mesh prim, or the face (qualified by its group); None for file-level findings."""
+    if f.prim is not None:
+        return {"name": f.prim.rsplit("/", 1)[-1], "fullyQualifiedName": f.prim, "kind": "object"}
+    if not face_label(f):
+        return None
+    qualified = "/".join(filter(None, [f.group, face_label(f)]))
+    return {"name": face_label(f), "fullyQualifiedName": qualified, "kind": "element"}
 
 
 def _notifications(reports: list[FileReport]) -> list[dict]:
