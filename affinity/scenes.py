@@ -10,6 +10,9 @@ Our own constructions (design.md: the seeds hold only the captions):
 - :func:`color_squares` — Fig. 10: two unit squares, one with corner colours
   that do not form a parallelogram in colour space (blue, red, green, black) and
   one whose colours do (blue, red, yellow, cyan).
+- :func:`quad_strip` — a twisted, tapering ribbon of nonplanar quads (HT04
+  Fig. 10/11, Bloomenthal section 3.4): each quad is a bilinear patch whose uv
+  is the patch's own (s, t) scaled, so the exact render is the parametrisation.
 
 ``DEMO`` lists the scenes bundled as OBJ files under ``affinity/data/demo``;
 ``python -m affinity.scenes`` rewrites them.
@@ -71,6 +74,27 @@ def color_squares() -> Mesh:
     yellow, cyan = [1, 1, 0], [0, 1, 1]
     colors = [blue, red, green, black, blue, red, yellow, cyan]
     return mesh_from_polygons("color_squares", positions, [[0, 1, 2, 3], [4, 5, 6, 7]], colors=colors)
+
+
+def quad_strip(n: int = 6, twist: float = 0.35, taper: float = 0.15) -> Mesh:
+    """A ribbon of ``n`` nonplanar quads along x in [-2, 2] (y up), with uv on a regular grid.
+
+    The cross-section at x is the segment of half-width ``0.5 + taper * x``
+    through the x axis, turned by ``twist * x`` radians about it, so neighbouring
+    sections are skew: every quad is a twisted trapezoid, a bilinear patch that
+    no plane contains. ``u = i / n`` along the strip, ``v`` 0 and 1 across it.
+    """
+    x = np.linspace(-2.0, 2.0, n + 1)
+    half = 0.5 + taper * x
+    angle = twist * x
+    side = np.stack([np.zeros_like(x), np.cos(angle), np.sin(angle)], axis=-1) * half[:, None]
+    rail = np.stack([x, np.zeros_like(x), np.zeros_like(x)], axis=-1)
+    positions = np.concatenate([rail - side, rail + side])  # bottom rail, then top rail
+    u = np.arange(n + 1) / n
+    uv = np.concatenate([np.stack([u, np.zeros_like(u)], -1), np.stack([u, np.ones_like(u)], -1)])
+    i = np.arange(n)
+    faces = np.stack([i, i + 1, n + 2 + i, n + 1 + i], axis=1)
+    return mesh_from_polygons("quad_strip", positions, faces, texcoords=uv)
 
 
 def demo_sphere() -> Mesh:

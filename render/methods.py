@@ -23,11 +23,19 @@
   on a trapezoid. It is the split's plane machinery with the per-corner
   weights rho_i = w_i q_i in place of 1.
 
-``exact`` (ray / bilinear-patch intersection, which needs world-space corners)
-is a reserved name. A new weight method is one more entry in ``WEIGHTS`` (and
-in ``QUAD_COVERAGE`` if it fills the quad rather than its two triangles);
-``exact`` would also need the world-space corners passed through
-``rasterize_quads``.
+- ``exact``: the float64 reference. The pixel's eye ray meets the quad taken
+  as a bilinear patch in 3-D (``render.patch``, solved in homogeneous clip
+  space, which has the same patch parameters (s, t) as world space), and the
+  corner attributes are weighted bilinearly in (s, t). For a planar quad that
+  is perspective-correct inverse bilinear interpolation in the quad's plane;
+  for a nonplanar one it is the surface a modelling tool means. Where the ray
+  misses the patch (pixel centres that fixed-point coverage admits a hair
+  outside the outline, and quads with a corner at w <= 0) the parameters are
+  clamped into the unit square (``ray_patch_parameters``).
+
+A new weight method is one more entry in ``WEIGHTS`` (and in ``QUAD_COVERAGE``
+if it fills the quad rather than its two triangles). Weight methods receive the
+quads' clip-space corners (4, 4, N): x, y, z, w; corner; pixel.
 """
 
 from __future__ import annotations
@@ -41,14 +49,15 @@ from render.coords import (
     mean_value_from_terms,
     mean_value_terms,
 )
+from render.patch import ray_patch_parameters
 
 
 def mvc_weights(corners, px, py) -> np.ndarray:
     """Perspective mean value weights (HT04 eq. 8, 10, 11) of pixels in their quads.
 
-    corners : (3, 4, N) float64 clip x, y, w; px, py : (N,). Returns (4, N) float64.
+    corners : (4, 4, N) float64 clip x, y, z, w; px, py : (N,). Returns (4, N) float64.
     """
-    X, Y, W = corners
+    X, Y, _, W = corners
     sx, sy = X - px * W, Y - py * W  # s~_i = X_i - p W_i
     dW = W[NEXT] - W
     # Homogeneous edge vectors s~_{i+1} - s~_i, formed from the corners.
@@ -60,10 +69,10 @@ def mvc_weights(corners, px, py) -> np.ndarray:
 def bilinear_screen_weights(corners, px, py) -> np.ndarray:
     """Weights of the inverse bilinear map of the screen quad (not perspective-correct).
 
-    corners : (3, 4, N) float64 clip x, y, w; px, py : (N,). Returns (4, N)
+    corners : (4, 4, N) float64 clip x, y, z, w; px, py : (N,). Returns (4, N)
     float64. Pixels of quads with a corner at W <= 0 get ``mvc_weights`` instead.
     """
-    X, Y, W = corners
+    X, Y, _, W = corners
     projectable = (W > 0).all(axis=0)
     if projectable.all():
         return bilinear_weights(*bilinear_parameters(px, py, X / W, Y / W))
@@ -71,6 +80,15 @@ def bilinear_screen_weights(corners, px, py) -> np.ndarray:
     ok = np.flatnonzero(projectable)
     lam[:, ok] = bilinear_screen_weights(np.take(corners, ok, axis=2), px[ok], py[ok])
     return lam
+
+
+def exact_weights(corners, px, py) -> np.ndarray:
+    """Bilinear weights at the nearest ray / patch hit (``render.patch``).
+
+    corners : (4, 4, N) float64 clip x, y, z, w; px, py : (N,). Returns (4, N) float64.
+    """
+    s, t, _ = ray_patch_parameters(corners, px, py)
+    return bilinear_weights(s, t)
 
 
 def projective_corner_weights(clip) -> np.ndarray:
@@ -100,10 +118,7 @@ def projective_corner_weights(clip) -> np.ndarray:
     return np.where(convex[:, None], rho, 1.0)
 
 
-METHODS = ("split", "mvc", "bilinear", "projective")
+METHODS = ("split", "mvc", "bilinear", "projective", "exact")
 PLANE_METHODS = frozenset({"split", "projective"})
-WEIGHTS = {"mvc": mvc_weights, "bilinear": bilinear_screen_weights}
-QUAD_COVERAGE = frozenset({"mvc", "bilinear"})
-RESERVED = {
-    "exact": "the 3-D ray / bilinear-patch intersection needs world-space corners and is not implemented yet",
-}
+WEIGHTS = {"mvc": mvc_weights, "bilinear": bilinear_screen_weights, "exact": exact_weights}
+QUAD_COVERAGE = frozenset({"mvc", "bilinear", "exact"})

@@ -15,29 +15,30 @@ The pipeline, all of it vectorised over quads, triangles, rows or fragments:
    found as exact integer spans per row (``render.spans``), with the top-left
    fill rule.
 4. Coverage per method: ``split`` and ``projective`` draw the two triangles.
-   ``mvc`` and ``bilinear`` fill the quad itself: a pixel is covered when it
-   is in exactly one of the two triangles (their exclusive or). For a convex
-   quad, or a concave one whose reflex corner is 0 or 2, the triangles do not
-   overlap and this is their union; for a quad concave at corner 1 or 3 (the
-   second triangle lies inside the first, oppositely wound) and for a bow-tie
-   it removes the overlap. This is the non-zero winding rule of the outline
-   0-1-2-3, the region of HT04 eq. 12; it is evaluated on the visible part of
-   each triangle, i.e. with the homogeneous edge functions of Olano & Greer,
-   as the clarifications ask for quads with corners at w <= 0. With culling a
-   covered pixel faces the way its triangle does, so a bow-tie keeps its
-   front-facing lobe only.
+   ``mvc``, ``bilinear`` and ``exact`` fill the quad itself: a pixel is
+   covered when it is in exactly one of the two triangles (their exclusive
+   or). For a convex quad, or a concave one whose reflex corner is 0 or 2,
+   the triangles do not overlap and this is their union; for a quad concave
+   at corner 1 or 3 (the second triangle lies inside the first, oppositely
+   wound) and for a bow-tie it removes the overlap. This is the non-zero
+   winding rule of the outline 0-1-2-3, the region of HT04 eq. 12; it is
+   evaluated on the visible part of each triangle, i.e. with the homogeneous
+   edge functions of Olano & Greer, as the clarifications ask for quads with
+   corners at w <= 0. With culling a covered pixel faces the way its triangle
+   does, so a bow-tie keeps its front-facing lobe only.
 5. Depth: every fragment's depth is the NDC z of the 3-D split triangle that
    covers it, for every method. For planar quads that is the plane, the very
-   surface that mvc (HT04 eq. 9, whose depth z(v) is the plane's) and
-   bilinear describe; for a non-planar quad the mvc/bilinear attributes are
-   painted on the split surface. So visibility never depends on the method,
-   which is what lets a per-quad method array give, on each quad, exactly the
-   pixels of that method's own render. Depth test "less"; ties go to the
-   earlier quad (``render.depth``).
+   surface that mvc (HT04 eq. 9, whose depth z(v) is the plane's), bilinear
+   and exact describe; for a non-planar quad the mvc/bilinear/exact
+   attributes are painted on the split surface (exact's attributes are those
+   of the patch point on the pixel's ray, its depth the split's). So
+   visibility never depends on the method, which is what lets a per-quad
+   method array give, on each quad, exactly the pixels of that method's own
+   render. Depth test "less"; ties go to the earlier quad (``render.depth``).
 6. Attributes are evaluated for the winning fragment of each pixel only (a
    visibility buffer): from the triangle's planes for split and projective,
    from the per-method corner weights of ``render.methods`` and the quad's
-   clip-space corners for mvc and bilinear.
+   clip-space corners for mvc, bilinear and exact.
 
 Memory is bounded by drawing the image in bands of rows, each holding about
 ``batch_fragments`` fragments (estimated from the triangles' areas), and by
@@ -62,7 +63,6 @@ from render.methods import (
     METHODS,
     PLANE_METHODS,
     QUAD_COVERAGE,
-    RESERVED,
     WEIGHTS,
     projective_corner_weights,
 )
@@ -106,10 +106,10 @@ def rasterize_quads(
     width, height : int
         Image size in pixels, from 1 to 65536.
     method : str or (Q,) sequence of str
-        ``"split"``, ``"mvc"``, ``"bilinear"`` or ``"projective"`` for all
+        ``"split"``, ``"mvc"``, ``"bilinear"``, ``"projective"`` or
+        ``"exact"`` (the float64 ray / bilinear-patch reference) for all
         quads, or one name per quad (the hybrid render); see
-        ``render.methods``. ``"exact"`` is reserved and raises
-        ``NotImplementedError``.
+        ``render.methods``.
     cull_backfaces : bool
         Drop fragments of triangles wound clockwise on screen (NDC y up).
     batch_fragments : int
@@ -120,8 +120,8 @@ def rasterize_quads(
     Frame
         ``face`` (H, W) int64 (-1 empty), ``attrs`` (H, W, K) float64 (NaN
         empty), ``depth`` (H, W) float64 (NDC z, inf empty), and the
-        ``fragments`` count. Attributes are perspective-correct for split and
-        mvc, screen-space for bilinear and projective.
+        ``fragments`` count. Attributes are perspective-correct for split,
+        mvc and exact, screen-space for bilinear and projective.
 
     Examples
     --------
@@ -146,7 +146,7 @@ def rasterize_quads(
 class _Scene:
     """Everything set up once per call, before the bands are drawn.
 
-    Quads: ``corners`` (3, 4, Q) float64 clip x, y, w (component, corner,
+    Quads: ``corners`` (4, 4, Q) float64 clip x, y, z, w (component, corner,
     quad); ``attrs`` (4, K, Q) (corner, channel, quad); ``method_of_quad``
     (Q,) int index into ``names``. Split triangles (index 2 q + half):
     ``planes`` (3, K + 2, 2Q), the interpolation planes (``render.planes``)
@@ -200,7 +200,7 @@ class _Scene:
             cull_backfaces=cull_backfaces,
             names=names,
             method_of_quad=method_of_quad,
-            corners=np.ascontiguousarray(clip[..., [0, 1, 3]].transpose(2, 1, 0)),
+            corners=np.ascontiguousarray(clip.transpose(2, 1, 0)),
             attrs=np.ascontiguousarray(attrs.transpose(1, 2, 0)),
             planes=planes,
             depth_planes=np.ascontiguousarray(planes[:, -1]),
@@ -402,8 +402,6 @@ def _checked_input(clip, attrs, width, height, method):
         unique, method_of_quad = np.unique(method, return_inverse=True)
         names = [str(n) for n in unique]
     for name in names:
-        if name in RESERVED:
-            raise NotImplementedError(f"method {name!r}: {RESERVED[name]}")
         if name not in METHODS:
             raise ValueError(f"unknown method {name!r}; known: {', '.join(METHODS)}")
     return clip, attrs, method_of_quad, names

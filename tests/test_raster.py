@@ -8,7 +8,7 @@ import pytest
 from render import rasterize_quads
 from render.camera import look_at, perspective, to_clip
 
-METHODS = ["split", "mvc", "bilinear", "projective"]
+METHODS = ["split", "mvc", "bilinear", "projective", "exact"]
 
 
 def pixel_centres(width, height):
@@ -156,7 +156,7 @@ def test_concave_and_bowtie_quads_fill_exactly_their_outline_with_mvc():
         # Corners are snapped to 1/256 pixel: pixels that close to the outline may go either way.
         clear = distance_to_outline(points, quad).reshape(height, width) > 2 * (2 / width) / 256
         # The bow-tie outline is two triangles: even-odd and non-zero agree.
-        for method in ("mvc", "bilinear"):
+        for method in ("mvc", "bilinear", "exact"):
             face = rasterize_quads(flat_clip(quad[None]), np.zeros((1, 4, 1)), width, height, method).face
             assert np.array_equal((face == 0)[clear], inside[clear]), (name, method)
             assert clear.sum() > 0.99 * clear.size
@@ -217,7 +217,8 @@ def analytic_uv(matrix, world, uv_of, width, height):
 
 @pytest.mark.parametrize(
     "method, parallelogram",
-    [("split", False), ("mvc", False), ("split", True), ("mvc", True), ("projective", True)],
+    [("split", False), ("mvc", False), ("exact", False), ("split", True), ("mvc", True), ("exact", True),
+     ("projective", True)],
 )
 def test_perspective_correct_uv_on_tilted_plane(method, parallelogram):
     world, uv, matrix, uv_of = tilted_plane_scene(parallelogram)
@@ -459,10 +460,6 @@ def test_bad_input_raises_clear_errors():
         rasterize_quads(square, attrs, 4, 4, batch_fragments=0)
     with pytest.raises(ValueError, match="unknown method"):
         rasterize_quads(square, attrs, 4, 4, "phong")
-    with pytest.raises(NotImplementedError, match="exact"):
-        rasterize_quads(square, attrs, 4, 4, "exact")
-    with pytest.raises(NotImplementedError, match="exact"):
-        rasterize_quads(square, attrs, 4, 4, ["exact"])
     bad = square.copy()
     bad[0, 0, 0] = np.nan
     with pytest.raises(ValueError, match="NaN"):

@@ -1,0 +1,82 @@
+"""``affinity bench [MESH...] [--quick] -o DIR``: error against run time, every method and hybrid setting.
+
+Without MESH it studies the built-in scenes (the paper's figures and a
+nonplanar quad strip) and every mesh of ``../shared/meshes`` when that folder
+is there; ``--quick`` keeps three small built-in scenes at a small size and
+finishes in seconds (for CI). Writes ``study.csv``, ``summary.md`` and PNG
+charts into DIR.
+"""
+
+from __future__ import annotations
+
+import sys
+
+from ..check import UsageError
+from . import EXIT_CLEAN
+from .render import _size as image_size
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser(
+        "bench", help="measure error against the exact reference and run time of every method",
+        description="Render every scene with split, mvc, bilinear, projective, exact and the hybrid at a sweep of "
+                    "settings; time them and compare each with exact. Writes study.csv, summary.md and charts.",
+    )
+    p.add_argument("meshes", nargs="*", metavar="MESH",
+                   help="meshes to study (default: the built-in scenes and ../shared/meshes when present)")
+    p.add_argument("-o", "--output", required=True, metavar="DIR", help="folder for the CSV, summary and charts")
+    p.add_argument("--quick", action="store_true", help="three small built-in scenes, small images, two repeats")
+    p.add_argument("--route", choices=["view", "lint"], default="view",
+                   help="lint: also sweep the lint threshold, in the misplacement and the barycentric reading")
+    p.add_argument("--size", type=image_size, metavar="WxH", help="image size (default 800x600, 240x180 with --quick)")
+    p.add_argument("--repeat", type=int, metavar="N", help="timed runs per configuration (default 7, 2 with --quick)")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress lines")
+    p.set_defaults(run=run)
+
+
+def _command_line(args) -> str:
+    """The command as it could be typed again (for the summary's header)."""
+    words = ["affinity bench", *args.meshes, "-o", args.output]
+    words += ["--quick"] if args.quick else []
+    words += ["--route", args.route] if args.route != "view" else []
+    words += [f"--size {args.size[0]}x{args.size[1]}"] if args.size else []
+    words += [f"--repeat {args.repeat}"] if args.repeat is not None else []
+    return " ".join(words)
+
+
+def run(args) -> int:
+    import dataclasses
+
+    from ..study.cases import builtin_cases, mesh_cases, shared_mesh_paths
+    from ..study.run import run_cases, write_outputs
+    from ..study.sweep import QUICK, StudySettings
+
+    settings = QUICK if args.quick else StudySettings()
+    changes = {"lint_route": args.route == "lint"}
+    if args.size:
+        changes["width"], changes["height"] = args.size
+    if args.repeat is not None:
+        if args.repeat < 1:
+            raise UsageError(f"--repeat must be at least 1, got {args.repeat}")
+        changes["repeat"] = args.repeat
+    settings = dataclasses.replace(settings, **changes)
+    if args.meshes:
+        cases = mesh_cases(args.meshes)
+    else:
+        cases = builtin_cases(quick=args.quick) + ([] if args.quick else mesh_cases(shared_mesh_paths()))
+
+    def progress(line: str) -> None:
+        if not args.quiet:
+            sys.stderr.write(f"affinity bench: {line}\n")
+
+    rows, skipped = run_cases(cases, settings, progress)
+    for line in skipped:
+        sys.stderr.write(f"affinity bench: skipped {line}\n")
+    if not rows:
+        raise UsageError("nothing could be studied" + (f": {'; '.join(skipped)}" if skipped else ""))
+    try:
+        paths = write_outputs(rows, skipped, settings, args.output, _command_line(args))
+    except OSError as err:
+        raise UsageError(f"{args.output}: cannot write ({err.strerror or err})") from None
+    progress(f"wrote {', '.join(paths)}")
+    return EXIT_CLEAN
