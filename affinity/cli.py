@@ -11,13 +11,16 @@ import sys
 
 from .check import UsageError
 from .commands import EXIT_CLEAN, EXIT_ERROR
+from .commands import bench as bench_command
 from .commands import check as check_command
 from .commands import render as render_command
 from .commands import report as report_command
 from .commands import rules as rules_command
+from .commands import stability as stability_command
 from .commands import view as view_command
 
-SUBCOMMANDS = [check_command, render_command, rules_command, report_command, view_command]
+SUBCOMMANDS = [check_command, render_command, rules_command, report_command, view_command, stability_command,
+               bench_command]
 
 
 def build_parser() -> argparse.ArgumentParser:

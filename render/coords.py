@@ -18,6 +18,7 @@ the same two steps, ``mean_value_terms`` then ``mean_value_from_terms``.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 
 import numpy as np
@@ -28,10 +29,15 @@ PREV = np.array([3, 0, 1, 2])
 # Used only where the general formula gives inf or NaN: |A_i| <= EDGE_SINE *
 # r_i r_{i+1} with D_i < 0 means sin(alpha_i) < 2^-60, the point is on edge i
 # to within rounding and the edge value is exact far below float64 precision;
-# r_i <= CORNER_RATIO * max_j r_j means the point is at corner i.
+# r_i = 0 means the point is at corner i.
 EDGE_SINE = 2.0**-60
-CORNER_RATIO = 2.0**-60
 NEWTON_STEPS = 2
+# inverse_bilinear's frames: FRAMES[k] renumbers the corners so that corner k
+# comes first, keeping the patch (q0, q1, q2, q3 at (0,0), (1,0), (1,1), (0,1));
+# FLIPS_S[k] / FLIPS_T[k]: the frame's s / t is 1 - s / 1 - t.
+FRAMES = np.array([[0, 1, 2, 3], [1, 0, 3, 2], [2, 3, 0, 1], [3, 2, 1, 0]])
+FLIPS_S = np.array([False, True, True, False])
+FLIPS_T = np.array([False, False, True, True])
 
 
 def mean_value(p, quad, w=None) -> np.ndarray:
@@ -55,7 +61,8 @@ def mean_value(p, quad, w=None) -> np.ndarray:
     Returns
     -------
     lam : (N, 4) float64
-        Weights summing to 1. A point on edge i gets the linear weights of
+        Weights summing to 1 (float32, computed in float32, when ``p`` and
+        ``quad`` are float32 arrays). A point on edge i gets the linear weights of
         that edge (exactly where A_i evaluates to 0, else to rounding), a
         point at corner i the unit vector e_i.
 
@@ -83,20 +90,22 @@ def mean_value(p, quad, w=None) -> np.ndarray:
     scale[scale == 0] = 1.0
     s = s / scale[:, None]
     e = e / scale[:, None]
-    r, A, D = mean_value_terms(s[..., 0], s[..., 1], e[..., 0], e[..., 1])
+    r, A, D, diagonals = mean_value_terms(s[..., 0], s[..., 1], e[..., 0], e[..., 1])
     if w is not None:
-        w = _corner_weights(w, p.shape[0])
-        # r~ = |w_i| r_i, A~ = w_i w_{i+1} A_i, D~ = w_i w_{i+1} D_i give
-        # exactly the eq. 10 weights with the eq. 11 signs (see
+        w = _corner_weights(w, p.shape[0], p.dtype)
+        # r~ = |w_i| r_i, A~ = w_i w_{i+1} A_i, D~ = w_i w_{i+1} D_i (and the
+        # diagonal terms with w_{i-1} w_{i+1}) are the terms of s~_i = w_i s_i
+        # and give exactly the eq. 10 weights with the eq. 11 signs (see
         # mean_value_from_terms); the common scale of w cancels.
         w = w / np.abs(w).max(axis=0)
         ww = w * w[NEXT]
         r, A, D = np.abs(w) * r, ww * A, ww * D
-    return mean_value_from_terms(r, A, D).T
+        diagonals = dataclasses.replace(diagonals, weight=w[PREV] * w[NEXT])
+    return mean_value_from_terms(r, A, D, diagonals).T
 
 
 def mean_value_terms(sx, sy, ex, ey):
-    """The per-corner terms r_i, A_i, D_i of HT04 section 4.2.
+    """The per-corner terms r_i, A_i, D_i of HT04 section 4.2, and the diagonal terms.
 
     Parameters
     ----------
@@ -117,15 +126,58 @@ def mean_value_terms(sx, sy, ex, ey):
         would lose (R/L)^2 of the precision, the edge form keeps R/L.
     D : (4, N) float64
         s_i . s_{i+1}.
+    diagonals : Diagonals
+        C_i = s_{i-1} x s_{i+1} and E_i = s_{i-1} . s_{i+1}, formed on demand.
     """
     sxn, syn = sx[NEXT], sy[NEXT]
     r = np.sqrt(sx * sx + sy * sy)
     D = sx * sxn + sy * syn
     A = np.where(r <= r[NEXT], sx * ey - sy * ex, sxn * ey - syn * ex)
-    return r, A, D
+    return r, A, D, Diagonals(sx, sy, ex, ey)
 
 
-def mean_value_from_terms(r, A, D) -> np.ndarray:
+@dataclasses.dataclass(frozen=True)
+class Diagonals:
+    """The diagonal terms of ``mean_value_terms``, formed only for the points
+    that need them (those where some alpha_{i-1}, alpha_i have opposite signs,
+    see ``mean_value_from_terms``).
+
+    sx, sy : (4, N) and ex, ey : (4, N) or (4, 1), as given to
+    ``mean_value_terms``; weight : None or (4, N) or (4, 1), w_{i-1} w_{i+1}
+    for the perspective terms of ``mean_value``.
+    """
+
+    sx: np.ndarray
+    sy: np.ndarray
+    ex: np.ndarray
+    ey: np.ndarray
+    weight: np.ndarray | None = None
+
+    def terms(self, cols):
+        """C, E, G (4, M) float64 of the points ``cols`` (M,) int.
+
+        C_i = s_{i-1} x s_{i+1}, as u x d with u the shorter of the two and
+        d = e_{i-1} + e_i = q_{i+1} - q_{i-1}, for the same reason as A;
+        E_i = s_{i-1} . s_{i+1}; G_i = |u_x| (|ey_{i-1}| + |ey_i|) +
+        |u_y| (|ex_{i-1}| + |ex_i|), the size of the terms C is formed from
+        (d included), so that its rounding error is about u G. With a weight,
+        C and E are multiplied by it and G by its absolute value.
+        """
+        sx, sy = self.sx[:, cols], self.sy[:, cols]
+        ex, ey = (v if v.shape[1] == 1 else v[:, cols] for v in (self.ex, self.ey))
+        sxp, syp, sxn, syn = sx[PREV], sy[PREV], sx[NEXT], sy[NEXT]
+        shorter = sxp * sxp + syp * syp <= sxn * sxn + syn * syn
+        ux, uy = np.where(shorter, sxp, sxn), np.where(shorter, syp, syn)
+        C = ux * (ey[PREV] + ey) - uy * (ex[PREV] + ex)
+        E = sxp * sxn + syp * syn
+        G = np.abs(ux) * (np.abs(ey[PREV]) + np.abs(ey)) + np.abs(uy) * (np.abs(ex[PREV]) + np.abs(ex))
+        if self.weight is None:
+            return C, E, G
+        wd = self.weight if self.weight.shape[1] == 1 else self.weight[:, cols]
+        return wd * C, wd * E, np.abs(wd) * G
+
+
+def mean_value_from_terms(r, A, D, diagonals) -> np.ndarray:
     """Normalised mean value weights from the terms r, A, D (HT04 eq. 7, 8).
 
     With t_i = tan(alpha_i / 2), mu_i = (t_{i-1} + t_i) / r_i (eq. 8) and
@@ -133,6 +185,20 @@ def mean_value_from_terms(r, A, D) -> np.ndarray:
     t_i = (r_i r_{i+1} - D_i) / A_i = A_i / (r_i r_{i+1} + D_i) the first
     cancels for small angles (far points, needles) and the second near an
     edge (alpha_i near pi); the form is chosen by the sign of r_i r_{i+1} D_i.
+
+    Where alpha_{i-1} and alpha_i have opposite signs the sum t_{i-1} + t_i
+    cancels when they nearly balance: near the sharp tip q_i of a needle,
+    whose neighbours p sees in almost the same direction, both are O(1) and
+    the sum is the tip's angle. There it is taken as
+    sin(gamma_i / 2) / (cos(alpha_{i-1} / 2) cos(alpha_i / 2)), with
+    gamma_i = alpha_{i-1} + alpha_i the angle from s_{i-1} to s_{i+1} (in
+    (-pi, pi) for opposite signs): each factor has a form that does not
+    cancel, cos(alpha / 2) = sqrt(h / 2 r r') for D >= 0 and |A| / sqrt(2 r r' h)
+    for D < 0 (h = r r' + |D|), and sin(gamma / 2) from the diagonal terms
+    C, E alike. Of the two, the one with the smaller rounding is taken: the
+    plain sum loses max(|t_{i-1}|, |t_i|) / |t_{i-1} + t_i| ulps, this form
+    G / |C| (C itself cancels where p is near the line through q_{i-1} and
+    q_{i+1}).
 
     Perspective (eq. 10, 11) enters only through the terms: with
     r_i = |w_i||s_i|, A_i = w_i w_{i+1} (s_i x s_{i+1}) and
@@ -148,6 +214,8 @@ def mean_value_from_terms(r, A, D) -> np.ndarray:
     ----------
     r, A, D : (4, N) float64
         As returned by ``mean_value_terms``, possibly scaled by w (above).
+    diagonals : Diagonals
+        As returned by ``mean_value_terms`` (with its weight, if scaled).
 
     Returns
     -------
@@ -165,13 +233,31 @@ def mean_value_from_terms(r, A, D) -> np.ndarray:
     h = rr + np.abs(D)  # r_i r_{i+1} + |D_i|: never cancels
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         t = np.where(D > 0, A / h, h / A)
-        mu = (t[PREV] + t) / r
+        summed = t[PREV] + t
+        cols = np.flatnonzero((A[PREV] * A < 0).any(axis=0))
+        if cols.size:
+            sub = (slice(None), cols)
+            summed[sub] = _balanced_sums(r[sub], A[sub], D[sub], rr[sub], h[sub], t[sub], *diagonals.terms(cols))
+        mu = summed / r
         total = mu.sum(axis=0)
         lam = mu / total
     cols = np.flatnonzero(~np.isfinite(total) | (total == 0))
     if cols.size:
         lam[:, cols] = _exact_special_weights(r[:, cols], A[:, cols], D[:, cols])
     return lam
+
+
+def _balanced_sums(r, A, D, rr, h, t, C, E, G):
+    """t_{i-1} + t_i (4, M), by the half-angle form where alpha_{i-1} and alpha_i
+    have opposite signs and it rounds less (see mean_value_from_terms)."""
+    summed = t[PREV] + t
+    better = (A[PREV] * A < 0) & (G * np.abs(summed) < np.abs(C) * np.maximum(np.abs(t[PREV]), np.abs(t)))
+    root2rr, root_h = np.sqrt(2 * rr), np.sqrt(h)
+    half_cos = np.where(D >= 0, root_h / root2rr, np.abs(A) / (root2rr * root_h))  # cos(alpha_i / 2)
+    rho = r[PREV] * r[NEXT]
+    root2rho, root_g = np.sqrt(2 * rho), np.sqrt(rho + np.abs(E))
+    half_sin = np.where(E >= 0, C / (root2rho * root_g), np.copysign(root_g / root2rho, C))  # sin(gamma_i / 2)
+    return np.where(better, half_sin / (half_cos[PREV] * half_cos), summed)
 
 
 def _exact_special_weights(r, A, D) -> np.ndarray:
@@ -182,10 +268,12 @@ def _exact_special_weights(r, A, D) -> np.ndarray:
     m = r.shape[1]
     cols = np.arange(m)
     on_edge = (D < 0) & (np.abs(A) <= EDGE_SINE * r * r[NEXT])
-    at_corner = r <= CORNER_RATIO * r.max(axis=0)
     lam = np.zeros_like(r)
     lam[np.argmin(r, axis=0), cols] = 1.0  # corner, or the documented fallback
-    edge = on_edge.any(axis=0) & ~at_corner.any(axis=0)
+    # The edge value also holds next to its corners (it tends to e_i there); an
+    # exact corner (r_i = 0) keeps e_i even where a degenerate quad puts it on
+    # another edge. (r is |w_i| |s_i| with w, so "small" would depend on w.)
+    edge = on_edge.any(axis=0) & ~(r == 0).any(axis=0)
     i = np.argmax(on_edge[:, edge], axis=0)
     j = NEXT[i]
     c = cols[edge]
@@ -212,9 +300,17 @@ def inverse_bilinear(p, quad) -> np.ndarray:
     Returns
     -------
     st : (N, 2) float64
+        (float32, computed in float32, when ``p`` and ``quad`` are float32 arrays)
 
     Notes
     -----
+    The patch is solved in the frame of the corner nearest to p: the corners
+    are renumbered so that it is q0 (and s -> 1 - s, t -> 1 - t where that
+    flips the axes), so the unknowns are small near it and carry relative
+    precision, and the terms of the residual below are as small as p's
+    offsets from the nearby corners (near the collapsed edge of a pole quad
+    they are otherwise long vectors that cancel, and s loses L / delta of
+    its digits at a distance delta from the pole).
     With a = q0 - p (translated to the point first), b = q1 - q0, c = q3 - q0,
     d = q0 - q1 + q2 - q3, P(s, t) = p reads a + s b + t c + s t d = 0, and
     eliminating s gives k2 t^2 + k1 t + k0 = 0 with k2 = c x d,
@@ -223,12 +319,16 @@ def inverse_bilinear(p, quad) -> np.ndarray:
     t = Q / k2: at a near-parallelogram (k2 -> 0) the first stays accurate and
     the second goes to infinity, and at an exact parallelogram nothing divides
     by zero. Of the two the root whose (s, t) lies closer to the unit square is
-    kept (s from t by least squares), then two safeguarded Newton steps on the
-    2-D system (a step is kept only if it lowers the residual) recover the
-    digits lost where the two roots nearly meet (near a collapsed edge).
+    kept (s from t by least squares; a root on a collapsed edge, where every s
+    is the same point, only when there is no other), then safeguarded Newton
+    steps on the 2-D system (a step is kept only if it lowers the residual)
+    recover the digits lost where the two roots nearly meet.
+    A point at a corner gets exactly that corner's (s, t) (also at the reflex
+    corner of a dart, where the patch folds and a second solution exists).
     Where no real solution exists (negative discriminant: outside the patch's
     image) the discriminant is taken as 0; a row with no finite candidate
-    (zero-area quad) starts from (0, 0). The result is always finite.
+    (zero-area quad, or p on a collapsed edge) starts from the corner q0 of
+    its frame. The result is always finite.
 
     Examples
     --------
@@ -244,8 +344,14 @@ def inverse_bilinear(p, quad) -> np.ndarray:
 def bilinear_parameters(px, py, qx, qy):
     """``inverse_bilinear`` on components: px, py (N,), qx, qy (4, N) or (4, 1).
 
-    Returns s, t (N,) float64.
+    Returns s, t (N,) of the inputs' float dtype.
     """
+    # The frame of the nearest corner (see inverse_bilinear): FRAMES[k] lists
+    # the corners renumbered so that corner k is q0.
+    nearest = np.argmin(np.maximum(np.abs(qx - px), np.abs(qy - py)), axis=0)
+    order = FRAMES[nearest].T  # (4, N)
+    qx = np.take_along_axis(np.broadcast_to(qx, order.shape), order, axis=0)
+    qy = np.take_along_axis(np.broadcast_to(qy, order.shape), order, axis=0)
     a = (qx[0] - px, qy[0] - py)  # translated to the point first
     b = (qx[1] - qx[0], qy[1] - qy[0])
     c = (qx[3] - qx[0], qy[3] - qy[0])
@@ -263,12 +369,14 @@ def bilinear_parameters(px, py, qx, qy):
         s_near, s_far = _s_given_t(a, b, c, d, t_near), _s_given_t(a, b, c, d, t_far)
     far = _outside_unit_square(s_far, t_far) < _outside_unit_square(s_near, t_near)
     s, t = np.where(far, s_far, s_near), np.where(far, t_far, t_near)
-    undefined = ~(np.isfinite(s) & np.isfinite(t))
-    s[undefined] = 0.0
-    t[undefined] = 0.0
+    # p at the frame's corner q0 (a = 0) gets exactly (0, 0): the Lagrange property,
+    # also where the patch folds over a reflex corner and another root exists.
+    start_at_corner = ~(np.isfinite(s) & np.isfinite(t)) | ((a[0] == 0) & (a[1] == 0))
+    s[start_at_corner] = 0.0
+    t[start_at_corner] = 0.0
     for _ in range(NEWTON_STEPS):
         s, t = _newton_step(a, b, c, d, s, t)
-    return s, t
+    return np.where(FLIPS_S[nearest], 1 - s, s), np.where(FLIPS_T[nearest], 1 - t, t)
 
 
 def bilinear_weights(s, t) -> np.ndarray:
@@ -278,12 +386,12 @@ def bilinear_weights(s, t) -> np.ndarray:
 
 
 def _s_given_t(a, b, c, d, t):
-    """Least-squares s of (a + t c) + s (b + t d) = 0; 0.5 where b + t d = 0
+    """Least-squares s of (a + t c) + s (b + t d) = 0; NaN where b + t d = 0
     (a collapsed edge, every s the same point). Components (N,) -> (N,)."""
     ux, uy = b[0] + t * d[0], b[1] + t * d[1]  # dP/ds
     uu = ux * ux + uy * uy
     s = -(ux * (a[0] + t * c[0]) + uy * (a[1] + t * c[1])) / uu
-    return np.where(uu > 0, s, 0.5)
+    return np.where(uu > 0, s, np.nan)
 
 
 def _outside_unit_square(s, t):
@@ -295,23 +403,33 @@ def _outside_unit_square(s, t):
 def _newton_step(a, b, c, d, s, t):
     """One safeguarded Newton step for F = a + s b + t c + s t d = 0 (components).
 
-    The step is kept only where it lowers |F|.
+    The step is kept only where it lowers the backward error of ``_residual``.
     """
-    F = _residual(a, b, c, d, s, t)
+    F, error = _residual(a, b, c, d, s, t)
     Js = (b[0] + t * d[0], b[1] + t * d[1])
     Jt = (c[0] + s * d[0], c[1] + s * d[1])
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         det = _cross(Js, Jt)
         s1 = s + _cross(Jt, F) / det
         t1 = t + _cross(F, Js) / det
-        F1 = _residual(a, b, c, d, s1, t1)
-        better = F1[0] * F1[0] + F1[1] * F1[1] < F[0] * F[0] + F[1] * F[1]
+        better = _residual(a, b, c, d, s1, t1)[1] < error
     return np.where(better, s1, s), np.where(better, t1, t)
 
 
 def _residual(a, b, c, d, s, t):
+    """F = a + s b + t c + s t d (component pair) and its componentwise backward
+    error max_k |F_k| / (|a_k| + |s b_k| + |t c_k| + |s t d_k|) (N,): each row
+    relative to its own terms, so that a thin quad's short row counts as much
+    as its long one (|F| alone would only see the long one)."""
     st = s * t
-    return (a[0] + s * b[0] + t * c[0] + st * d[0], a[1] + s * b[1] + t * c[1] + st * d[1])
+    F, error = [], 0.0
+    for k in range(2):
+        terms = (a[k], s * b[k], t * c[k], st * d[k])
+        F.append(terms[0] + terms[1] + terms[2] + terms[3])
+        size = np.abs(terms[0]) + np.abs(terms[1]) + np.abs(terms[2]) + np.abs(terms[3])
+        relative = np.where(size > 0, np.abs(F[k]) / np.where(size > 0, size, 1), 0.0)
+        error = np.maximum(error, np.where(np.isfinite(F[k]), relative, np.inf))
+    return tuple(F), error
 
 
 def _cross(u, v) -> np.ndarray:
@@ -320,9 +438,12 @@ def _cross(u, v) -> np.ndarray:
 
 
 def _points_and_corners(p, quad):
-    """Validate and return p (N, 2) and corner-major corners (4, N|1, 2), float64."""
-    p = np.asarray(p, dtype=np.float64)
-    quad = np.asarray(quad, dtype=np.float64)
+    """Validate and return p (N, 2) and corner-major corners (4, N|1, 2): float32
+    when both are float32 arrays (to measure the forms at GPU precision), else float64."""
+    single = all(getattr(v, "dtype", None) == np.float32 for v in (p, quad))
+    dtype = np.float32 if single else np.float64
+    p = np.asarray(p, dtype=dtype)
+    quad = np.asarray(quad, dtype=dtype)
     if p.ndim != 2 or p.shape[1] != 2:
         raise ValueError(f"p must have shape (N, 2), got {p.shape}")
     if quad.shape == (4, 2):
@@ -334,9 +455,9 @@ def _points_and_corners(p, quad):
     return p, q
 
 
-def _corner_weights(w, n) -> np.ndarray:
-    """Validate w ((4,) or (N, 4), finite, nonzero) and return it corner-major (4, N|1)."""
-    w = np.asarray(w, dtype=np.float64)
+def _corner_weights(w, n, dtype) -> np.ndarray:
+    """Validate w ((4,) or (N, 4), finite, nonzero) and return it corner-major (4, N|1) of ``dtype``."""
+    w = np.asarray(w, dtype=dtype)
     if w.shape == (4,):
         w = w[:, None]
     elif w.shape == (n, 4):

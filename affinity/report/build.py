@@ -24,7 +24,7 @@ from .demo import MeshInput, View
 from .scores import QuadScores, quad_scores, scored_codes, shown_code
 
 RENDER_SIZE = (480, 360)
-#: Methods drawn beside the hybrid when it sent quads to mvc; ``exact`` once ``render`` has it.
+#: Methods drawn beside the hybrid when it sent quads to mvc (``exact``: the ray / bilinear-patch reference).
 COMPARED_METHODS = ("split", "mvc", "exact")
 
 

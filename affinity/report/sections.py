@@ -10,6 +10,7 @@ here, its entry in ``MESH_SECTIONS`` or ``CLOSING_SECTIONS``, and its template
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
@@ -37,6 +38,11 @@ SCORE_FLOOR = 1e-3
 #: their threshold) and Q302's negative uv area (see affinity.lint).
 LOWEST_IS_WORST = frozenset({"Q201", "Q301", "Q302"})
 MISSING_ATTRIBUTE = {"Q101": "no texture coordinates", "Q102": "no vertex colours", "Q103": "no normals"}
+#: Where the stability section looks for ``affinity stability``'s table, in order.
+STABILITY_RESULTS = (
+    Path("reports/stability/stability.csv"),
+    Path(__file__).resolve().parents[2] / "reports" / "stability" / "stability.csv",
+)
 
 
 @dataclass
@@ -128,15 +134,57 @@ def summary_section(run: ReportRun) -> Section:
 
 
 def study_section(run: ReportRun) -> Section:
-    """Error against run time, from the study (issue 10, ``affinity bench``): not built yet."""
-    return leave_out("study", "Error against run time",
-                     "the error-against-run-time study (affinity bench, issue 10) is not built yet")
+    """Error against exact over render time of split, hybrid and mvc, per mesh that needed mvc.
+
+    From the renders the report made (one run each, routing included): a first
+    look; ``affinity bench`` times with warm-up and repeats and sweeps the
+    hybrid's settings.
+    """
+    from ..hybrid import RenderOptions
+    from ..study.charts import error_against_time
+    from ..study.sweep import mark_pareto
+
+    title = "Error against run time"
+    rows = []
+    for result in run.meshes:
+        errors = _errors_against_exact(result) if result.readable and "exact" in result.renders else None
+        if errors is None:
+            continue
+        unit = unit_of(result.shown, result.settings)
+        of_mesh = [
+            {"scene": result.input.label, "method": method, "route": "view" if method == "hybrid" else "",
+             "setting": RenderOptions.pixel_tolerance if method == "hybrid" else np.nan,
+             "seconds": result.renders[method].seconds, "unit": unit,
+             "err_rms": float(np.sqrt(np.mean(error[covered] ** 2))) if covered.any() else 0.0}
+            for method, (error, covered) in errors.items()
+        ]
+        mark_pareto(of_mesh)
+        rows += of_mesh
+    if not rows:
+        return leave_out("study", title,
+                         "no mesh has an exact render to compare with (nothing needed mvc in any view)")
+    table = [{"mesh": row["scene"], "method": row["method"], "ms": f"{row['seconds'] * 1e3:.1f}",
+              "rms": with_unit(number(row["err_rms"]), row["unit"]), "pareto": row["pareto"]} for row in rows]
+    chart = error_against_time(rows, time_label="render time (ms), one run")
+    return Section("study", title, {"src": data_uri(chart), "rows": table})
 
 
 def stability_section(run: ReportRun) -> Section:
-    """The stability table (issue 11, ``affinity stability``): not built yet."""
-    return leave_out("stability", "Numerical stability",
-                     "the stability catalogue (affinity stability, issue 11) is not built yet")
+    """The summary of the stability table (issue 11) from the CSV ``affinity stability`` writes:
+    in the current folder's reports/stability/, else the one committed beside the package."""
+    from ..stability.table import from_csv, summary
+
+    title = "Numerical stability"
+    path = next((p for p in STABILITY_RESULTS if p.is_file()), None)
+    if path is None:
+        return leave_out("stability", title, "no stability results: `affinity stability` writes them to reports/stability/")
+    rows = from_csv(path.read_text(encoding="utf-8"))
+    stats = summary(rows)
+    return Section("stability", title, {
+        "path": "reports/stability/stability.csv", "cases": len({r.case for r in rows}),
+        "methods": [s for s in stats if not s["naive"]],
+        "naive": [s for s in stats if s["naive"] and s["precision"] == "float64"],
+    })
 
 
 # --- one mesh ---------------------------------------------------------------------------------
@@ -261,26 +309,37 @@ def _why_no_exact(result: MeshResult) -> str:
     return "nothing needed mvc in this view, so there is no comparison to map"
 
 
-def error_heatmaps_section(result: MeshResult) -> Section:
-    """Per-pixel error of split, hybrid and mvc against the exact render, on one colour scale."""
-    title = "Error against exact"
-    if "exact" not in result.renders:
-        return leave_out("errors", title, _why_no_exact(result))
+def _errors_against_exact(result: MeshResult) -> dict | None:
+    """Per-pixel error (H, W) of split, hybrid, mvc and exact against the exact render, in the
+    lint's unit of the attribute shown, and the pixels where both show the same quad (H, W) bool
+    (the split may show another quad at a concave or bow-tie one); None for plain shading."""
     if result.shown is None:
-        return leave_out("errors", title, "the renders show plain shading: no attribute to compare")
+        return None
     from ..imagesize import image_size
     from .errors import pixel_error
 
     exact = result.renders["exact"].frame
     texture_size = image_size(result.mesh.texture_path()) or (result.settings.texture_size,) * 2
-    unit = unit_of(result.shown, result.settings)
     errors = {}
-    for method in ("split", "hybrid", "mvc"):
+    for method in ("split", "hybrid", "mvc", "exact"):
         frame = result.renders[method].frame
-        covered = (frame.face >= 0) & (exact.face >= 0)
+        covered = (frame.face >= 0) & (frame.face == exact.face)
         error = np.zeros(covered.shape)
         error[covered] = pixel_error(frame.attrs[covered], exact.attrs[covered], result.shown, texture_size)
         errors[method] = error, covered
+    return errors
+
+
+def error_heatmaps_section(result: MeshResult) -> Section:
+    """Per-pixel error of split, hybrid and mvc against the exact render, on one colour scale."""
+    title = "Error against exact"
+    if "exact" not in result.renders:
+        return leave_out("errors", title, _why_no_exact(result))
+    errors = _errors_against_exact(result)
+    if errors is None:
+        return leave_out("errors", title, "the renders show plain shading: no attribute to compare")
+    del errors["exact"]
+    unit = unit_of(result.shown, result.settings)
     scale = max(float(np.percentile(e[c], 99)) if c.any() else 0.0 for e, c in errors.values())
     figures = [
         {"method": method, "src": heatmap_uri(error, covered, scale),
