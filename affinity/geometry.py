@@ -56,14 +56,14 @@ def _corner_major(corners: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(np.moveaxis(corners, 1, 0))
 
 
+def by_component(corners: np.ndarray) -> np.ndarray:
+    """(Q, 4, D) corners -> (D, 4, Q) float64 copy: component d of corner k of every
+    quad is one contiguous row, the layout the measures compute in."""
+    return np.ascontiguousarray(np.transpose(np.asarray(corners, dtype=np.float64), (2, 1, 0)))
+
+
 # Corner-major helpers: ``p`` is (4, Q, D), p[k] the k-th corner of every quad.
-_NEXT, _OPPOSITE, _PREVIOUS = [1, 2, 3, 0], [2, 3, 0, 1], [3, 0, 1, 2]
-
-
-def _longest_edge(p: np.ndarray) -> np.ndarray:
-    """(Q,) length of the longest edge p_{k+1} - p_k."""
-    edges = p[_NEXT] - p
-    return np.sqrt(_dot(edges, edges).max(axis=0))
+_NEXT, _PREVIOUS = [1, 2, 3, 0], [3, 0, 1, 2]
 
 
 def _diagonals_parallel(n: np.ndarray, d02: np.ndarray, d13: np.ndarray) -> np.ndarray:
@@ -110,13 +110,6 @@ def _plane_coordinates(p: np.ndarray) -> np.ndarray:
     return xy
 
 
-def _opposite_areas(xy: np.ndarray) -> np.ndarray:
-    """(Q, 4) T_i of 2-D corners (4, Q, 2): twice the signed area of the triangle
-    (p_{i+1}, p_{i+2}, p_{i+3})."""
-    first = xy[_NEXT]
-    return _cross2(xy[_OPPOSITE] - first, xy[_PREVIOUS] - first).T
-
-
 def quad_normals(corners: np.ndarray) -> np.ndarray:
     """Normals of the quads' own planes, following the face winding (right-hand rule).
 
@@ -158,27 +151,91 @@ def plane_coordinates(corners: np.ndarray) -> np.ndarray:
     return np.moveaxis(_plane_coordinates(_corner_major(corners)), 0, 1)
 
 
+# Component-major helpers: ``p`` is (D, 4, Q), p[d, k] component d of corner k.
+
+
+def _edges(p: np.ndarray) -> np.ndarray:
+    """(D, 4, Q) edge vectors e_k = p_{k+1} - p_k."""
+    e = np.empty_like(p)
+    np.subtract(p[:, 1:], p[:, :-1], out=e[:, :-1])
+    np.subtract(p[:, 0], p[:, -1], out=e[:, -1])
+    return e
+
+
+def squared_lengths(v: np.ndarray) -> np.ndarray:
+    """(D, ...) vectors laid out by component -> (...) squared Euclidean lengths."""
+    total = v[0] * v[0]
+    for component in v[1:]:
+        total += component * component
+    return total
+
+
+def _corner_turns(e: np.ndarray) -> np.ndarray:
+    """(D, 4, Q) edges -> c_k = e_k x e_{k+1}: (3, 4, Q) vectors for D = 3, (4, Q)
+    z components for D = 2. c_k is the corner normal at corner k + 1, and the
+    triangle opposite corner i has the doubled vector area c_{i+1}."""
+    following = np.roll(e, -1, axis=1)
+    if len(e) == 2:
+        return e[0] * following[1] - e[1] * following[0]
+    turns = np.empty_like(e)
+    for d in range(3):
+        u, v = (d + 1) % 3, (d + 2) % 3
+        np.multiply(e[u], following[v], out=turns[d])
+        turns[d] -= e[v] * following[u]
+    return turns
+
+
+def _warp(e0: np.ndarray, normal: np.ndarray, d02: np.ndarray, d13: np.ndarray, parallel: np.ndarray) -> np.ndarray:
+    """Relative warp |e0 . n| / (|n| (|d02| + |d13|) / 2), 0 where the diagonals are
+    ``parallel``; e0 (3, Q), n (3, Q) = d02 x d13, diagonal lengths (Q,)."""
+    distance = np.abs(e0[0] * normal[0] + e0[1] * normal[1] + e0[2] * normal[2])
+    denominator = np.sqrt(squared_lengths(normal)) * (d02 + d13) / 2
+    return np.divide(distance, denominator, out=np.zeros_like(distance), where=~parallel)
+
+
 @dataclass(frozen=True)
 class PlanarQuads:
     """Quads seen in their own planes, with what the measures share.
 
     Attributes
     ----------
-    xy : (Q, 4, 2) float64
-        In-plane corners.
     areas : (Q, 4) float64
         T_i, twice the signed area of the triangle (p_{i+1}, p_{i+2}, p_{i+3})
-        opposite corner i, counter-clockwise positive.
+        opposite corner i, counter-clockwise positive: in the quad's plane,
+        T_i = (e_{i+1} x e_{i+2}) . n / |n| with edges e_k = p_{k+1} - p_k (the
+        area of the triangle projected onto the plane), or the 2-D cross
+        product for 2-D corners.
     size : (Q,) float64
         Longest edge, measured on the original corners.
     diagonals : (Q, 2) float64
         Lengths of the diagonals 0-2 and 1-3, measured on the original corners.
+    components : (D, 4, Q) float64
+        The corners themselves (see :func:`by_component`).
+    normals : (3, Q) float64 or None
+        The quad normals d02 x d13 of 3-D corners (before the stand-in for
+        parallel diagonals, see :func:`quad_normals`); None for 2-D corners.
     """
 
-    xy: np.ndarray
     areas: np.ndarray
     size: np.ndarray
     diagonals: np.ndarray
+    components: np.ndarray
+    normals: np.ndarray | None = None
+
+    @cached_property
+    def xy(self) -> np.ndarray:
+        """(Q, 4, 2) float64 in-plane corners: ``plane_coordinates`` of 3-D corners,
+        2-D corners as they are."""
+        corners = np.transpose(self.components, (2, 1, 0))
+        return plane_coordinates(corners) if len(self.components) == 3 else corners
+
+    @cached_property
+    def warp(self) -> np.ndarray:
+        """(Q,) float64 ``nonplanarity`` of 3-D quads."""
+        e0 = self.components[:, 1] - self.components[:, 0]
+        d02, d13 = self.diagonals[:, 0], self.diagonals[:, 1]
+        parallel = np.sqrt(squared_lengths(self.normals)) <= DEGENERATE_AREA * d02 * d13
+        return _warp(e0, self.normals, d02, d13, parallel)
 
     @cached_property
     def valid(self) -> np.ndarray:
@@ -193,24 +250,59 @@ class PlanarQuads:
 
     def take(self, rows) -> PlanarQuads:
         """The quads selected by ``rows`` (an index array, a boolean mask or a slice)."""
-        return PlanarQuads(self.xy[rows], self.areas[rows], self.size[rows], self.diagonals[rows])
+        if isinstance(rows, slice) and rows == slice(None):
+            return self
+        normals = None if self.normals is None else self.normals[:, rows]
+        return PlanarQuads(self.areas.T[:, rows].T, self.size[rows], self.diagonals[rows], self.components[:, :, rows], normals)
 
     def __len__(self) -> int:
-        return len(self.areas)
+        return len(self.size)
 
 
 def planar_quads(corners: np.ndarray) -> PlanarQuads:
-    """Build :class:`PlanarQuads` from 3-D corners (projected with ``plane_coordinates``)
-    or 2-D corners (texture coordinates, used as they are).
+    """Build :class:`PlanarQuads` from 3-D corners (seen in the plane of
+    ``plane_coordinates``) or 2-D corners (texture coordinates, used as they are).
 
     Parameters
     ----------
     corners : (Q, 4, 3) or (Q, 4, 2) float64
     """
-    p = _corner_major(np.asarray(corners, dtype=np.float64))
-    xy = _plane_coordinates(p) if p.shape[-1] == 3 else p
-    diagonals = np.stack([lengths(p[2] - p[0]), lengths(p[3] - p[1])], axis=1)
-    return PlanarQuads(np.moveaxis(xy, 0, 1), _opposite_areas(xy), _longest_edge(p), diagonals)
+    return planar_quads_by_component(by_component(corners))
+
+
+def planar_quads_by_component(p: np.ndarray) -> PlanarQuads:
+    """:func:`planar_quads` of corners laid out by component.
+
+    Parameters
+    ----------
+    p : (D, 4, Q) float64, D = 3 or 2 (see :func:`by_component`)
+    """
+    e = _edges(p)
+    size = np.sqrt(squared_lengths(e).max(axis=0))
+    turns = _corner_turns(e)
+    d02, d13 = e[:, 0] + e[:, 1], e[:, 1] + e[:, 2]
+    diagonals = np.sqrt(np.stack([squared_lengths(d02), squared_lengths(d13)])).T
+    normals = None
+    if len(p) == 2:
+        areas = turns
+    else:
+        # d02 x d13 = c_0 + c_2: the sum of opposite corner turns is twice the vector area.
+        normals = turns[:, 0] + turns[:, 2]
+        normal_length = np.sqrt(squared_lengths(normals))
+        unit = normals.copy()
+        parallel = normal_length <= DEGENERATE_AREA * diagonals[:, 0] * diagonals[:, 1]
+        if parallel.any():  # the largest corner normal stands in (see quad_normals)
+            corner = turns[:, _PREVIOUS][:, :, parallel]  # the normal at corner k is c_{k-1}
+            largest = squared_lengths(corner).argmax(axis=0)
+            unit[:, parallel] = corner[:, largest, np.arange(corner.shape[2])]
+            normal_length[parallel] = np.sqrt(squared_lengths(unit[:, parallel]))
+        np.divide(unit, normal_length, out=unit, where=normal_length > 0)
+        areas = turns[0] * unit[0]
+        areas += turns[1] * unit[1]
+        areas += turns[2] * unit[2]
+    # The triangle opposite corner i has the vector area c_{i+1}.
+    areas = np.roll(areas, -1, axis=0)
+    return PlanarQuads(areas.T, size, diagonals, p, normals)
 
 
 def _relative(area: np.ndarray, size: np.ndarray) -> np.ndarray:
@@ -267,13 +359,15 @@ def nonplanarity(corners: np.ndarray) -> np.ndarray:
     -------
     (Q,) float64, 0 for planar quads.
     """
-    d02 = corners[:, 2] - corners[:, 0]
-    d13 = corners[:, 3] - corners[:, 1]
-    n = np.cross(d02, d13)
-    distance = np.abs(_dot(corners[:, 1] - corners[:, 0], n))
-    denominator = lengths(n) * (lengths(d02) + lengths(d13)) / 2
-    planar = _diagonals_parallel(n, d02, d13)
-    return np.divide(distance, denominator, out=np.zeros_like(distance), where=~planar)
+    p = by_component(corners)
+    d02, d13 = p[:, 2] - p[:, 0], p[:, 3] - p[:, 1]
+    normal = np.empty_like(d02)
+    for d in range(3):
+        u, v = (d + 1) % 3, (d + 2) % 3
+        normal[d] = d02[u] * d13[v] - d02[v] * d13[u]
+    length02, length13 = np.sqrt(squared_lengths(d02)), np.sqrt(squared_lengths(d13))
+    parallel = np.sqrt(squared_lengths(normal)) <= DEGENERATE_AREA * length02 * length13
+    return _warp(p[:, 1] - p[:, 0], normal, length02, length13, parallel)
 
 
 def _reflex(quads: PlanarQuads) -> np.ndarray:

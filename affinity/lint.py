@@ -28,63 +28,118 @@ from .geometry import (
     folded_fraction,
     interior_angles,
     is_bowtie,
-    lengths,
-    nonplanarity,
-    planar_quads,
+    planar_quads_by_component,
     relative_signed_area,
+    squared_lengths,
 )
 from .imagesize import image_size
-from .measures import barycentric_score, color_steps, misplacement, normal_degrees, texels
+from .measures import (
+    barycentric_score,
+    color_steps,
+    misplacement_by_component,
+    normal_degrees,
+    split_scale,
+    texels,
+)
 from .mesh import Mesh
 from .rules import RULES, resolve_codes
 from .settings import Settings
 
 _FLAG_AT_OR_BELOW = frozenset({"Q201", "Q301"})
-_ATTRIBUTE_WIDTH = {"texcoords": 2, "colors": 3, "normals": 3}
+#: The attribute each rule reads besides the positions.
+_ATTRIBUTE_OF_RULE = {"Q101": "texcoords", "Q102": "colors", "Q103": "normals", "Q301": "texcoords", "Q302": "texcoords"}
 
 
 #: Quads measured together. Whole-mesh temporaries of a million quads spill out
-#: of the caches; batches of this size keep them in, which measured 3-4 times
-#: faster on a 1M-quad mesh, and let the batches run on parallel threads.
-BATCH_SIZE = 65536
+#: of the caches; batches of this size keep them in, and let the batches run on
+#: parallel threads.
+BATCH_SIZE = 16384
+
+
+class _Tables:
+    """A mesh's attribute tables and their corner indices, shared by every batch."""
+
+    def __init__(self, mesh: Mesh):
+        self.mesh = mesh
+        self.corner_index = {
+            "positions": mesh.corner_vertex,
+            "colors": mesh.corner_vertex,
+            "texcoords": mesh.corner_texcoord,
+            "normals": mesh.corner_normal,
+        }
+        self.tables: dict[str, np.ndarray | None] = {}
+        self.has_nan: dict[str, bool] = {}
+
+    def prepare(self, name: str) -> None:
+        """Look table ``name`` over once (NaN rows mark missing values) before the batches share it."""
+        if name in self.tables:
+            return
+        values = getattr(self.mesh, name)
+        if values is None or len(values) == 0 or self.corner_index[name] is None:
+            self.tables[name] = None
+            return
+        self.tables[name] = np.asarray(values, dtype=np.float64)
+        self.has_nan[name] = name != "positions" and bool(np.isnan(self.tables[name]).any())
+
+    def gather(self, name: str, corners: np.ndarray, complete: bool = True) -> tuple[np.ndarray | slice, np.ndarray] | None:
+        """Attribute ``name`` at the (4, Q) corners: ``rows`` of the quads that have
+        it at all four corners (a slice when all do, or without ``complete``) and
+        their values laid out by component, (D, 4, n); normals scaled to unit
+        length (zero ones kept). None when the mesh has no such attribute."""
+        table = self.tables[name]
+        if table is None:
+            return None
+        index = self.corner_index[name][corners]
+        missing = index < 0
+        np.maximum(index, 0, out=index)
+        values = np.ascontiguousarray(np.transpose(table.take(index, axis=0), (2, 0, 1)))
+        if name == "normals":
+            length = np.sqrt(squared_lengths(values))
+            np.divide(values, length, out=values, where=length > 0)
+        if complete and (self.has_nan[name] or missing.any()):
+            has_all = ~(missing.any(axis=0) | np.isnan(values).any(axis=(0, 1)))
+            if not has_all.all():
+                rows = np.flatnonzero(has_all)
+                return rows, values[:, :, rows]
+        return slice(None), values
 
 
 class _QuadBatch:
     """A batch of a mesh's quads, with what several rules share computed once, on demand."""
 
-    def __init__(self, mesh: Mesh, settings: Settings, faces, corners, texture_size):
-        self.mesh = mesh
+    def __init__(self, tables: _Tables, settings: Settings, faces, corners, texture_size):
+        self.tables = tables
         self.settings = settings
         self.faces = faces  # (Q,) face indices in file order
-        self.corners = corners  # (Q, 4) corner indices
+        self.corners = corners  # (4, Q) corner indices
         self.texture_size = texture_size
 
     def __len__(self) -> int:
         return len(self.faces)
 
     @cached_property
-    def positions(self) -> np.ndarray:
-        """(Q, 4, 3) float64"""
-        return self.mesh.corner_attribute("positions", self.corners)
-
-    @cached_property
     def planar(self) -> PlanarQuads:
-        return planar_quads(self.positions)
+        return planar_quads_by_component(self.tables.gather("positions", self.corners, complete=False)[1])
 
     def complete(self, name: str) -> tuple[np.ndarray | slice, np.ndarray]:
-        """Quads that have attribute ``name`` at all four corners.
+        """Quads that have attribute ``name`` at all four corners: ``rows`` (a slice
+        over every quad when all have it, else indices into the batch) and the
+        attribute (K, 4, n) of those quads."""
+        found = self.tables.gather(name, self.corners)
+        if found is None:
+            width = {"texcoords": 2}.get(name, 3)
+            return np.zeros(0, dtype=np.int64), np.zeros((width, 4, 0))
+        return found
 
-        Returns ``rows`` (a slice over every quad when all have it, else indices
-        into the batch) and the attribute (n, 4, K) of those quads.
-        """
-        values = self.mesh.corner_attribute(name, self.corners)
-        if values is None:
-            return np.zeros(0, dtype=np.int64), np.zeros((0, 4, _ATTRIBUTE_WIDTH[name]))
-        has_all = ~np.isnan(values).any(axis=(1, 2))
-        if has_all.all():
-            return slice(None), values
-        rows = np.flatnonzero(has_all)
-        return rows, values[rows]
+    def misplacement(self, rows, attrs: np.ndarray) -> np.ndarray:
+        """(K, n) ``misplacement`` of attributes (K, 4, n) of the quads ``rows``."""
+        if isinstance(rows, slice):  # every quad: the split's scale is shared
+            return misplacement_by_component(self.planar, attrs, scale=self.split_scale)
+        return misplacement_by_component(self.planar.take(rows), attrs, self.settings.diagonal)
+
+    @cached_property
+    def split_scale(self) -> np.ndarray:
+        return split_scale(self.planar, self.settings.diagonal)
 
     @cached_property
     def uv(self) -> tuple[np.ndarray | slice, np.ndarray]:
@@ -92,21 +147,26 @@ class _QuadBatch:
 
     @cached_property
     def uv_planar(self) -> PlanarQuads:
-        return planar_quads(self.uv[1])
+        return planar_quads_by_component(self.uv[1])
 
 
-def _map_quad_batches(mesh: Mesh, settings: Settings, measure) -> list:
+def _map_quad_batches(mesh: Mesh, settings: Settings, measure, attributes=()) -> list:
     """Run ``measure(batch: _QuadBatch)`` on every batch of the mesh's quads, in
-    parallel threads (NumPy releases the GIL in its loops); results in file order."""
-    faces, corners = mesh.faces_of_size(4)
-    size = image_size(mesh.texture_path())
+    parallel threads (NumPy releases the GIL in its loops); results in file order.
+    ``attributes`` names the tables the measure reads besides the positions."""
+    tables = _Tables(mesh)
+    for name in ("positions", *attributes):
+        tables.prepare(name)
+    size = image_size(mesh.texture_path()) if "texcoords" in attributes else None
     texture_size = size if size is not None else (settings.texture_size,) * 2
-    starts = range(0, len(faces), BATCH_SIZE)
+    quads = np.flatnonzero(mesh.face_sizes == 4)
 
     def run(start: int):
-        batch = slice(start, start + BATCH_SIZE)
-        return measure(_QuadBatch(mesh, settings, faces[batch], corners[batch], texture_size))
+        faces = quads[start : start + BATCH_SIZE]
+        corners = mesh.face_start[faces] + np.arange(4)[:, None]  # (4, Q): corner-major
+        return measure(_QuadBatch(tables, settings, faces, corners, texture_size))
 
+    starts = range(0, len(quads), BATCH_SIZE)
     if len(starts) <= 1:
         return [run(start) for start in starts]
     with ThreadPoolExecutor(max_workers=os.cpu_count()) as pool:
@@ -118,20 +178,29 @@ def _uv_disaffinity(quads: _QuadBatch) -> tuple:
     diagonal = quads.settings.diagonal
     if quads.settings.measure == "barycentric":
         return rows, barycentric_score(quads.planar.take(rows), quads.uv_planar, diagonal)
-    return rows, texels(misplacement(quads.planar.take(rows), uv, diagonal), quads.texture_size)
+    return rows, texels(quads.misplacement(rows, uv).T, quads.texture_size)
 
 
 def _color_disaffinity(quads: _QuadBatch) -> tuple:
     rows, colors = quads.complete("colors")
-    return rows, color_steps(misplacement(quads.planar.take(rows), colors, quads.settings.diagonal))
+    return rows, color_steps(quads.misplacement(rows, colors).T)
 
 
 def _normal_disaffinity(quads: _QuadBatch) -> tuple:
-    rows, normals = quads.complete("normals")
-    length = lengths(normals)[..., None]
-    unit = np.divide(normals, length, out=np.zeros_like(normals), where=length > 0)
-    m = misplacement(quads.planar.take(rows), unit, quads.settings.diagonal)
-    return rows, normal_degrees(m, unit)
+    rows, unit = quads.complete("normals")  # unit length already (see _Tables.gather)
+    m = quads.misplacement(rows, unit)
+    # The angle atan2(|m|, |mean normal|) exceeds the threshold only where
+    # |m| > tan(threshold) |mean normal|: the arctangent is taken for those only.
+    threshold = quads.settings.threshold("Q103")
+    picked = slice(None)
+    if threshold < 89:
+        m_length = np.sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2])
+        mean = unit.sum(axis=1)
+        mean_length = np.sqrt(mean[0] * mean[0] + mean[1] * mean[1] + mean[2] * mean[2]) / 4
+        picked = np.flatnonzero(m_length >= mean_length * (np.tan(np.radians(threshold)) * (1 - 1e-9)))
+    rows = np.arange(len(quads))[rows][picked]
+    degrees = normal_degrees(m.T[picked], np.transpose(unit, (2, 1, 0))[picked])
+    return rows, degrees
 
 
 def _degenerate(quads: _QuadBatch) -> tuple:
@@ -139,12 +208,20 @@ def _degenerate(quads: _QuadBatch) -> tuple:
 
 
 def _nonplanar(quads: _QuadBatch) -> tuple:
-    return slice(None), nonplanarity(quads.positions)
+    return slice(None), quads.planar.warp
 
 
 def _concave(quads: _QuadBatch) -> tuple:
-    rows = np.flatnonzero(~is_bowtie(quads.planar))
-    return rows, interior_angles(quads.planar).max(axis=1)[rows]
+    planar = quads.planar
+    candidates = ~is_bowtie(planar)
+    if quads.settings.threshold("Q203") >= 180:
+        # An angle above 180 degrees needs a clockwise turn; half the tolerance
+        # keeps every turn interior_angles could read as one.
+        candidates &= (planar.areas < -0.5 * planar.tolerance[:, None]).any(axis=1)
+    rows = np.flatnonzero(candidates)
+    if len(rows) == 0:
+        return rows, np.zeros(0)
+    return rows, interior_angles(planar.take(rows)).max(axis=1)
 
 
 def _bowtie(quads: _QuadBatch) -> tuple:
@@ -217,7 +294,8 @@ def lint_mesh(mesh: Mesh, settings: Settings) -> list[RuleHits]:
             found[code] = faces, values
         return found
 
-    batches = _map_quad_batches(mesh, settings, flag)
+    attributes = sorted({_ATTRIBUTE_OF_RULE[code] for code in codes if code in _ATTRIBUTE_OF_RULE})
+    batches = _map_quad_batches(mesh, settings, flag, attributes) if codes else []
     for code in codes:
         faces = np.concatenate([found[code][0] for found in batches] or [np.zeros(0, dtype=np.int64)])
         if len(faces):
@@ -248,8 +326,9 @@ def quad_uv_misplacement(mesh: Mesh, diagonal: str = "02") -> tuple[np.ndarray, 
     def measure(batch: _QuadBatch) -> np.ndarray:
         m = np.full(len(batch), np.nan)
         rows, uv = batch.uv
-        m[rows] = lengths(misplacement(batch.planar.take(rows), uv, diagonal))
+        uv_m = misplacement_by_component(batch.planar.take(rows), uv, diagonal)
+        m[rows] = np.sqrt(uv_m[0] * uv_m[0] + uv_m[1] * uv_m[1])
         return m
 
-    faces, _ = mesh.faces_of_size(4)
-    return faces, np.concatenate(_map_quad_batches(mesh, Settings(), measure) or [np.zeros(0)])
+    faces = np.flatnonzero(mesh.face_sizes == 4)
+    return faces, np.concatenate(_map_quad_batches(mesh, Settings(), measure, ("texcoords",)) or [np.zeros(0)])

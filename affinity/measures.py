@@ -6,7 +6,7 @@ b_ij with respect to the other three corners j = i+1, i+2, i+3 (mod 4), once in
 position space and once in attribute space, and calls the quad affine when the
 two agree. The defects of the listing are fixed here (design.md, "The affinity
 test"): triangle areas are signed in the quad's own plane
-(``affinity.geometry.plane_coordinates``), not by ``v.z``; degenerate reference
+(measured along the quad's own normal, ``affinity.geometry.PlanarQuads``), not by ``v.z``; degenerate reference
 triangles are marked invalid by a tolerance relative to the quad's size
 (``affinity.geometry.DEGENERATE_AREA``), never an absolute ``FLT_EPSILON``, and
 skipped explicitly; attributes may have any dimension.
@@ -125,20 +125,56 @@ def misplacement(quads: PlanarQuads, attrs: np.ndarray, diagonal: str = "both") 
     -------
     (Q, K) float64 vector m in the attribute's units; always finite.
     """
-    T = quads.areas
+    return misplacement_by_component(quads, np.transpose(attrs, (2, 1, 0)), diagonal).T
+
+
+def misplacement_by_component(quads: PlanarQuads, attrs: np.ndarray, diagonal: str = "both", scale: np.ndarray | None = None) -> np.ndarray:
+    """:func:`misplacement` of attributes laid out by component.
+
+    Parameters
+    ----------
+    quads : PlanarQuads of Q quads.
+    attrs : (K, 4, Q) float64, component k of corner i of quad q at [k, i, q].
+    diagonal : {"both", "02", "13", "shortest"}
+    scale : (Q,) float64, ``split_scale(quads, diagonal)`` when already known
+        (it depends on the positions only, so several attributes share it).
+
+    Returns
+    -------
+    (K, Q) float64
+    """
+    T = quads.areas.T  # (4, Q): T[i] holds every quad's T_i
     # Relative to corner 0 (sum_k (-1)^k T_k = 0 makes this exact), so attributes far
     # from zero keep their digits.
-    R = np.einsum("qk,qkd->qd", (T * _ALTERNATING)[:, 1:], attrs[:, 1:] - attrs[:, :1])
-    usable = quads.valid & selected_corners(quads, diagonal)
-    smallest = np.full(len(T), np.inf)
-    signed_area = np.zeros(len(T))  # (-1)^i T_i of the chosen corner i
+    a0 = attrs[:, 0]
+    R = attrs[:, 2] - a0
+    R *= T[2]
+    R -= (attrs[:, 1] - a0) * T[1]
+    R -= (attrs[:, 3] - a0) * T[3]
+    R *= split_scale(quads, diagonal) if scale is None else scale
+    return R
+
+
+def split_scale(quads: PlanarQuads, diagonal: str = "both") -> np.ndarray:
+    """1 / (4 (-1)^i T_i) for the corner i that :func:`misplacement` reads: among
+    the corners selected by ``diagonal`` whose reference triangle is not
+    degenerate, the one with the smallest |T_i| (the first of equals); 0 where
+    no corner is usable.
+
+    Returns
+    -------
+    (Q,) float64
+    """
+    T = quads.areas.T
+    usable = quads.valid.T & selected_corners(quads, diagonal).T
+    smallest = np.full(len(quads), np.inf)
+    signed_area = np.zeros(len(quads))  # (-1)^i T_i of the chosen corner i
     for i in range(4):  # the four corners, each vectorized over all quads
-        candidate = np.where(usable[:, i], np.abs(T[:, i]), np.inf)
+        candidate = np.where(usable[i], np.abs(T[i]), np.inf)
         smaller = candidate < smallest
         smallest = np.where(smaller, candidate, smallest)
-        signed_area = np.where(smaller, _ALTERNATING[i] * T[:, i], signed_area)
-    scale = np.divide(0.25, signed_area, out=np.zeros_like(signed_area), where=signed_area != 0)
-    return R * scale[:, None]
+        signed_area = np.where(smaller, _ALTERNATING[i] * T[i], signed_area)
+    return np.divide(0.25, signed_area, out=np.zeros_like(signed_area), where=signed_area != 0)
 
 
 def barycentric_score(quads: PlanarQuads, uv_quads: PlanarQuads, diagonal: str = "both") -> np.ndarray:

@@ -8,6 +8,17 @@ from the separator before it: whitespace starts a corner, '/' moves to the next
 slot, '//' skips the ``vt`` slot. Statements without bulk (``g``, ``o``,
 ``usemtl``, ``mtllib``, ``s``, ``l``, ...) are rare and handled one by one.
 
+The common file is regular: within a chunk, the lines of one kind follow each
+other and carry the same number of tokens, and every face line is laid out
+like the first (``v/vt/vn`` quads, say). Then the numbers of a kind are one
+``(lines, tokens)`` block read straight out of the token arrays, and faces are
+parsed as one integer matrix whose columns are the corners' slots; anything
+else takes the general path, token by token.
+
+Chunks are parsed on worker threads (NumPy releases the GIL inside its loops)
+while the main thread reads the file and appends each finished chunk, in file
+order, to the growing arrays of the mesh, so no chunk's arrays outlive it.
+
 Indices may be negative (relative to the elements defined so far) and may refer
 to elements defined later in the file; every index is range-checked against the
 whole file.
@@ -25,7 +36,7 @@ import numpy as np
 from ..mesh import Mesh, MeshError
 from .faces import check_indices, ragged_positions
 from .mtl import read_material_textures
-from .numbers import parse_ints
+from .numbers import PAD, parse_floats, parse_ints
 from .text import Tokens, floats_or_raise, read_chunks, tokenize
 
 _V, _VT, _VN, _F = 1, 2, 3, 4
@@ -35,6 +46,8 @@ _WIDTHS = {_V: (3, 4, 6, 7), _VT: (1, 2, 3), _VN: (3,)}
 _MAX_WIDTH = 8
 #: ``_ALLOWED[kind][min(n, 8)]``: a line of that kind may carry ``n`` numbers.
 _ALLOWED = {kind: np.isin(np.arange(_MAX_WIDTH + 1), widths) for kind, widths in _WIDTHS.items()}
+_ELEMENT_OF_SLOT = (_V, _VT, _VN)
+_SLOT_NAMES = ("vertex", "texture coordinate", "normal")
 _SLASH = ord("/")
 _KEYWORD = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 
@@ -44,16 +57,22 @@ class _Part:
     """What one chunk contributes; indices are still relative to the chunk.
 
     ``corners[k]`` is (C,) int64 0-based index for slot ``k`` (vertex, texcoord,
-    normal), -1 where the corner lacks it; ``relative[k]`` lists the corners
-    whose index counted back from the chunk's own elements and still needs
-    the count of elements before the chunk added.
+    normal), -1 where a corner lacks it, or None when no corner of the chunk
+    has the slot; ``relative[k]`` lists the corners whose index counted back
+    from the chunk's own elements and still needs the count of elements before
+    the chunk added. ``bounds[k]`` is (min, max) of ``corners[k]`` without them.
+    ``face_sizes`` is an int when every face of the chunk has that many corners.
+    Line numbers count from the chunk's first line (see :meth:`_Assembly.result`).
     """
 
     elements: dict  # kind -> (n, width) float64
-    face_sizes: np.ndarray
+    face_sizes: np.ndarray | int
     face_line: np.ndarray
     corners: list
     relative: list
+    bounds: list
+    lines: int  # lines of the chunk
+    bytes: int  # bytes of the chunk's lines
     events: list = field(default_factory=list)  # (face in chunk, keyword, name)
     mtllibs: list = field(default_factory=list)
 
@@ -64,30 +83,41 @@ _WORKERS = 2
 
 def load_obj(path) -> Mesh:
     """Read a Wavefront OBJ file (and the ``map_Kd`` entries of its ``mtllib`` files)."""
-    parts, pending = [], []
+    pending = []
     with open(path, "rb") as fh, ThreadPoolExecutor(_WORKERS) as pool:
-        for chunk in read_chunks(fh, continuations=True):
+        assembly = _Assembly(os.fstat(fh.fileno()).st_size)
+        for chunk in read_chunks(fh, continuations=True, count_lines=False):
             pending.append(pool.submit(_parse_chunk, chunk, path))
             if len(pending) > 2 * _WORKERS:  # bound the chunks held in memory
-                parts.append(pending.pop(0).result())
-        parts += [future.result() for future in pending]
-    return _assemble(path, parts)
+                assembly.add(assembly.result(pending.pop(0)))
+        for future in pending:
+            assembly.add(assembly.result(future))
+    return assembly.mesh(path)
 
 
 def _parse_chunk(chunk, path) -> _Part:
     tokens = tokenize(chunk, path, slash=True)
     counts = tokens.counts
     kind = _line_kinds(tokens, counts)
-    elements = {k: _elements(tokens, path, np.flatnonzero(kind == k), k) for k in _WIDTHS}
-    _check_colors(tokens, path, np.flatnonzero(kind == _V), elements[_V])
+    element_lines = {k: np.flatnonzero(kind == k) for k in _WIDTHS}
+    elements = {k: _elements(tokens, path, lines, k) for k, lines in element_lines.items()}
+    _check_colors(tokens, path, element_lines[_V], elements[_V])
     face_lines = np.flatnonzero(kind == _F)
-    sizes, corners, relative = _faces(tokens, path, kind, face_lines)
+    sizes, corners, relative, bounds, face_slashes = _faces(tokens, path, kind, face_lines)
+    if tokens.slashes != face_slashes:
+        # Some '/' is not where a face layout puts one; when every one is, none
+        # can touch a number of a v/vt/vn line and the lines need no look.
+        for lines in element_lines.values():
+            _reject_slashes(tokens, path, lines)
     part = _Part(
         elements=elements,
         face_sizes=sizes,
         face_line=tokens.number[face_lines],
         corners=corners,
         relative=relative,
+        bounds=bounds,
+        lines=len(tokens.end) + len(chunk.joined),
+        bytes=len(chunk.buf) - 2 * PAD,
     )
     statements = np.flatnonzero((counts > 0) & (kind == 0))
     if len(statements):
@@ -105,12 +135,16 @@ def _line_kinds(tokens: Tokens, counts) -> np.ndarray:
         return kind
     keyword = np.minimum(tokens.first[:-1], len(tokens.starts) - 1)
     start = tokens.starts[keyword]
-    length = np.where(counts > 0, tokens.ends[keyword] - start, 0)
+    length = tokens.ends[keyword] - start
+    length[counts == 0] = 0
     first, second = buf[start], buf[start + 1]
-    kind[(length == 1) & (first == ord("v"))] = _V
-    kind[(length == 2) & (first == ord("v")) & (second == ord("t"))] = _VT
-    kind[(length == 2) & (first == ord("v")) & (second == ord("n"))] = _VN
-    kind[(length == 1) & (first == ord("f"))] = _F
+    one, two, v = length == 1, length == 2, first == ord("v")
+    kind[one & v] = _V
+    kind[one & (first == ord("f"))] = _F
+    if two.any():
+        two &= v
+        kind[two & (second == ord("t"))] = _VT
+        kind[two & (second == ord("n"))] = _VN
     return kind
 
 
@@ -120,30 +154,63 @@ def _line_tokens(tokens: Tokens, lines):
     return width, ragged_positions(tokens.first[lines] + 1, width)
 
 
+def _token_block(tokens: Tokens, lines, width: int, previous: bool = False):
+    """Byte offsets of the ``width`` tokens after the keyword of every line of
+    ``lines``, all of which have that many: ``starts, ends`` (n, width) int64
+    (and the ends of the tokens before them with ``previous``). A run of
+    consecutive lines owns a contiguous range of tokens: then they are views."""
+    n = len(lines)
+    if n and lines[-1] - lines[0] + 1 == n:
+        first = tokens.first[lines[0]]
+        rows = slice(first, first + n * (width + 1))
+        starts = tokens.starts[rows].reshape(n, width + 1)
+        ends = tokens.ends[rows].reshape(n, width + 1)
+        block = starts[:, 1:], ends[:, 1:]
+        return block + (ends[:, :-1],) if previous else block
+    index = tokens.first[lines, None] + np.arange(1, width + 1)
+    block = tokens.starts[index], tokens.ends[index]
+    return block + (tokens.ends[index - 1],) if previous else block
+
+
 def _elements(tokens: Tokens, path, lines, which) -> np.ndarray:
     """(n, width) float64 numbers of the ``which`` lines, NaN where a line has fewer."""
-    width, numbers = _line_tokens(tokens, lines)
-    wrong = ~_ALLOWED[which][np.minimum(width, _MAX_WIDTH)]
-    if wrong.any():
-        line = lines[np.argmax(wrong)]
-        raise MeshError(path, tokens.number[line], f"{tokens.text(tokens.first[line])} line with {width[wrong][0]} numbers")
+    if len(lines) == 0:
+        return np.zeros((0, _WIDTHS[which][0]))
+    counts = tokens.counts[lines]
+    if counts.min() == counts.max() and _ALLOWED[which][min(counts[0] - 1, _MAX_WIDTH)]:
+        width = int(counts[0]) - 1  # one width: a (lines, numbers) block
+        starts, ends = _token_block(tokens, lines, width)
+        rows, bad = parse_floats(tokens.buf, starts, ends, finite=True)
+        if len(bad):  # let the token-by-token path say what is wrong with it
+            floats_or_raise(tokens, path, tokens.first[lines[bad[:1] // width]] + 1 + bad[:1] % width, finite=True)
+    else:
+        width, numbers = _line_tokens(tokens, lines)
+        wrong = ~_ALLOWED[which][np.minimum(width, _MAX_WIDTH)]
+        if wrong.any():
+            line = lines[np.argmax(wrong)]
+            raise MeshError(path, tokens.number[line], f"{tokens.text(tokens.first[line])} line with {width[wrong][0]} numbers")
+        values = floats_or_raise(tokens, path, numbers, finite=True)
+        rows = np.full((len(width), max(_WIDTHS[which])), np.nan)
+        rows[np.repeat(np.arange(len(width)), width), ragged_positions(np.zeros(len(width), np.int64), width)] = values
+        if len(width) == 0:
+            rows = rows[:, : _WIDTHS[which][0]]
+    if which != _V or rows.shape[1] == 3:
+        return rows
+    if rows.shape[1] == 4:  # 'v x y z w': w is not a colour
+        return rows[:, :3]
+    if rows.shape[1] == 7:
+        rows[np.isnan(rows[:, 4]), 3] = np.nan  # 'v x y z w' among colour lines
+    return rows[:, :6]  # the alpha of 'v x y z r g b a' is not kept
+
+
+def _reject_slashes(tokens: Tokens, path, lines) -> None:
+    """MeshError at the first number of these v/vt/vn lines with a '/' right before or after it."""
+    _, numbers = _line_tokens(tokens, lines)
     buf = tokens.buf
     slashed = (buf[tokens.starts[numbers] - 1] == _SLASH) | (buf[tokens.ends[numbers]] == _SLASH)
     if slashed.any():
         token = numbers[np.argmax(slashed)]
         raise MeshError(path, tokens.line_of_token(token), f"unexpected '/' next to {tokens.text(token)!r}")
-    values = floats_or_raise(tokens, path, numbers, finite=True)
-    if len(width) == 0 or (width == width[0]).all():
-        rows = values.reshape(len(width), width[0] if len(width) else _WIDTHS[which][0])
-    else:
-        rows = np.full((len(width), max(_WIDTHS[which])), np.nan)
-        rows[np.repeat(np.arange(len(width)), width), ragged_positions(np.zeros(len(width), np.int64), width)] = values
-    if which != _V or rows.shape[1] == 3:
-        return rows
-    if rows.shape[1] == 4:  # 'v x y z w': w is not a colour
-        return rows[:, :3]
-    rows[width == 4, 3] = np.nan
-    return rows[:, :6]  # the alpha of 'v x y z r g b a' is not kept
 
 
 def _check_colors(tokens: Tokens, path, lines, vertices) -> None:
@@ -189,28 +256,121 @@ def _corner_slots(layout, line_start):
     return slot, malformed
 
 
+def _slash_count(layout) -> int:
+    """Number of '/' bytes the separators of these face tokens hold."""
+    return int(np.count_nonzero(layout & _AFTER_SLASH) + np.count_nonzero(layout & _AFTER_DOUBLE))
+
+
 def _faces(tokens: Tokens, path, kind, face_lines):
     """Corner structure of the chunk's ``f`` lines.
 
-    Returns ``sizes (F,) int64``, ``corners`` [3 x (C,) int64] and
-    ``relative`` [3 x (r,) int64] as described in :class:`_Part`. Blocks of
-    face lines with one layout (the usual case: all ``v/vt/vn`` quads) are
-    checked as a whole against their first line instead of token by token.
+    Returns ``sizes`` ((F,) int64, or an int when all faces have that size),
+    ``corners``, ``relative`` and ``bounds`` as described in :class:`_Part`, and
+    the number of '/' bytes between the face tokens.
     """
+    if len(face_lines) == 0:
+        return 0, [None] * 3, [None] * 3, [None] * 3, 0
+    counts = tokens.counts[face_lines]
+    width = int(counts[0]) - 1
+    if width > 0 and counts.min() == counts.max():
+        start, end, previous_end = _token_block(tokens, face_lines, width, previous=True)
+        if _laid_out_alike(tokens.buf, start, end, previous_end):
+            layout = _face_layout(tokens.buf, start[0], end[0], previous_end[0])
+            return _uniform_faces(tokens, path, kind, face_lines, start, end, layout)
+    return _mixed_faces(tokens, path, kind, face_lines)
+
+
+def _laid_out_alike(buf, start, end, previous_end) -> bool:
+    """Whether every face line has the separators of the first, so that all
+    share its :func:`_face_layout` bit for bit: the same gap before each token,
+    ending in the same byte, starting with the same byte where the gap is
+    longer than one; and the same byte after the line's last token.
+
+    start, end, previous_end : (F, T) int64 offsets of the lines' tokens and
+    of the ends of the tokens before them.
+    """
+    gap = start - previous_end
+    if not (gap == gap[0]).all():
+        return False
+    last = buf[start - 1]
+    if not (last == last[0]).all():
+        return False
+    wide = np.flatnonzero(gap[0] > 1)
+    if len(wide):
+        first = buf[previous_end[:, wide]]
+        if not (first == first[0]).all():
+            return False
+    after = buf[end[:, -1]]
+    return bool((after == after[0]).all())
+
+
+def _raise_bad_index(tokens: Tokens, path, token) -> None:
+    raise MeshError(path, tokens.line_of_token(token), f"bad index {tokens.text(token)!r} (indices start at 1)")
+
+
+def _uniform_faces(tokens: Tokens, path, kind, face_lines, start, end, layout):
+    """Faces whose lines are all laid out like the first: ``start``/``end`` (F, T)
+    offsets of their tokens, ``layout`` (T,) of the first line. The index block
+    parses as one (F, T) matrix; a slot's columns are its corners."""
+    n_faces, width = start.shape
+
+    def token_at(flat):
+        return tokens.first[face_lines[flat // width]] + 1 + flat % width
+
+    values, bad = parse_ints(tokens.buf, start, end)
+    if len(bad):
+        _raise_bad_index(tokens, path, token_at(int(bad[0])))
+    slot, malformed = _corner_slots(layout, np.arange(len(layout)) == 0)
+    if malformed.any():
+        token = token_at(int(np.argmax(malformed)))
+        raise MeshError(path, tokens.line_of_token(token), f"malformed face corner near {tokens.text(token)!r}")
+    corner = np.cumsum(slot == 0) - 1
+    size = int(corner[-1]) + 1
+    if size < 3:
+        raise MeshError(path, tokens.number[face_lines[0]], f"face with {size} corners (at least 3 needed)")
+    forms = np.zeros(size, dtype=np.int8)  # 0: v, 1: v/vt, 2: v//vn, 3: v/vt/vn
+    for which in (1, 2):
+        forms[corner[slot == which]] += which
+    if forms.min() != forms.max():
+        raise MeshError(path, tokens.number[face_lines[0]], "face corners mix the forms v, v/vt, v//vn, v/vt/vn")
+
+    corners, relative, bounds = [None] * 3, [None] * 3, [None] * 3
+    for which in range(3):
+        columns = np.flatnonzero(slot == which)
+        if len(columns) == 0:
+            continue
+        step = int(columns[1] - columns[0]) if len(columns) > 1 else 1
+        if (columns == columns[0] + step * np.arange(len(columns))).all():  # a strided view
+            picked = values[:, columns[0] :: step][:, : len(columns)] - 1
+        else:
+            picked = values[:, columns] - 1
+        picked = picked.reshape(-1)
+        low, high = int(picked.min()), int(picked.max())
+        if low < 0:  # zero (an error) or counted back from the line (relative)
+            zero = np.flatnonzero(values.reshape(-1) == 0)
+            if len(zero):
+                _raise_bad_index(tokens, path, token_at(int(zero[0])))
+            back = np.flatnonzero(picked < 0)
+            line = face_lines[back // size]
+            picked[back] += 1 + np.cumsum(kind == _ELEMENT_OF_SLOT[which])[line]
+            rest = np.ones(len(picked), dtype=bool)
+            rest[back] = False
+            relative[which] = back
+            low, high = (int(picked[rest].min()), int(picked[rest].max())) if rest.any() else (0, -1)
+        corners[which], bounds[which] = picked, (low, high)
+    return size, corners, relative, bounds, _slash_count(layout) * n_faces
+
+
+def _mixed_faces(tokens: Tokens, path, kind, face_lines):
+    """Face lines of differing widths or layouts, token by token."""
     buf = tokens.buf
     width, index = _line_tokens(tokens, face_lines)
-    if len(face_lines) == 0:
-        empty = np.zeros(0, np.int64)
-        return empty, [empty] * 3, [empty] * 3
     start, end = tokens.starts[index], tokens.ends[index]
     layout = _face_layout(buf, start, end, tokens.ends[index - 1])
     values, bad = parse_ints(buf, start, end)
     if len(bad) or not values.all():
         token = index[np.concatenate([bad, np.flatnonzero(values == 0)]).min()]
-        raise MeshError(path, tokens.line_of_token(token), f"bad index {tokens.text(token)!r} (indices start at 1)")
-    uniform = width[0] > 0 and (width == width[0]).all() and (layout.reshape(-1, width[0]) == layout[: width[0]]).all()
-    if uniform:  # every line is laid out like the first: work out the first line only
-        width, layout = width[:1], layout[: width[0]]
+        _raise_bad_index(tokens, path, token)
     line_start = np.zeros(len(layout), dtype=bool)
     token_offsets = np.concatenate(([0], np.cumsum(width)))
     line_start[token_offsets[:-1][width > 0]] = True
@@ -232,27 +392,25 @@ def _faces(tokens: Tokens, path, kind, face_lines):
     if mixed.any():
         line = face_lines[np.argmax(mixed)]
         raise MeshError(path, tokens.number[line], "face corners mix the forms v, v/vt, v//vn, v/vt/vn")
-    if uniform:
-        values = values.reshape(len(face_lines), -1)
-        sizes = np.repeat(sizes, len(face_lines))
 
-    corners, relative = [], []
-    for which, element in enumerate((_V, _VT, _VN)):
+    corners, relative, bounds = [None] * 3, [None] * 3, [None] * 3
+    for which, element in enumerate(_ELEMENT_OF_SLOT):
         own = slot == which
-        if uniform:  # (F, T) values: the slot's columns land in their corners' columns
-            picked = np.full((len(face_lines), len(form)), -1, dtype=np.int64)
-            picked[:, corner[own]] = values[:, own] - 1
-            picked = picked.ravel()
-        else:
-            picked = np.full(len(form), -1, dtype=np.int64)
-            picked[corner[own]] = values[own] - 1
+        if not own.any():
+            continue
+        picked = np.full(len(form), -1, dtype=np.int64)
+        picked[corner[own]] = values[own] - 1
         back = np.flatnonzero(picked < -1)
         if len(back):  # relative index: count the elements defined above the line
             line = face_lines[np.repeat(np.arange(len(sizes)), sizes)[back]]
             picked[back] += 1 + np.cumsum(kind == element)[line]
-        corners.append(picked)
-        relative.append(back)
-    return sizes, corners, relative
+            relative[which] = back
+        absolute = np.ones(len(picked), dtype=bool)
+        absolute[back] = False
+        rest = picked[absolute]
+        corners[which] = picked
+        bounds[which] = (int(rest.min()), int(rest.max())) if len(rest) else (0, -1)
+    return sizes, corners, relative, bounds, _slash_count(layout)
 
 
 def _statement(tokens: Tokens, path, line, faces_before, part: _Part) -> None:
@@ -273,61 +431,218 @@ def _statement(tokens: Tokens, path, line, faces_before, part: _Part) -> None:
         part.mtllibs.append(name)
 
 
-def _assemble(path, parts: list[_Part]) -> Mesh:
-    elements = {k: _stack([p.elements[k] for p in parts]) for k in _WIDTHS}
-    sizes = np.concatenate([np.zeros(0, np.int64)] + [p.face_sizes for p in parts])
-    if len(elements[_V]) == 0 and len(sizes) == 0:
-        raise MeshError(path, 0, "empty file (no vertices or faces)")
-    face_start = np.concatenate(([0], np.cumsum(sizes)))
-    face_line = np.concatenate([np.zeros(0, np.int64)] + [p.face_line for p in parts])
-    corner_offset = face_start[np.cumsum([0] + [len(p.face_sizes) for p in parts])]
-    corners = []
-    for which, (element, name) in enumerate(zip((_V, _VT, _VN), ("vertex", "texture coordinate", "normal"))):
-        element_offset = np.cumsum([0] + [len(p.elements[element]) for p in parts])
-        index = np.concatenate([np.zeros(0, np.int64)] + [p.corners[which] for p in parts])
-        back = np.concatenate([np.zeros(0, np.int64)] + [p.relative[which] + c for p, c in zip(parts, corner_offset)])
-        index[back] += np.repeat(element_offset[:-1], [len(p.relative[which]) for p in parts])
-        index[back[index[back] < 0]] = -2  # counted back past the first element
-        check_indices(path, index, len(elements[element]), face_start, face_line, name, absent=-1)
-        corners.append(index)
+class _Progress:
+    """How far the assembly is through the file: bytes before and after the chunk being added."""
 
-    vertices, texcoords, normals = elements[_V], elements[_VT], elements[_VN]
-    events = [
-        (face + offset, key, name)
-        for part, offset in zip(parts, np.cumsum([0] + [len(p.face_sizes) for p in parts]))
-        for face, key, name in part.events
-    ]
-    group_names, face_group = _groups(events, len(sizes))
-    material_names, face_material = _materials(events, len(sizes))
-    folder = os.path.dirname(os.fspath(path))
-    textures: dict[str, str] = {}
-    for library in (name for p in parts for name in p.mtllibs):
-        for material, texture in read_material_textures(os.path.join(folder, library)).items():
-            textures.setdefault(material, texture)
-    return Mesh(
-        path=os.fspath(path),
-        positions=np.ascontiguousarray(vertices[:, :3]),
-        face_start=face_start,
-        corner_vertex=corners[0],
-        face_line=face_line,
-        texcoords=_texcoords(texcoords) if len(texcoords) else None,
-        corner_texcoord=corners[1] if len(texcoords) else None,
-        normals=normals if len(normals) else None,
-        corner_normal=corners[2] if len(normals) else None,
-        colors=np.nan_to_num(vertices[:, 3:6], nan=1.0) if vertices.shape[1] >= 6 else None,
-        group_names=group_names,
-        face_group=face_group,
-        material_names=material_names,
-        face_material=face_material,
-        material_textures=textures,
-    )
+    def __init__(self, total: int):
+        self.total = total
+        self.before = 0
+        self.after = 0
 
 
-def _stack(blocks: list[np.ndarray]) -> np.ndarray:
-    """Stack (n_i, w_i) blocks into (sum n_i, max w_i), NaN-padding narrower ones."""
-    width = max([b.shape[1] for b in blocks], default=3)
-    padded = [np.pad(b, ((0, 0), (0, width - b.shape[1])), constant_values=np.nan) if b.shape[1] < width else b for b in blocks]
-    return np.concatenate([np.zeros((0, width))] + padded)
+class _Growing:
+    """An array filled block by block along its first axis.
+
+    When full, the capacity grows to a quarter more than the rows expected by
+    the end of the file (extrapolated from the rows per byte since the first
+    block), so a file of one kind of content after the other costs one or two
+    copies; :meth:`array` is a view of the filled rows, and the capacity beyond
+    them is never written, so it stays virtual memory. Rows may widen
+    (``v`` lines gaining colours): narrower rows are NaN-padded.
+    """
+
+    def __init__(self, dtype, progress: _Progress, width: int | None = None):
+        self.dtype = dtype
+        self.progress = progress
+        self.width = width
+        self.size = 0
+        self.first_byte = None  # file offset of the chunk that brought the first rows
+        self.data = np.empty((0,) if width is None else (0, width), dtype)
+
+    def __len__(self) -> int:
+        return self.size
+
+    def _capacity(self, needed: int) -> int:
+        progress = self.progress
+        if self.first_byte is None:
+            self.first_byte = progress.before
+        rate = needed / max(progress.after - self.first_byte, 1)
+        expected = needed + rate * max(progress.total - progress.after, 0)
+        return int(max(needed, 1.25 * expected, 1 << 12))
+
+    def _reserve(self, rows: int, width: int | None) -> None:
+        needed = self.size + rows
+        wider = width is not None and width > self.width
+        if needed <= len(self.data) and not wider:
+            return
+        capacity = self._capacity(needed) if needed > len(self.data) else len(self.data)
+        if width is None:
+            data = np.empty(capacity, self.dtype)
+            data[: self.size] = self.data[: self.size]
+        else:
+            self.width = max(width, self.width)
+            data = np.empty((capacity, self.width), self.dtype)
+            data[: self.size, : self.data.shape[1]] = self.data[: self.size]
+            data[: self.size, self.data.shape[1] :] = np.nan
+        self.data = data
+
+    def append(self, block: np.ndarray) -> None:
+        width = None if self.width is None else block.shape[1]
+        self._reserve(len(block), width)
+        end = self.size + len(block)
+        if width is None or width == self.width:
+            self.data[self.size : end] = block
+        else:
+            self.data[self.size : end, :width] = block
+            self.data[self.size : end, width:] = np.nan
+        self.size = end
+
+    def fill(self, rows: int, value) -> None:
+        self._reserve(rows, None)
+        self.data[self.size : self.size + rows] = value
+        self.size += rows
+
+    def array(self) -> np.ndarray:
+        return self.data[: self.size]
+
+
+class _Assembly:
+    """The mesh's arrays, grown chunk by chunk in file order (see :func:`load_obj`)."""
+
+    def __init__(self, total_bytes: int):
+        self.progress = _Progress(total_bytes)
+        self.elements = {k: self._growing(np.float64, width=0) for k in _WIDTHS}
+        self.face_line = self._growing(np.int64)
+        self.sizes = self._growing(np.int64)  # filled only once faces of differing sizes appear
+        self.uniform_size = None  # the one face size while there is only one
+        self.n_faces = 0
+        self.n_corners = 0
+        self.n_lines = 0  # lines of the chunks added so far
+        self.corners = [None, None, None]  # slot -> _Growing, once a chunk has the slot
+        self.bounds = [(0, -1)] * 3
+        self.events = []
+        self.mtllibs = []
+
+    def _growing(self, dtype, width=None) -> _Growing:
+        return _Growing(dtype, self.progress, width)
+
+    def result(self, future) -> _Part:
+        """The part a worker parsed, its line numbers made absolute (the chunk's
+        own count from 1: only here is the number of lines before it known)."""
+        try:
+            part = future.result()
+        except MeshError as error:
+            raise MeshError(error.path, error.line + self.n_lines * (error.line > 0), error.reason) from None
+        part.face_line += self.n_lines
+        return part
+
+    def add(self, part: _Part) -> None:
+        self.progress.before = self.progress.after
+        self.progress.after += part.bytes
+        self.n_lines += part.lines
+        before = {k: len(self.elements[k]) for k in _WIDTHS}
+        for k in _WIDTHS:
+            self.elements[k].append(part.elements[k])
+        n_faces = len(part.face_line)
+        if n_faces == 0:
+            self.mtllibs += part.mtllibs
+            self.events += [(face + self.n_faces, key, name) for face, key, name in part.events]
+            return
+        n_corners = self._add_sizes(part.face_sizes, n_faces)
+        for which in range(3):
+            index = part.corners[which]
+            if index is None:
+                if self.corners[which] is not None:
+                    self.corners[which].fill(n_corners, -1)
+                    self.bounds[which] = (min(self.bounds[which][0], -1), self.bounds[which][1])
+                continue
+            if self.corners[which] is None:
+                self.corners[which] = self._growing(np.int64)
+                self.corners[which].fill(self.n_corners, -1)
+                if self.n_corners:
+                    self.bounds[which] = (-1, -1)
+            low, high = part.bounds[which]
+            back = part.relative[which]
+            if back is not None and len(back):
+                index[back] += before[_ELEMENT_OF_SLOT[which]]
+                index[back[index[back] < 0]] = -2  # counted back past the first element
+                low, high = min(low, int(index[back].min())), max(high, int(index[back].max()))
+            self.corners[which].append(index)
+            self.bounds[which] = (min(self.bounds[which][0], low), max(self.bounds[which][1], high))
+        self.face_line.append(part.face_line)
+        self.events += [(face + self.n_faces, key, name) for face, key, name in part.events]
+        self.mtllibs += part.mtllibs
+        self.n_faces += n_faces
+        self.n_corners += n_corners
+
+    def _add_sizes(self, sizes, n_faces: int) -> int:
+        """Record the chunk's face sizes; return its number of corners."""
+        if isinstance(sizes, int) and self.uniform_size in (None, sizes):
+            self.uniform_size = sizes
+            return sizes * n_faces
+        if self.uniform_size is not None:  # the first face of another size: spell the sizes out
+            self.sizes.fill(self.n_faces, self.uniform_size)
+            self.uniform_size = None
+        if isinstance(sizes, int):
+            self.sizes.fill(n_faces, sizes)
+            return sizes * n_faces
+        self.sizes.append(sizes)
+        return int(sizes.sum())
+
+    def face_start(self) -> np.ndarray:
+        if self.uniform_size is not None or self.n_faces == 0:
+            size = self.uniform_size or 0
+            return np.arange(0, size * self.n_faces + 1, max(size, 1))[: self.n_faces + 1]
+        face_start = np.empty(self.n_faces + 1, dtype=np.int64)
+        face_start[0] = 0
+        np.cumsum(self.sizes.array(), out=face_start[1:])
+        return face_start
+
+    def mesh(self, path) -> Mesh:
+        elements = {k: self.elements[k].array() for k in _WIDTHS}
+        elements = {k: v if v.shape[1] else v.reshape(0, _WIDTHS[k][0]) for k, v in elements.items()}
+        if len(elements[_V]) == 0 and self.n_faces == 0:
+            raise MeshError(path, 0, "empty file (no vertices or faces)")
+        face_start = self.face_start()
+        face_line = self.face_line.array()
+        corners = []
+        for which, name in enumerate(_SLOT_NAMES):
+            total = len(elements[_ELEMENT_OF_SLOT[which]])
+            grown = self.corners[which]
+            if grown is None:  # no face names this slot: every corner lacks it
+                corners.append(np.full(self.n_corners, -1, dtype=np.int64) if total or which == 0 else None)
+                continue
+            index = grown.array()
+            low, high = self.bounds[which]
+            if low < -1 or high >= total:
+                check_indices(path, index, total, face_start, face_line, name, absent=-1)
+            corners.append(index)
+
+        vertices, texcoords, normals = elements[_V], elements[_VT], elements[_VN]
+        group_names, face_group = _groups(self.events, self.n_faces)
+        material_names, face_material = _materials(self.events, self.n_faces)
+        folder = os.path.dirname(os.fspath(path))
+        textures: dict[str, str] = {}
+        for library in self.mtllibs:
+            for material, texture in read_material_textures(os.path.join(folder, library)).items():
+                textures.setdefault(material, texture)
+        return Mesh(
+            path=os.fspath(path),
+            positions=vertices if vertices.shape[1] == 3 else np.ascontiguousarray(vertices[:, :3]),
+            face_start=face_start,
+            corner_vertex=corners[0],
+            face_line=face_line,
+            texcoords=_texcoords(texcoords) if len(texcoords) else None,
+            corner_texcoord=corners[1] if len(texcoords) else None,
+            normals=normals if len(normals) else None,
+            corner_normal=corners[2] if len(normals) else None,
+            colors=np.nan_to_num(vertices[:, 3:6], nan=1.0) if vertices.shape[1] >= 6 else None,
+            group_names=group_names,
+            face_group=face_group,
+            material_names=material_names,
+            face_material=face_material,
+            material_textures=textures,
+        )
 
 
 def _texcoords(vt: np.ndarray) -> np.ndarray:

@@ -27,7 +27,8 @@ class Chunk:
     """Whole lines of a text file.
 
     buf : (n,) uint8
-        :data:`PAD` spaces, then the lines, the last one ending with '\\n'.
+        :data:`PAD` spaces, the lines (the last one ending with '\\n'), then
+        :data:`PAD` spaces more, so that words read around any token stay inside.
     first_line : int
         1-based number of the chunk's first line.
     joined : (j,) int64
@@ -38,22 +39,34 @@ class Chunk:
     first_line: int
     joined: np.ndarray
 
+    def find(self, byte: bytes) -> int:
+        """Offset of the first ``byte`` in ``buf`` (-1: none), at C speed."""
+        base = self.buf.base
+        if isinstance(base, bytearray):
+            return base.find(byte, 0, len(self.buf))
+        hits = np.flatnonzero(self.buf == byte[0])
+        return int(hits[0]) if len(hits) else -1
 
-def read_chunks(fh, first_line: int = 1, continuations: bool = False, size: int = CHUNK_BYTES):
+
+def read_chunks(fh, first_line: int = 1, continuations: bool = False, size: int = CHUNK_BYTES, count_lines: bool = True):
     """Yield :class:`Chunk` s of whole lines from the binary file object ``fh``.
 
     With ``continuations`` a '\\' right before a line break joins the two lines
     (the backslash and the break become spaces, so byte offsets and line
     numbers still point into the file). The last line gets a '\\n' if it lacks one.
+    Without ``count_lines`` every chunk's lines count from ``first_line`` (the
+    caller adds the lines of the chunks before; counting them here would cost
+    a pass over every chunk on the reading thread).
     """
     carry = b""
     line = first_line
     while True:
-        buf = bytearray(PAD + len(carry) + size)
+        head = PAD + len(carry)
+        buf = bytearray(head + size + PAD)
         buf[:PAD] = b" " * PAD
-        buf[PAD : PAD + len(carry)] = carry
-        end = PAD + len(carry) + fh.readinto(memoryview(buf)[PAD + len(carry) :])
-        if end == PAD + len(carry):  # end of file
+        buf[PAD:head] = carry
+        end = head + fh.readinto(memoryview(buf)[head : head + size])
+        if end == head:  # end of file
             if not carry:
                 return
             buf[end : end + 1] = b"\n"
@@ -64,10 +77,14 @@ def read_chunks(fh, first_line: int = 1, continuations: bool = False, size: int 
                 carry = bytes(buf[PAD:end])
                 continue
         carry = bytes(buf[cut:end])
-        array = np.frombuffer(buf, dtype=np.uint8, count=cut)
-        joined = _join_continuations(array) if continuations and buf.find(b"\\", PAD, cut) >= 0 else np.zeros(0, np.int64)
+        buf[cut : cut + PAD] = b" " * PAD
+        array = np.frombuffer(buf, dtype=np.uint8, count=cut + PAD)
+        joined = np.zeros(0, np.int64)
+        if continuations and buf.find(b"\\", PAD, cut) >= 0:
+            joined = _join_continuations(array, cut - 1)
         yield Chunk(array, line, joined)
-        line += buf.count(b"\n", PAD, cut) + len(joined)
+        if count_lines:
+            line += buf.count(b"\n", PAD, cut) + len(joined)
 
 
 def _last_line_break(buf: bytearray, end: int, continuations: bool) -> int:
@@ -84,17 +101,17 @@ def _continued(buf: bytearray, newline: int) -> bool:
     return before >= PAD and buf[before] == _BACKSLASH
 
 
-def _join_continuations(buf: np.ndarray) -> np.ndarray:
+def _join_continuations(buf: np.ndarray, last: int) -> np.ndarray:
     """Blank out '\\' + line break in place; return the removed newlines' offsets.
 
-    A '\\' before the chunk's last line break (the end of the file) joins
-    nothing: it is blanked and the break kept.
+    ``last`` is the offset of the chunk's last line break: a '\\' before it
+    (the end of the file) joins nothing: it is blanked and the break kept.
     """
-    slash = np.flatnonzero(buf[:-1] == _BACKSLASH)
-    crlf = (buf[slash + 1] == _CR) & (buf[np.minimum(slash + 2, len(buf) - 1)] == _NEWLINE)
+    slash = np.flatnonzero(buf[:last] == _BACKSLASH)
+    crlf = (buf[slash + 1] == _CR) & (buf[np.minimum(slash + 2, last)] == _NEWLINE)
     newline = np.where(crlf, slash + 2, slash + 1)
     hit = buf[newline] == _NEWLINE
-    joined = hit & (newline < len(buf) - 1)
+    joined = hit & (newline < last)
     for offset in (0, 1, 2):
         blank = slash[hit & (offset <= newline - slash - (~joined))] + offset
         buf[blank] = ord(" ")
@@ -125,6 +142,8 @@ class Tokens(_Ragged):
         1-based line number in the file of every line.
     begin, end : (L,) int64
         Byte offsets of every line's first byte and of its '\\n'.
+    slashes : int
+        Number of '/' bytes in the chunk (counted when they separate tokens, else 0).
     """
 
     buf: np.ndarray
@@ -134,6 +153,7 @@ class Tokens(_Ragged):
     number: np.ndarray
     begin: np.ndarray
     end: np.ndarray
+    slashes: int = 0
 
     def line_of_byte(self, offset) -> int:
         return int(self.number[np.searchsorted(self.end, offset)])
@@ -153,29 +173,47 @@ def tokenize(chunk: Chunk, path, slash: bool = False) -> Tokens:
     the file is not text: :class:`MeshError` naming their line.
     """
     buf = chunk.buf
-    end = np.flatnonzero(buf == _NEWLINE)
-    begin = np.concatenate(([PAD], end[:-1] + 1))
-    number = chunk.first_line + np.arange(len(end))
+    low = np.flatnonzero(buf < 32)  # the line breaks, and any other control byte
+    end = low if (buf[low] == _NEWLINE).all() else low[buf[low] == _NEWLINE]
+    begin = np.empty_like(end)
+    begin[:1] = PAD
+    np.add(end[:-1], 1, out=begin[1:])
+    number = np.arange(chunk.first_line, chunk.first_line + len(end))
     if len(chunk.joined):
         number += np.searchsorted(chunk.joined, begin)
     separator = buf <= 32
+    slashes = 0
     if slash:
-        separator |= buf == _SLASH
-    edges = np.flatnonzero(separator[1:] != separator[:-1]) + 1
+        is_slash = buf == _SLASH
+        slashes = int(np.count_nonzero(is_slash))
+        separator |= is_slash
+    # Token edges alternate start, end: the buffer starts and ends with spaces.
+    edges = np.flatnonzero(separator[1:] != separator[:-1])
+    edges += 1
     starts, ends = edges[0::2], edges[1::2]
-    tokens = Tokens(buf, starts, ends, np.zeros(0, np.int64), number, begin, end)
-    _reject_control_bytes(tokens, path)
-    if _HASH in buf:
+    tokens = Tokens(buf, starts, ends, np.zeros(0, np.int64), number, begin, end, slashes)
+    if len(low) != len(end) or chunk.find(b"\x7f") >= 0:
+        _reject_control_bytes(tokens, low, path)
+    first = np.empty(len(begin) + 1, dtype=np.int64)
+    if chunk.find(b"#") >= 0:
         tokens.starts, tokens.ends = _drop_comments(buf, starts, ends, end)
-    tokens.first = np.append(np.searchsorted(tokens.starts, begin), len(tokens.starts))
+        first[:-1] = np.searchsorted(tokens.starts, begin)
+    else:  # no token spans a line break: 2 * (tokens before a line) edges precede it
+        np.right_shift(np.searchsorted(edges, begin), 1, out=first[:-1])
+    first[-1] = len(tokens.starts)
+    tokens.first = first
     return tokens
 
 
-def _reject_control_bytes(tokens: Tokens, path) -> None:
-    text = tokens.buf[PAD:]
-    control = ((text < 32) & (text - np.uint8(9) > 4)) | (text == 127)
-    if control.any():
-        offset = PAD + int(np.argmax(control))
+def _reject_control_bytes(tokens: Tokens, low: np.ndarray, path) -> None:
+    """MeshError at the first byte below 32 (offsets ``low``) other than tab, line
+    feed, vertical tab, form feed and carriage return, or DEL (127)."""
+    text = tokens.buf
+    control = low[text[low] - np.uint8(9) > 4]
+    delete = np.flatnonzero(text == 127)
+    offsets = np.concatenate([control[:1], delete[:1]])
+    if len(offsets):
+        offset = int(offsets.min())
         byte = int(tokens.buf[offset])
         raise MeshError(path, tokens.line_of_byte(offset), f"binary data (byte 0x{byte:02x}): not a text mesh")
 

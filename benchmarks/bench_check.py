@@ -1,0 +1,151 @@
+"""``affinity check`` end to end against ``pyvista.read`` (and trimesh) on one big OBJ.
+
+The goal of issue 3: ``affinity check`` on a 1,000,000-quad OBJ with uv and
+normals (about 166 MB), as a user runs it (interpreter start, imports, load,
+every lint rule, JSON output), takes no longer than ``pyvista.read`` alone, with
+a peak resident memory under 1 GiB.
+
+Every case runs in a fresh process. The cases take turns, round after round,
+so that whatever else the machine is doing weighs on all of them alike; for
+each the fastest and the median round are reported, with the CPU time (user +
+system) and peak memory of that process. One more child times the phases of
+``affinity check`` inside one process (load, lint, output, best of the rounds).
+The load average before and after tells how quiet the machine was.
+
+    python benchmarks/bench_check.py                     # 1M quads in a temp dir, 5 rounds
+    python benchmarks/bench_check.py --path /tmp/grid.obj --rounds 9 --trimesh
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import os
+import platform
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+from bench_load import write_grid_obj
+
+#: name -> (module that must be importable, Python statement run in the child)
+READERS = {
+    "pyvista.read": ("pyvista", "import pyvista, sys; pyvista.read(sys.argv[1])"),
+    "trimesh.load(process=False)": ("trimesh", "import trimesh, sys; trimesh.load(sys.argv[1], process=False)"),
+}
+
+#: The phases of ``affinity check`` in one process, as ``affinity.check.check_file`` and
+#: the JSON writer run them; prints seconds (wall, CPU) per phase.
+PHASES = """
+import io, sys, time
+from affinity.allocator import keep_freed_memory
+keep_freed_memory()
+from affinity.check import check_file
+from affinity.lint import lint_mesh
+from affinity.loaders import load
+from affinity.output import CheckRun
+from affinity.output.json import write
+from affinity.settings import Settings
+
+def timed(step):
+    wall, cpu = time.perf_counter(), time.process_time()
+    result = step()
+    return result, time.perf_counter() - wall, time.process_time() - cpu
+
+settings = Settings()
+mesh, *load_times = timed(lambda: load(sys.argv[1]))
+_, *lint_times = timed(lambda: lint_mesh(mesh, settings))
+del mesh
+report = check_file(sys.argv[1], settings)
+_, *output_times = timed(lambda: write(CheckRun([report], settings), io.StringIO()))
+print(*load_times, *lint_times, *output_times)
+"""
+
+
+def machine() -> str:
+    """CPU model, CPUs this process may use, NumPy version."""
+    model = platform.processor() or platform.machine()
+    try:
+        with open("/proc/cpuinfo") as fh:
+            model = next(line.split(":", 1)[1].strip() for line in fh if line.startswith("model name"))
+    except (OSError, StopIteration):
+        pass
+    cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    import numpy
+
+    return f"{model}, {cpus} CPUs, Python {platform.python_version()}, NumPy {numpy.__version__}"
+
+
+def run(command: list[str]) -> tuple[float, float, float, str, int]:
+    """Run a child; return (wall s, CPU s = user + system, peak RSS MiB, stdout, exit code)."""
+    start = time.perf_counter()
+    child = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    out = child.stdout.read()
+    _, status, usage = os.wait4(child.pid, 0)
+    wall = time.perf_counter() - start
+    return wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024, out, os.waitstatus_to_exitcode(status)
+
+
+def check_command() -> list[str] | None:
+    script = shutil.which("affinity", path=os.path.dirname(sys.executable)) or shutil.which("affinity")
+    if script is None and importlib.util.find_spec("affinity.cli") is None:
+        return None
+    return [script] if script else [sys.executable, "-m", "affinity.cli"]
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quads", type=int, default=1_000_000, help="quads in the generated OBJ (default 1,000,000)")
+    parser.add_argument("--path", help="OBJ to use; generated there when missing (default: a temp file)")
+    parser.add_argument("--rounds", type=int, default=5, help="runs of every case, taking turns (default 5)")
+    parser.add_argument("--trimesh", action="store_true", help="also time trimesh.load (slow: about 10 s a run)")
+    args = parser.parse_args(argv)
+
+    with tempfile.TemporaryDirectory() as folder:
+        path = args.path or os.path.join(folder, f"grid_{args.quads}.obj")
+        if not os.path.exists(path):
+            write_grid_obj(path, args.quads)
+        cases = {}
+        command = check_command()
+        if command is not None:
+            cases["affinity check --format json"] = command + ["check", path, "--format", "json"]
+        for name, (module, statement) in READERS.items():
+            if importlib.util.find_spec(module) is not None and (args.trimesh or module != "trimesh"):
+                cases[name] = [sys.executable, "-c", statement, path]
+
+        print(f"{machine()}")
+        print(f"{os.path.getsize(path) / 1e6:.0f} MB OBJ, {args.quads:,} quads with vt and vn; {args.rounds} rounds")
+        print(f"load average before: {' '.join(f'{x:.2f}' for x in os.getloadavg())}\n")
+        results = {name: [] for name in cases}
+        phases = []
+        for _ in range(args.rounds):
+            for name, argv_ in cases.items():
+                wall, cpu, peak, _, code = run(argv_)
+                results[name].append((wall, cpu, peak, code))
+            if command is not None:
+                _, _, _, out, code = run([sys.executable, "-c", PHASES, path])
+                if code == 0:
+                    phases.append([float(x) for x in out.split()])
+
+        print("| case | best s | median s | CPU s (best run) | peak RSS MiB |")
+        print("|---|---:|---:|---:|---:|")
+        for name, rows in results.items():
+            ok = [r for r in rows if r[3] in (0, 1)]  # check: 0 clean, 1 findings
+            if not ok:
+                print(f"| {name} | failed (exit {rows[0][3]}) | | | |")
+                continue
+            best = min(ok)
+            median = statistics.median(r[0] for r in ok)
+            print(f"| {name} | {best[0]:.2f} | {median:.2f} | {best[1]:.2f} | {max(r[2] for r in ok):.0f} |")
+        if phases:
+            best = [min(p[i] for p in phases) for i in range(6)]
+            print("\nInside one `affinity check` process (best of the rounds; wall s / CPU s):")
+            print(f"load {best[0]:.2f} / {best[1]:.2f}, lint {best[2]:.2f} / {best[3]:.2f}, JSON output {best[4]:.3f} / {best[5]:.3f}")
+        print(f"\nload average after: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
+
+
+if __name__ == "__main__":
+    main()
