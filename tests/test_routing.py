@@ -29,7 +29,7 @@ def test_screen_area_of_a_centred_square():
 
 def test_error_is_misplacement_times_pixels_per_uv_unit():
     # 100 x 100 pixel square showing the unit uv square: 100 px per uv unit.
-    error = split_error_pixels(np.array([0.01]), UNIT_UV, square_clip(0.5), 200, 200)
+    error = split_error_pixels(np.array([0.01]), UNIT_UV, screen_area(square_clip(0.5), 200, 200))
     np.testing.assert_allclose(error, [1.0])
     np.testing.assert_allclose(attribute_area(UNIT_UV * 2), [4.0])
 
@@ -52,3 +52,12 @@ def test_affine_quads_stay_split_even_across_the_eye_plane():
     clip[0, 0, 3] = -0.5
     assert route_by_view(np.array([0.0]), UNIT_UV, clip, 64, 64)[0] == "split"
     assert route_by_view(np.array([1e-6]), UNIT_UV, clip, 64, 64)[0] == "mvc"
+
+
+def test_screen_area_equals_the_shoelace_sum_on_any_quad():
+    rng = np.random.default_rng(7)
+    clip = rng.normal(size=(200, 4, 4))
+    clip[..., 3] = rng.uniform(0.5, 2.0, size=(200, 4))  # in front of the eye; convex, concave and bow-ties
+    x, y = clip[..., 0] / clip[..., 3] * 32.0, clip[..., 1] / clip[..., 3] * 24.0
+    shoelace = 0.5 * (x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y).sum(axis=1)
+    np.testing.assert_allclose(screen_area(clip, 64, 48), shoelace, rtol=1e-10, atol=1e-10)
