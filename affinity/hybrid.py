@@ -66,8 +66,10 @@ class RenderResult:
 
     def summary(self) -> str:
         """One line: where the quads went and how long the render took."""
+        if self.method != "hybrid":
+            return f"{self.mesh.path}: {self.method}: all {len(self.methods)} quads ({self.seconds:.2f} s)"
         mvc = int(np.count_nonzero(self.methods == MVC))
-        return (f"{self.mesh.path}: {self.method}: {mvc} of {len(self.methods)} quads to mvc, "
+        return (f"{self.mesh.path}: hybrid: {mvc} of {len(self.methods)} quads to mvc, "
                 f"{len(self.methods) - mvc} to split ({self.seconds:.2f} s)")
 
     def save_png(self, path: str) -> None:

@@ -12,7 +12,7 @@ import sys
 from ..check import UsageError
 from . import EXIT_CLEAN
 
-METHODS = ("hybrid", "split", "mvc", "bilinear")
+METHODS = ("hybrid", "split", "mvc", "bilinear", "projective", "exact")
 
 
 def _size(text: str) -> tuple[int, int]:
