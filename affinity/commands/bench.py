@@ -12,7 +12,7 @@ from __future__ import annotations
 import sys
 
 from ..check import UsageError
-from . import EXIT_CLEAN
+from . import EXIT_CLEAN, require
 from .render import _size as image_size
 
 
@@ -46,6 +46,8 @@ def _command_line(args) -> str:
 
 def run(args) -> int:
     import dataclasses
+
+    require(("PIL", "matplotlib"), "report")
 
     from ..study.cases import builtin_cases, mesh_cases, shared_mesh_paths
     from ..study.run import run_cases, write_outputs

@@ -10,7 +10,7 @@ import argparse
 import sys
 
 from ..check import UsageError
-from . import EXIT_CLEAN
+from . import EXIT_CLEAN, require
 
 METHODS = ("hybrid", "split", "mvc", "bilinear", "projective", "exact")
 
@@ -61,6 +61,7 @@ def add_parser(sub) -> None:
 
 
 def run(args) -> int:
+    require(("PIL",), "render")
     from ..hybrid import RenderOptions, render_mesh
     from ..mesh import MeshError
     from ..texture import TextureError

@@ -13,7 +13,7 @@ import os
 import sys
 
 from ..check import UsageError
-from . import EXIT_CLEAN, EXIT_ERROR
+from . import EXIT_CLEAN, EXIT_ERROR, require
 
 
 def add_parser(sub) -> None:
@@ -65,15 +65,6 @@ def _write(path: str, html: str) -> None:
         raise UsageError(f"{path}: cannot write the report ({err.strerror or err})") from None
 
 
-def _check_report_extra() -> None:
-    """The report's libraries are the ``report`` extra; say how to get them rather than fail on an import."""
-    import importlib.util
-
-    missing = [name for name in ("PIL", "jinja2", "matplotlib") if importlib.util.find_spec(name) is None]
-    if missing:
-        raise UsageError(f"needs {', '.join(missing)}, the report extra: pip install 'quad-affinity[report]'")
-
-
 def run(args) -> int:
     from tqdm import tqdm
 
@@ -81,7 +72,7 @@ def run(args) -> int:
     from ..report.build import collect_run
     from ..report.page import render_page
 
-    _check_report_extra()
+    require(("PIL", "jinja2", "matplotlib", "mpmath"), "report")
     _check_writable(args.output)
     resolver = Resolver({})
     inputs = _inputs(args.meshes, resolver)

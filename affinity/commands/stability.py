@@ -12,7 +12,7 @@ import time
 from pathlib import Path
 
 from ..check import UsageError
-from . import EXIT_CLEAN, EXIT_FINDINGS
+from . import EXIT_CLEAN, EXIT_FINDINGS, require
 
 DEFAULT_DIR = "reports/stability"
 CSV_NAME, MARKDOWN_NAME = "stability.csv", "stability.md"
@@ -32,6 +32,7 @@ def add_parser(sub) -> None:
 
 
 def run(args) -> int:
+    require(("mpmath",), "stability")
     from ..atomic import atomic_write
     from ..stability import table
     from ..stability.run import PRECISIONS
