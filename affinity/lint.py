@@ -193,7 +193,7 @@ def _normal_disaffinity(quads: _QuadBatch) -> tuple:
     # |m| > tan(threshold) |mean normal|: the arctangent is taken for those only.
     threshold = quads.settings.threshold("Q103")
     picked = slice(None)
-    if threshold < 89:
+    if 0 <= threshold < 89:  # a negative threshold (every value wanted) picks every quad
         m_length = np.sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2])
         mean = unit.sum(axis=1)
         mean_length = np.sqrt(mean[0] * mean[0] + mean[1] * mean[1] + mean[2] * mean[2]) / 4

@@ -265,3 +265,14 @@ def test_corpus_sphere_pole_quads_are_degenerate_and_scored_finitely():
     assert len(found(mesh, select=["Q201"])["Q201"][0]) == 128
     faces, m = quad_uv_misplacement(mesh, diagonal="both")
     assert np.isfinite(m).all() and m.max() == pytest.approx(1 / 64 / 4)
+
+
+def test_a_threshold_of_minus_infinity_reports_every_quad_for_every_rule():
+    """The report scores every quad by linting at -inf; no rule may drop quads then."""
+    from affinity.scenes import demo_sphere
+
+    sphere = demo_sphere()
+    for code in ("Q101", "Q103"):
+        hits = lint_mesh(sphere, Settings(select=[code], thresholds={code: -np.inf}))
+        assert len(hits) == 1 and len(hits[0]) == 128, code
+        assert np.isfinite(hits[0].values).all()
