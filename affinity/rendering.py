@@ -12,7 +12,6 @@ import numpy as np
 
 from .mesh import Mesh
 
-SHOW_MODES = ("uv", "color", "normal", "shaded")
 BACKGROUND = np.array([1.0, 1.0, 1.0], dtype=np.float32)
 OVERLAY_TINT = np.array([1.0, 0.1, 0.6], dtype=np.float32)
 
@@ -115,7 +114,7 @@ def shade(attrs: np.ndarray, covered: np.ndarray, inputs: ShadingInputs, show: s
     ----------
     attrs : (H, W, K) float, the rasterizer's interpolated attributes
     covered : (H, W) bool
-    show : one of SHOW_MODES
+    show : "uv", "color", "normal" or "shaded"
     texture : (h, w, 3) float32, sampled where ``inputs.uv`` is set
     light : (3,) unit vector toward the light
 
