@@ -89,6 +89,6 @@ def run(args) -> int:
         sys.stderr.write(f"{file.path}:{file.error_line}: Q901 unreadable: {file.error}\n")
     if not args.quiet:
         unreadable = f", {len(failed)} unreadable" if failed else ""
-        sys.stderr.write(f"affinity report: wrote {args.output} ({len(inputs)} files{unreadable}, "
+        sys.stderr.write(f"affinity report: wrote {args.output} ({len(inputs)} file{'s' * (len(inputs) != 1)}{unreadable}, "
                          f"{len(html.encode()) / 1e6:.1f} MB, {report.seconds:.1f} s)\n")
     return EXIT_ERROR if failed else EXIT_CLEAN
