@@ -50,6 +50,16 @@ def write_grid_obj(path: str, quads: int) -> None:
         np.savetxt(fh, np.repeat(faces, 3, axis=1), fmt="f" + " %d/%d/%d" * 4)
 
 
+def generated_input(path: str, quads: int, write) -> str:
+    """``path``, first written by ``write(path, quads)`` when it does not exist; prints its size."""
+    if not os.path.exists(path):
+        start = time.perf_counter()
+        write(path, quads)
+        print(f"generated {path} in {time.perf_counter() - start:.1f} s")
+    print(f"{quads:,} quads, {os.path.getsize(path) / 1e6:.0f} MB, {os.cpu_count()} CPUs\n")
+    return path
+
+
 def run(command: list[str]) -> tuple[float, float, str, int]:
     """Run a child; return (wall seconds, peak RSS MiB, stdout, exit code)."""
     start = time.perf_counter()
@@ -88,12 +98,7 @@ def main(argv=None) -> None:
     args = parser.parse_args(argv)
 
     with tempfile.TemporaryDirectory() as folder:
-        path = args.path or os.path.join(folder, f"grid_{args.quads}.obj")
-        if not os.path.exists(path):
-            start = time.perf_counter()
-            write_grid_obj(path, args.quads)
-            print(f"generated {path} in {time.perf_counter() - start:.1f} s")
-        print(f"{args.quads:,} quads, {os.path.getsize(path) / 1e6:.0f} MB, {os.cpu_count()} CPUs\n")
+        path = generated_input(args.path or os.path.join(folder, f"grid_{args.quads}.obj"), args.quads, write_grid_obj)
         cases = [(name, lambda m=module, s=setup: measure_reader(m, s, path)) for name, (module, setup) in READERS.items()]
         cases.insert(1, ("affinity check --format json", lambda: measure_check(path)))
         print("| case | call s | process s | peak RSS MiB |")

@@ -23,10 +23,9 @@ import os
 import shutil
 import sys
 import tempfile
-import time
 
 import numpy as np
-from bench_load import run
+from bench_load import generated_input, run
 
 BARE = """
 import sys, time
@@ -102,12 +101,8 @@ def main(argv=None) -> None:
     args = parser.parse_args(argv)
 
     with tempfile.TemporaryDirectory() as folder:
-        path = args.path or os.path.join(folder, f"grid_{args.quads}.usdc")
-        if not os.path.exists(path):
-            started = time.perf_counter()
-            write_grid_stage(path, args.quads)
-            print(f"wrote {path} in {time.perf_counter() - started:.1f} s")
-        print(f"{args.quads:,} quads, {os.path.getsize(path) / 1e6:.0f} MB, {os.cpu_count()} CPUs\n")
+        path = generated_input(args.path or os.path.join(folder, f"grid_{args.quads}.usdc"), args.quads,
+                               write_grid_stage)
         check = [shutil.which("affinity") or "affinity", "check", "-q"]
         print_table([
             ("bare open + extract (pxr, NumPy)", [sys.executable, "-c", BARE, path], True),

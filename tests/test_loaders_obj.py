@@ -3,7 +3,6 @@
 from pathlib import Path
 
 import numpy as np
-import pytest
 
 from affinity.loaders import load
 from affinity.loaders import text as loader_text
