@@ -74,13 +74,9 @@ class RenderResult:
 
     def save_png(self, path: str) -> None:
         """Write the image as PNG, atomically (Pillow)."""
-        from PIL import Image
+        from .png import to_pixels, write_png
 
-        from .atomic import atomic_write
-
-        pixels = np.round(self.image * 255.0).astype(np.uint8)
-        with atomic_write(path, binary=True) as f:
-            Image.fromarray(pixels).save(f, format="PNG")
+        write_png(path, to_pixels(self.image))
 
 
 def default_show(mesh: Mesh) -> str:
@@ -112,24 +108,24 @@ def camera_for(mesh: Mesh, options: RenderOptions, is_demo: bool):
                   near=far * 1e-4, far=far)
 
 
-def choose_methods(mesh: Mesh, faces: np.ndarray, corners: np.ndarray, clip: np.ndarray,
+def choose_methods(mesh: Mesh, faces: np.ndarray, uv: np.ndarray | None, clip: np.ndarray,
                    show: str, options: RenderOptions) -> np.ndarray:
     """The method of every render quad: one name, or the hybrid's per-quad routing.
 
-    Routing by view uses the uv misplacement (along the renderer's diagonal
-    0-2) times the quad's on-screen scale; for colours and normals, and with
-    ``--route lint``, the lint rule of the attribute shown decides.
+    ``uv`` (R, 4, 2) is the render quads' texture coordinates when the render
+    shows them, else None. Routing by view uses the uv misplacement (along the
+    renderer's diagonal 0-2) times the quad's on-screen scale; for colours and
+    normals, and with ``--route lint``, the lint rule of the attribute shown decides.
     """
     if options.method != "hybrid":
         return np.full(len(faces), options.method)
-    routes_uv = show in ("uv", "shaded") and mesh.texcoords is not None
+    routes_uv = uv is not None
     if options.route == "view" and routes_uv:
         from .lint import quad_uv_misplacement
 
         quad_faces, m = quad_uv_misplacement(mesh, diagonal="02")
         per_face = np.zeros(mesh.n_faces)
         per_face[quad_faces] = np.nan_to_num(m)
-        uv = np.nan_to_num(mesh.corner_attribute("texcoords", corners))
         return route_by_view(per_face[faces], uv, clip, options.width, options.height,
                              options.pixel_tolerance, options.cull)
     from .lint import lint_mesh
@@ -186,7 +182,8 @@ def render_mesh(source: str | Mesh | None, options: RenderOptions,
     texture = resolve_texture(mesh, options, warn) if inputs.uv is not None else None
 
     start = time.perf_counter()
-    methods = choose_methods(mesh, faces, corners, clip, show, options)
+    uv = None if inputs.uv is None else inputs.attrs[..., inputs.uv]
+    methods = choose_methods(mesh, faces, uv, clip, show, options)
     frame = rasterize_quads(clip, inputs.attrs, options.width, options.height, method=methods,
                             cull_backfaces=options.cull)
     seconds = time.perf_counter() - start

@@ -50,8 +50,13 @@ def render_corners(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
 
 
 def flat_normals(positions: np.ndarray) -> np.ndarray:
-    """Unit normal of each quad from the cross product of its diagonals, (R,4,3) -> (R,4,3) (repeated per corner)."""
-    n = np.cross(positions[:, 2] - positions[:, 0], positions[:, 3] - positions[:, 1])
+    """Unit normal of each quad's own plane (``affinity.geometry.quad_normals``), repeated per corner.
+
+    (R, 4, 3) -> (R, 4, 3); zero for a quad whose corners are collinear.
+    """
+    from .geometry import quad_normals
+
+    n = quad_normals(positions)
     length = np.linalg.norm(n, axis=-1, keepdims=True)
     n = np.divide(n, length, out=np.zeros_like(n), where=length > 0)
     return np.repeat(n[:, None], 4, axis=1)

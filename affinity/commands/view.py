@@ -7,7 +7,7 @@ of opening a window (the report's overview picture is the same scene).
 from __future__ import annotations
 
 from ..check import UsageError
-from . import EXIT_CLEAN
+from . import EXIT_CLEAN, require
 
 ATTRIBUTES = ("uv", "colour", "normal")
 
@@ -44,10 +44,9 @@ def _scores(mesh, path: str, attribute: str | None):
 def run(args) -> int:
     from ..loaders import load
     from ..mesh import MeshError, SkippedFile
-    from ..view import INSTALL_HINT, overview_image, pyvista_installed, show
+    from ..view import overview_image, show
 
-    if not pyvista_installed():
-        raise UsageError(f"needs pyvista, the view extra: {INSTALL_HINT}")
+    require(("pyvista",), "view")
     try:
         mesh = load(args.mesh)
     except MeshError as err:
@@ -58,14 +57,11 @@ def run(args) -> int:
     if args.screenshot is None:
         show(mesh, scores, args.up)
         return EXIT_CLEAN
-    from PIL import Image
-
-    from ..atomic import atomic_write
+    from ..png import write_png
 
     pixels = overview_image(mesh, scores, None, args.up, (800, 600))
     try:
-        with atomic_write(args.screenshot, binary=True) as out:
-            Image.fromarray(pixels).save(out, format="PNG")
+        write_png(args.screenshot, pixels)
     except OSError as err:
         raise UsageError(f"{args.screenshot}: cannot write ({err.strerror or err})") from None
     return EXIT_CLEAN

@@ -74,13 +74,11 @@ class ReportRun:
 
 def _checker_file(folder: str, checks: int) -> str:
     """Write the checker with ``checks`` squares across as a PNG in ``folder``; its path."""
-    from PIL import Image
-
+    from ..png import to_pixels, write_png
     from ..texture import checker
-    from .images import to_pixels
 
     path = os.path.join(folder, f"checker-{checks}.png")
-    Image.fromarray(to_pixels(checker(512, checks))).save(path)
+    write_png(path, to_pixels(checker(512, checks)))
     return path
 
 

@@ -6,28 +6,15 @@ Everything is embedded in the HTML file, so PNGs are optimised and kept small.
 from __future__ import annotations
 
 import base64
-import io
 
 import numpy as np
+
+from ..png import png_bytes, to_pixels
 
 #: A crop never shows less than this many pixels across, so a tiny quad keeps some context.
 MIN_CROP = 16
 #: Nor more than this: a large quad is zoomed at its centre, where the split moves the attribute most.
 MAX_CROP = 96
-
-
-def to_pixels(image: np.ndarray) -> np.ndarray:
-    """(H, W, C) float in [0, 1] -> (H, W, C) uint8."""
-    return np.round(np.clip(image, 0.0, 1.0) * 255.0).astype(np.uint8)
-
-
-def png_bytes(pixels: np.ndarray) -> bytes:
-    """An optimised PNG of (H, W, 3) or (H, W) uint8 pixels."""
-    from PIL import Image
-
-    out = io.BytesIO()
-    Image.fromarray(pixels).save(out, format="PNG", optimize=True)
-    return out.getvalue()
 
 
 def data_uri(png: bytes) -> str:
