@@ -14,7 +14,7 @@ from functools import partial
 from pathlib import Path
 
 from .findings import FileReport
-from .mesh import MeshError, SkippedFile
+from .mesh import Mesh, MeshError, SkippedFile
 from .settings import Settings
 
 MESH_SUFFIXES = (".obj", ".ply", ".off", ".usd", ".usda", ".usdc", ".usdz")
@@ -53,16 +53,21 @@ def check_file(path: str, settings: Settings, usd=None) -> FileReport:
 
     ``usd`` (:class:`affinity.loaders.usd.UsdOptions`) says how to read USD stages.
     """
+    return load_and_check(path, settings, usd)[0]
+
+
+def load_and_check(path: str, settings: Settings, usd=None) -> tuple[FileReport, Mesh | None]:
+    """:func:`check_file`, also handing back the loaded mesh (None when it could not be read)."""
     from .lint import lint_mesh
     from .loaders import load
 
     try:
         mesh = load(path, usd)
     except SkippedFile as skip:
-        return FileReport(path, skipped=skip.reason)
+        return FileReport(path, skipped=skip.reason), None
     except MeshError as err:
-        return FileReport(path, error=err.reason, error_line=err.line)
-    return FileReport(
+        return FileReport(path, error=err.reason, error_line=err.line), None
+    report = FileReport(
         path,
         counts=mesh.counts(),
         hits=lint_mesh(mesh, settings),
@@ -72,6 +77,7 @@ def check_file(path: str, settings: Settings, usd=None) -> FileReport:
         meters_per_unit=mesh.meters_per_unit,
         notes=list(mesh.notes),
     )
+    return report, mesh
 
 
 #: Mesh bytes that pay for one more worker process: starting one costs about as

@@ -39,7 +39,7 @@ class RenderOptions:
     camera: tuple | None = None
     up: str | None = None
     show: str | None = None
-    texture: str | None = None
+    texture: str | np.ndarray | None = None  # an image path, or an (h, w, 3) float RGB image
     overlay: bool = False
     cull: bool = False
 
@@ -139,9 +139,12 @@ def choose_methods(mesh: Mesh, faces: np.ndarray, uv: np.ndarray | None, clip: n
 
 
 def resolve_texture(mesh: Mesh, options: RenderOptions, warn: Callable[[str], None]) -> np.ndarray:
-    """The explicit ``--texture`` (errors are fatal), else map_Kd (a missing one warns), else the checker."""
+    """The explicit texture (an image, or a path whose errors are fatal), else map_Kd (a missing
+    one warns), else the checker."""
     from .texture import TextureError, checker, load_image
 
+    if isinstance(options.texture, np.ndarray):
+        return options.texture
     if options.texture:
         return load_image(options.texture)
     path = mesh.texture_path()

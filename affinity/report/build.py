@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import datetime
 import os
-import tempfile
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -72,16 +71,6 @@ class ReportRun:
     seconds: float
 
 
-def _checker_file(folder: str, checks: int) -> str:
-    """Write the checker with ``checks`` squares across as a PNG in ``folder``; its path."""
-    from ..png import to_pixels, write_png
-    from ..texture import checker
-
-    path = os.path.join(folder, f"checker-{checks}.png")
-    write_png(path, to_pixels(checker(512, checks)))
-    return path
-
-
 def _texture_label(mesh: Mesh, view: View) -> str:
     if mesh.texcoords is None:
         return ""
@@ -96,7 +85,7 @@ def _texture_label(mesh: Mesh, view: View) -> str:
     return f"texture {name} (map_Kd)" if image_size(path) else f"checker texture (map_Kd {name} is not readable)"
 
 
-def _render(result: MeshResult, texture: str | None, step: Callable[[str], None]) -> None:
+def _render(result: MeshResult, texture: np.ndarray | None, step: Callable[[str], None]) -> None:
     """The hybrid render; when it sent quads to mvc, the compared methods and the overlay too."""
     from ..hybrid import RenderOptions, render_mesh
     from ..routing import MVC
@@ -148,22 +137,20 @@ def _overview(result: MeshResult, step: Callable[[str], None]) -> None:
 
 def collect_mesh(item: MeshInput, settings: Settings, step: Callable[[str], None] = lambda name: None) -> MeshResult:
     """Lint, score, render and picture one mesh; an unreadable file gives a result with ``file.error``."""
-    from ..check import check_file
-    from ..loaders import load
+    from ..check import load_and_check
+    from ..texture import checker
 
     start = time.perf_counter()
     step("lint")
-    result = MeshResult(item, check_file(item.path, settings), settings)
+    file, mesh = load_and_check(item.path, settings)
+    result = MeshResult(item, file, settings, mesh=mesh)
     if result.readable:
-        result.mesh = load(item.path)
         step("scores")
         result.scores = {code: quad_scores(result.mesh, settings, code) for code in scored_codes(result.mesh)}
         result.shown = shown_code(result.mesh)
         result.texture = _texture_label(result.mesh, item.view)
-        with tempfile.TemporaryDirectory(prefix="affinity-report-") as folder:
-            has_uv = result.mesh.texcoords is not None
-            texture = _checker_file(folder, item.view.checks) if item.view.checks and has_uv else None
-            _render(result, texture, step)
+        has_uv = result.mesh.texcoords is not None
+        _render(result, checker(512, item.view.checks) if item.view.checks and has_uv else None, step)
         _overview(result, step)
     result.seconds = time.perf_counter() - start
     return result
