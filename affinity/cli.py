@@ -9,7 +9,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .check import UsageError
+from .errors import UsageError
 from .commands import EXIT_CLEAN, EXIT_ERROR
 from .commands import bench as bench_command
 from .commands import check as check_command
@@ -38,7 +38,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    from .allocator import keep_freed_memory
+    from .commands.allocator import keep_freed_memory
 
     args = build_parser().parse_args(argv)
     keep_freed_memory()

@@ -30,7 +30,7 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
-from .check import UsageError
+from .errors import UsageError
 from .settings import DIAGONALS, MEASURES, Settings, unknown_codes, unthresholded_codes
 
 CONFIG_NAMES = ("affinity.toml", "pyproject.toml")

@@ -1,53 +1,30 @@
-"""Evaluate the lint rules on one mesh, vectorized over its quads.
+"""Evaluate the registered rules (``affinity.rules.RULES``) on one mesh, vectorized over its quads.
 
-Rules Q101-Q103 and Q201-Q204, Q301-Q302 apply to quads only: triangles are
-always affine and have no diagonal to split along, and n-gons are fanned by
-whoever renders them, so neither is measured (both are still counted by the
-mesh). Q205 applies to the whole file.
-
-Direction of the thresholds: Q201 and Q301 (relative areas) flag values at or
-below their threshold; every other thresholded rule flags values above it.
-Q204, Q205 and Q302 have no threshold (reported as 0): Q204 reports the folded
-fraction of the bow-tie (``affinity.geometry.folded_fraction``), Q302 the
-quad's negative relative UV area, Q205 the number of vertices, on face -1 and
-line 1 since no face exists to point at.
+Quad rules apply to quads only: triangles are always affine and have no
+diagonal to split along, and n-gons are fanned by whoever renders them, so
+neither is measured (both are still counted by the mesh). Each quad rule's check
+runs on batches of quads (:class:`QuadBatch`), which compute what several rules
+share once; mesh rules (Q205) look at the whole mesh. Which side of its
+threshold a rule flags is the rule's ``flags``; rules without a threshold
+report 0 as their threshold.
 """
 
 from __future__ import annotations
 
 import os
 from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, replace
 from functools import cached_property
 
 import numpy as np
 
 from .findings import RuleHits
-from .geometry import (
-    PlanarQuads,
-    degeneracy,
-    folded_fraction,
-    interior_angles,
-    is_bowtie,
-    planar_quads_by_component,
-    relative_signed_area,
-    squared_lengths,
-)
-from .imagesize import image_size
-from .measures import (
-    barycentric_score,
-    color_steps,
-    misplacement_by_component,
-    normal_degrees,
-    split_scale,
-    texels,
-)
-from .mesh import Mesh
+from .geometry import PlanarQuads, planar_quads_by_component, squared_lengths
+from .loaders.imagesize import image_size
+from .measures import misplacement_by_component, split_scale
+from .mesh import ATTRIBUTE_NAMES, Mesh
 from .rules import RULES, resolve_codes
 from .settings import Settings
-
-_FLAG_AT_OR_BELOW = frozenset({"Q201", "Q301"})
-#: The attribute each rule reads besides the positions.
-_ATTRIBUTE_OF_RULE = {"Q101": "texcoords", "Q102": "colors", "Q103": "normals", "Q301": "texcoords", "Q302": "texcoords"}
 
 
 #: Quads measured together. Whole-mesh temporaries of a million quads spill out
@@ -56,7 +33,7 @@ _ATTRIBUTE_OF_RULE = {"Q101": "texcoords", "Q102": "colors", "Q103": "normals", 
 BATCH_SIZE = 16384
 
 
-class _Tables:
+class CornerTables:
     """A mesh's attribute tables and their corner indices, shared by every batch."""
 
     def __init__(self, mesh: Mesh):
@@ -104,10 +81,17 @@ class _Tables:
         return slice(None), values
 
 
-class _QuadBatch:
-    """A batch of a mesh's quads, with what several rules share computed once, on demand."""
+class QuadBatch:
+    """A batch of a mesh's quads, with what several rules share computed once, on demand.
 
-    def __init__(self, tables: _Tables, settings: Settings, faces, corners, texture_size):
+    What a rule's check reads: ``faces`` (Q,) int64 face indices in file order,
+    ``corners`` (4, Q) corner indices, ``settings``, ``texture_size`` (w, h)
+    texels, ``planar`` (the quads in their own planes), ``uv`` and
+    ``uv_planar`` (the quads with uv at all four corners), ``complete(name)``
+    and ``misplacement(rows, attrs)``.
+    """
+
+    def __init__(self, tables: CornerTables, settings: Settings, faces, corners, texture_size):
         self.tables = tables
         self.settings = settings
         self.faces = faces  # (Q,) face indices in file order
@@ -151,10 +135,10 @@ class _QuadBatch:
 
 
 def _map_quad_batches(mesh: Mesh, settings: Settings, measure, attributes=()) -> list:
-    """Run ``measure(batch: _QuadBatch)`` on every batch of the mesh's quads, in
+    """Run ``measure(batch: QuadBatch)`` on every batch of the mesh's quads, in
     parallel threads (NumPy releases the GIL in its loops); results in file order.
     ``attributes`` names the tables the measure reads besides the positions."""
-    tables = _Tables(mesh)
+    tables = CornerTables(mesh)
     for name in ("positions", *attributes):
         tables.prepare(name)
     size = image_size(mesh.texture_path()) if "texcoords" in attributes else None
@@ -164,95 +148,13 @@ def _map_quad_batches(mesh: Mesh, settings: Settings, measure, attributes=()) ->
     def run(start: int):
         faces = quads[start : start + BATCH_SIZE]
         corners = mesh.face_start[faces] + np.arange(4)[:, None]  # (4, Q): corner-major
-        return measure(_QuadBatch(tables, settings, faces, corners, texture_size))
+        return measure(QuadBatch(tables, settings, faces, corners, texture_size))
 
     starts = range(0, len(quads), BATCH_SIZE)
     if len(starts) <= 1:
         return [run(start) for start in starts]
     with ThreadPoolExecutor(max_workers=os.cpu_count()) as pool:
         return list(pool.map(run, starts))
-
-
-def _uv_disaffinity(quads: _QuadBatch) -> tuple:
-    rows, uv = quads.uv
-    diagonal = quads.settings.diagonal
-    if quads.settings.measure == "barycentric":
-        return rows, barycentric_score(quads.planar.take(rows), quads.uv_planar, diagonal)
-    return rows, texels(quads.misplacement(rows, uv).T, quads.texture_size)
-
-
-def _color_disaffinity(quads: _QuadBatch) -> tuple:
-    rows, colors = quads.complete("colors")
-    return rows, color_steps(quads.misplacement(rows, colors).T)
-
-
-def _normal_disaffinity(quads: _QuadBatch) -> tuple:
-    rows, unit = quads.complete("normals")  # unit length already (see _Tables.gather)
-    m = quads.misplacement(rows, unit)
-    # The angle atan2(|m|, |mean normal|) exceeds the threshold only where
-    # |m| > tan(threshold) |mean normal|: the arctangent is taken for those only.
-    threshold = quads.settings.threshold("Q103")
-    picked = slice(None)
-    if 0 <= threshold < 89:  # a negative threshold (every value wanted) picks every quad
-        m_length = np.sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2])
-        mean = unit.sum(axis=1)
-        mean_length = np.sqrt(mean[0] * mean[0] + mean[1] * mean[1] + mean[2] * mean[2]) / 4
-        picked = np.flatnonzero(m_length >= mean_length * (np.tan(np.radians(threshold)) * (1 - 1e-9)))
-    rows = np.arange(len(quads))[rows][picked]
-    degrees = normal_degrees(m.T[picked], np.transpose(unit, (2, 1, 0))[picked])
-    return rows, degrees
-
-
-def _degenerate(quads: _QuadBatch) -> tuple:
-    return slice(None), degeneracy(quads.planar)
-
-
-def _nonplanar(quads: _QuadBatch) -> tuple:
-    return slice(None), quads.planar.warp
-
-
-def _concave(quads: _QuadBatch) -> tuple:
-    planar = quads.planar
-    candidates = ~is_bowtie(planar)
-    if quads.settings.threshold("Q203") >= 180:
-        # An angle above 180 degrees needs a clockwise turn; half the tolerance
-        # keeps every turn interior_angles could read as one.
-        candidates &= (planar.areas < -0.5 * planar.tolerance[:, None]).any(axis=1)
-    rows = np.flatnonzero(candidates)
-    if len(rows) == 0:
-        return rows, np.zeros(0)
-    return rows, interior_angles(planar.take(rows)).max(axis=1)
-
-
-def _bowtie(quads: _QuadBatch) -> tuple:
-    rows = np.flatnonzero(is_bowtie(quads.planar))
-    return rows, folded_fraction(quads.planar.take(rows))
-
-
-def _uv_degenerate(quads: _QuadBatch) -> tuple:
-    return quads.uv[0], np.abs(relative_signed_area(quads.uv_planar))
-
-
-def _uv_flipped(quads: _QuadBatch) -> tuple:
-    rows = np.arange(len(quads))[quads.uv[0]]
-    area = relative_signed_area(quads.uv_planar)
-    flipped = area < -RULES["Q301"].default_threshold
-    return rows[flipped], area[flipped]
-
-
-# Each returns (rows of the batch: indices or a slice, values of those rows); rules
-# without a threshold return only the rows they flag.
-_QUAD_RULES = {
-    "Q101": _uv_disaffinity,
-    "Q102": _color_disaffinity,
-    "Q103": _normal_disaffinity,
-    "Q201": _degenerate,
-    "Q202": _nonplanar,
-    "Q203": _concave,
-    "Q204": _bowtie,
-    "Q301": _uv_degenerate,
-    "Q302": _uv_flipped,
-}
 
 
 def lint_mesh(mesh: Mesh, settings: Settings) -> list[RuleHits]:
@@ -268,44 +170,42 @@ def lint_mesh(mesh: Mesh, settings: Settings) -> list[RuleHits]:
     list of RuleHits, one per rule with at least one finding, in rule-table order;
     faces in file order within each.
     """
-    enabled = resolve_codes(settings.select, settings.ignore)
+    enabled = [RULES[code] for code in resolve_codes(settings.select, settings.ignore)]
     hits = []
-    if "Q205" in enabled and mesh.n_faces == 0 and len(mesh.positions) > 0:
-        hits.append(
-            RuleHits("Q205", np.array([-1]), np.array([1]), np.array([float(len(mesh.positions))]),
-                     0.0, np.zeros(1, dtype=np.int32))
-        )
-    codes = [code for code in enabled if code in _QUAD_RULES]
-    thresholds = {
-        code: settings.threshold(code) if RULES[code].default_threshold is not None else None
-        for code in codes
-    }
+    for rule in enabled:
+        found = rule.check(mesh, settings) if rule.scope == "mesh" else None
+        if found is not None:
+            faces, lines, values = found
+            hits.append(RuleHits(rule.code, faces, lines, values, 0.0, np.zeros(len(faces), dtype=np.int32)))
+    quad_rules = [rule for rule in enabled if rule.scope == "quad"]
+    thresholds = {rule.code: settings.threshold(rule.code) if rule.has_threshold else None for rule in quad_rules}
 
-    def flag(batch: _QuadBatch) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    def flag(batch: QuadBatch) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         """Rule code -> (faces, values) of the batch's flagged quads."""
         found = {}
-        for code in codes:
-            rows, values = _QUAD_RULES[code](batch)
+        for rule in quad_rules:
+            rows, values = rule.check(batch)
             faces = batch.faces[rows]
-            threshold = thresholds[code]
+            threshold = thresholds[rule.code]
             if threshold is not None:
-                flagged = values <= threshold if code in _FLAG_AT_OR_BELOW else values > threshold
+                flagged = rule.flagged(values, threshold)
                 faces, values = faces[flagged], values[flagged]
-            found[code] = faces, values
+            found[rule.code] = faces, values
         return found
 
-    attributes = sorted({_ATTRIBUTE_OF_RULE[code] for code in codes if code in _ATTRIBUTE_OF_RULE})
-    batches = _map_quad_batches(mesh, settings, flag, attributes) if codes else []
-    for code in codes:
-        faces = np.concatenate([found[code][0] for found in batches] or [np.zeros(0, dtype=np.int64)])
+    attributes = sorted({rule.attribute for rule in quad_rules if rule.attribute})
+    batches = _map_quad_batches(mesh, settings, flag, attributes) if quad_rules else []
+    for rule in quad_rules:
+        faces = np.concatenate([found[rule.code][0] for found in batches] or [np.zeros(0, dtype=np.int64)])
         if len(faces):
-            values = np.concatenate([found[code][1] for found in batches])
-            threshold = thresholds[code]
+            values = np.concatenate([found[rule.code][1] for found in batches])
+            threshold = thresholds[rule.code]
             hits.append(
-                RuleHits(code, faces, mesh.face_line[faces], values,
+                RuleHits(rule.code, faces, mesh.face_line[faces], values,
                          0.0 if threshold is None else float(threshold), mesh.face_group[faces])
             )
-    return hits
+    order = {code: i for i, code in enumerate(RULES)}
+    return sorted(hits, key=lambda h: order[h.code])
 
 
 def quad_uv_misplacement(mesh: Mesh, diagonal: str = "02") -> tuple[np.ndarray, np.ndarray]:
@@ -323,7 +223,7 @@ def quad_uv_misplacement(mesh: Mesh, diagonal: str = "02") -> tuple[np.ndarray, 
         |m| in uv units; NaN for quads without texture coordinates at all corners.
     """
 
-    def measure(batch: _QuadBatch) -> np.ndarray:
+    def measure(batch: QuadBatch) -> np.ndarray:
         m = np.full(len(batch), np.nan)
         rows, uv = batch.uv
         uv_m = misplacement_by_component(batch.planar.take(rows), uv, diagonal)
@@ -332,3 +232,56 @@ def quad_uv_misplacement(mesh: Mesh, diagonal: str = "02") -> tuple[np.ndarray, 
 
     faces = np.flatnonzero(mesh.face_sizes == 4)
     return faces, np.concatenate(_map_quad_batches(mesh, Settings(), measure, ("texcoords",)) or [np.zeros(0)])
+
+
+@dataclass
+class QuadScores:
+    """One affinity rule's reading for every quad that has the attribute at all four corners.
+
+    Attributes
+    ----------
+    code : rule code of a scored rule (``Rule.scored``), e.g. ``"Q101"``
+    attribute : the attribute as the command line names it: ``"uv"``, ``"color"`` or ``"normal"``
+    unit : the values' unit under the settings' reading, e.g. ``"texels"``
+    threshold : the rule flags values above it
+    faces : (n,) int64, face index in file order
+    values : (n,) float64, the measured score; quads the rule cannot measure
+        (NaN, e.g. a missing corner attribute) are not listed
+    """
+
+    code: str
+    attribute: str
+    unit: str
+    threshold: float
+    faces: np.ndarray
+    values: np.ndarray
+
+    @property
+    def flagged(self) -> np.ndarray:
+        """(n,) bool: the quads the rule flags."""
+        return RULES[self.code].flagged(self.values, self.threshold)
+
+
+def scored_codes(mesh: Mesh) -> list[str]:
+    """The scored rules (Q101-Q103) whose attribute the mesh has, in code order."""
+    return [code for code, rule in RULES.items() if rule.scored and getattr(mesh, rule.attribute) is not None]
+
+
+def scored_code_of(attribute: str) -> str:
+    """The scored rule of an attribute named as on the command line (``"uv"``, ``"color"``, ``"normal"``)."""
+    return next(code for code, rule in RULES.items() if rule.scored and ATTRIBUTE_NAMES[rule.attribute] == attribute)
+
+
+def quad_scores(mesh: Mesh, settings: Settings, code: str) -> QuadScores:
+    """Score every quad of ``mesh`` with the scored rule ``code`` (as ``settings`` configure it).
+
+    The rule runs with its threshold at -inf, so every measured quad is kept and
+    the scores are exactly the values ``affinity check`` compares with the threshold.
+    """
+    rule = RULES[code]
+    everything = replace(settings, select=[code], ignore=[], thresholds={**settings.thresholds, code: -np.inf})
+    hits = lint_mesh(mesh, everything)
+    faces = hits[0].faces if hits else np.zeros(0, dtype=np.int64)
+    values = hits[0].values if hits else np.zeros(0)
+    return QuadScores(code, ATTRIBUTE_NAMES[rule.attribute], rule.unit_for(settings.measure),
+                      settings.threshold(code), faces, values)

@@ -246,3 +246,25 @@ def normal_degrees(m: np.ndarray, normals: np.ndarray) -> np.ndarray:
     """
     mean_normal = lengths(normals[:, 0] + normals[:, 1] + normals[:, 2] + normals[:, 3]) / 4
     return np.degrees(np.arctan2(lengths(m), mean_normal))
+
+
+def pixel_error(values: np.ndarray, reference: np.ndarray, attribute: str, texture_size) -> np.ndarray:
+    """Error of interpolated attributes against a reference's, in the lint's units.
+
+    Parameters
+    ----------
+    values, reference : (N, K) float64, the attribute at N pixels
+    attribute : the Mesh field they come from: ``"texcoords"``, ``"colors"`` or ``"normals"``
+    texture_size : (width, height) in texels, for texture coordinates
+
+    Returns
+    -------
+    (N,) float64: |du, dv| in texels, |d rgb| in 1/255 steps, or the angle
+    between the two normals in degrees.
+    """
+    if attribute == "texcoords":
+        return texels(values - reference, texture_size)
+    if attribute == "colors":
+        return color_steps(values - reference)
+    cross = np.linalg.norm(np.cross(values, reference), axis=-1)
+    return np.degrees(np.arctan2(cross, np.einsum("nk,nk->n", values, reference)))

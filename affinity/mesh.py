@@ -15,27 +15,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 
-class MeshError(Exception):
-    """A file that cannot be read as a mesh.
-
-    ``line`` is the 1-based source line the problem was found on, 0 when the
-    problem has no line (binary data, a missing file).
-    """
-
-    def __init__(self, path: str, line: int, reason: str):
-        super().__init__(f"{path}:{line}: {reason}")
-        self.path = str(path)
-        self.line = int(line)
-        self.reason = reason
-
-
-class SkippedFile(Exception):
-    """A file that is deliberately not checked (e.g. a Git LFS pointer); not an error."""
-
-    def __init__(self, path: str, reason: str):
-        super().__init__(f"{path}: skipped ({reason})")
-        self.path = str(path)
-        self.reason = reason
+#: How each per-corner attribute is named on the command line and in pictures (``--show uv``).
+ATTRIBUTE_NAMES = {"texcoords": "uv", "colors": "color", "normals": "normal"}
 
 
 @dataclass(eq=False)

@@ -14,12 +14,16 @@ Our own constructions (design.md: the seeds hold only the captions):
   Fig. 10/11, Bloomenthal section 3.4): each quad is a bilinear patch whose uv
   is the patch's own (s, t) scaled, so the exact render is the parametrisation.
 
-``DEMO`` lists the scenes bundled as OBJ files under ``affinity/data/demo``;
-``python -m affinity.scenes`` rewrites them.
+``SCENES`` lists every built-in scene once, with its view: the demo meshes
+(bundled as OBJ files under ``affinity/data/demo``, rewritten by ``python -m
+affinity.scenes``), the study's figures and the tests' scenes.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -102,21 +106,89 @@ def demo_sphere() -> Mesh:
     return latlong_sphere(16, 8)
 
 
-DEMO = {
-    "trapezoid.obj": trapezoid,
-    "sphere.obj": demo_sphere,
-    "color_squares.obj": color_squares,
-}
+@dataclass(frozen=True)
+class View:
+    """How a scene is looked at.
+
+    ``camera`` is ``RenderOptions.camera``: (eye, target, vertical field of view
+    in degrees), None to frame the whole mesh; ``up`` the world up axis (None:
+    the file's, else y). ``checks``: draw the texture as a checker with this many
+    squares across instead of the default fine checker.
+    """
+
+    camera: tuple | None = None
+    up: str | None = None
+    checks: int | None = None
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A built-in scene: its name, the figure it rebuilds, the mesh, and its view.
+
+    ``file`` names the scene's OBJ under ``affinity/data/demo`` when it is one
+    of the demo meshes (``affinity check --demo``, ``affinity report``);
+    ``quick`` keeps it in the quick study (``affinity bench --quick``); ``study``
+    puts it in the study at all.
+    """
+
+    name: str
+    source: str
+    mesh: Callable[[], Mesh]
+    view: View = View()
+    file: str | None = None
+    study: bool = True
+    quick: bool = False
+
+
+#: Straight on: the image plane is parallel to the trapezoid, every corner has
+#: the same w and the picture is the paper's front view. A 12-square checker is
+#: coarse enough for the crease along the diagonal to read at 480 pixels.
+FRONT_OF_TRAPEZOID = View(((0.0, 0.0, 10.0), (0.0, 0.0, 0.0), 12.0), "y", checks=12)
+TILTED_TRAPEZOID = View(((0.9, -2.2, 1.6), (0.0, 0.0, 0.0), 40.0), "z")
+#: The lat-long sphere (z up) seen from above the equator, the pole rows in view.
+SPHERE_FROM_ABOVE_EQUATOR = View(((0.0, -2.9, 2.1), (0.0, 0.0, 0.05), 40.0), "z")
+NORTH_POLE_CLOSE_UP = View(((0.0, -0.75, 1.55), (0.0, 0.0, 0.92), 40.0), "z")
+STRIP_IN_PERSPECTIVE = View(((1.2, 1.5, 3.0), (0.0, 0.0, 0.0), 45.0), "y")
+FRONT_OF_COLOR_SQUARES = View(((1.25, 0.5, 10.0), (1.25, 0.5, 0.0), 12.0), "y")
+
+#: Every built-in scene, once: the demo meshes, the study's figures, the tests' scenes.
+SCENES = (
+    Scene("trapezoid front", "Bloomenthal Fig. 3", trapezoid, FRONT_OF_TRAPEZOID, file="trapezoid.obj", quick=True),
+    Scene("trapezoid tilted", "Bloomenthal Fig. 3, in perspective", trapezoid, TILTED_TRAPEZOID),
+    Scene("sphere 16x8", "Bloomenthal Fig. 9", demo_sphere, SPHERE_FROM_ABOVE_EQUATOR, file="sphere.obj",
+          study=False),
+    Scene("sphere 8x16", "Bloomenthal Fig. 9", partial(latlong_sphere, 8, 16), SPHERE_FROM_ABOVE_EQUATOR,
+          quick=True),
+    Scene("sphere 30x20", "Bloomenthal Fig. 12 top", partial(latlong_sphere, 30, 20), SPHERE_FROM_ABOVE_EQUATOR),
+    Scene("sphere 100x40", "Bloomenthal Fig. 12 bottom", partial(latlong_sphere, 100, 40),
+          SPHERE_FROM_ABOVE_EQUATOR),
+    Scene("sphere 100x40 pole", "Bloomenthal Fig. 13 top", partial(latlong_sphere, 100, 40), NORTH_POLE_CLOSE_UP),
+    Scene("sphere 100x40 dense poles", "Bloomenthal Fig. 13 bottom",
+          partial(latlong_sphere, 100, 40, dense_poles=True), NORTH_POLE_CLOSE_UP),
+    Scene("color squares", "Bloomenthal Fig. 10", color_squares, FRONT_OF_COLOR_SQUARES, file="color_squares.obj",
+          study=False),
+    Scene("quad strip", "nonplanar quads (HT04 Fig. 10)", quad_strip, STRIP_IN_PERSPECTIVE, quick=True),
+)
+
+#: The demo scenes bundled as OBJ files, in the order the report shows them.
+DEMO_SCENES = tuple(scene for scene in SCENES if scene.file)
+#: What ``affinity render`` draws without a mesh.
+DEMO_SPHERE = next(scene for scene in SCENES if scene.file == "sphere.obj")
+
+
+def study_scenes(quick: bool = False) -> list[Scene]:
+    """The scenes of the error-against-run-time study; ``quick`` keeps one of each kind."""
+    return [scene for scene in SCENES if scene.study and (scene.quick or not quick)]
 
 
 def demo_paths() -> list[str]:
     """Paths of the bundled demo meshes."""
-    return [str(DEMO_DIR / name) for name in DEMO]
+    return [str(DEMO_DIR / scene.file) for scene in DEMO_SCENES]
 
 
 if __name__ == "__main__":
-    from .objwriter import write_obj
+    from .loaders.objwriter import write_obj
 
     DEMO_DIR.mkdir(parents=True, exist_ok=True)
-    for file_name, build in DEMO.items():
-        write_obj(build(), DEMO_DIR / file_name, header="quad-affinity demo scene (CC0): " + file_name)
+    for scene in DEMO_SCENES:
+        write_obj(scene.mesh(), DEMO_DIR / scene.file, header="quad-affinity demo scene (CC0): " + scene.file)

@@ -19,9 +19,6 @@ from fnmatch import fnmatchcase
 
 from .rules import RULES
 
-#: The paper's own tolerance for the dimensionless barycentric reading.
-BARYCENTRIC_TOLERANCE = 0.01
-
 MEASURES = ("misplacement", "barycentric")
 DIAGONALS = ("both", "02", "13", "shortest")
 
@@ -51,11 +48,10 @@ class Settings:
     root: str | None = None
 
     def threshold(self, code: str) -> float | None:
+        """The threshold of rule ``code``: the configured one, else the rule's default for the reading."""
         if code in self.thresholds:
             return self.thresholds[code]
-        if self.measure == "barycentric" and code == "Q101":
-            return BARYCENTRIC_TOLERANCE
-        return RULES[code].default_threshold
+        return RULES[code].default_for(self.measure)
 
     def updated(self, options: dict) -> Settings:
         """A copy with ``options`` (field name -> value) applied on top; thresholds merge per rule."""

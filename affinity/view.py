@@ -12,11 +12,11 @@ import importlib.util
 import numpy as np
 
 from .mesh import Mesh
-from .report.charts import FLAG_COLOUR
-from .report.scores import QuadScores
+from .draw.framing import UP_AXES
+from .draw.shading import FLAG_COLOUR
+from .lint import QuadScores
 
 INSTALL_HINT = "pip install 'quad-affinity[view]'"
-UP_VECTORS = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
 SURFACE_GREY = "#d1d5db"
 
 
@@ -71,10 +71,10 @@ def place_camera(plotter, camera: tuple | None, up: str | None) -> None:
     if camera is None:
         plotter.view_isometric()
         if up is not None:
-            plotter.set_viewup(UP_VECTORS[up])
+            plotter.set_viewup(UP_AXES[up])
         return
     eye, target, fov = camera
-    plotter.camera_position = [tuple(eye), tuple(target), UP_VECTORS[up or "y"]]
+    plotter.camera_position = [tuple(eye), tuple(target), UP_AXES[up or "y"]]
     plotter.camera.view_angle = fov
 
 

@@ -37,13 +37,13 @@ READERS = {
     "trimesh.load(process=False)": ("trimesh", "import trimesh, sys; trimesh.load(sys.argv[1], process=False)"),
 }
 
-#: The phases of ``affinity check`` in one process, as ``affinity.check.check_file`` and
+#: The phases of ``affinity check`` in one process, as ``affinity.pipeline.check_file`` and
 #: the JSON writer run them; prints seconds (wall, CPU) per phase.
 PHASES = """
 import io, sys, time
-from affinity.allocator import keep_freed_memory
+from affinity.commands.allocator import keep_freed_memory
 keep_freed_memory()
-from affinity.check import check_file
+from affinity.pipeline.check import check_file
 from affinity.lint import lint_mesh
 from affinity.loaders import load
 from affinity.output import CheckRun

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from affinity.hybrid import RenderOptions, render_mesh
+from affinity.draw.drawing import RenderOptions, render_mesh
 from affinity.loaders import load
 from affinity.scenes import demo_sphere
 

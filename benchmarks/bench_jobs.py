@@ -25,7 +25,7 @@ def main() -> None:
     parser.add_argument("--runs", type=int, default=5)
     args = parser.parse_args()
 
-    from affinity.objwriter import write_obj
+    from affinity.loaders.objwriter import write_obj
     from affinity.scenes import latlong_sphere
 
     n_lon = 2 * max(2, round((args.quads / 2) ** 0.5))

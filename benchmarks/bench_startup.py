@@ -68,7 +68,7 @@ def main() -> None:
     parser.add_argument("--runs", type=int, default=21)
     args = parser.parse_args()
 
-    from affinity.objwriter import write_obj
+    from affinity.loaders.objwriter import write_obj
     from affinity.scenes import latlong_sphere
 
     with tempfile.TemporaryDirectory() as tmp:

@@ -8,7 +8,7 @@ from pathlib import Path
 from test_cli_check import run
 from test_formats import SQUARE, UNIT_UV, hits, quad_obj, trapezoid
 
-from affinity import baseline
+from affinity.pipeline import baseline
 from affinity.findings import FileReport
 
 # Three trapezoids of different shapes (different Q101 values) in two groups, and a clean square.

@@ -2,7 +2,7 @@
 
 import pytest
 
-from affinity.check import UsageError
+from affinity.errors import UsageError
 from affinity.commands import require
 
 

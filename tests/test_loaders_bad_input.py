@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from affinity.loaders import load
-from affinity.mesh import MeshError, SkippedFile
+from affinity.errors import MeshError, SkippedFile
 
 SQUARE = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"  # lines 1-4
 

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from affinity.hybrid import RenderOptions, render_mesh
-from affinity.objwriter import write_obj
+from affinity.draw.drawing import RenderOptions, render_mesh
+from affinity.loaders.objwriter import write_obj
 from affinity.scenes import color_squares, latlong_sphere, trapezoid
 
 

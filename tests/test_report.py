@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from affinity.mesh import mesh_from_polygons
-from affinity.objwriter import write_obj
+from affinity.loaders.objwriter import write_obj
 from affinity.scenes import color_squares
 
 TRAPEZOID = "v -1 0 0\nv 1 0 0\nv 0.5 1 0\nv -0.5 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n"
@@ -160,7 +160,7 @@ def test_sections_a_mesh_lacks_are_left_out_and_the_others_remain(tmp_path):
     scores = section(colours, "scores")
     assert left_out(scores) is None
     assert "uv (no texture coordinates)" in scores.text()
-    assert "colour score histogram" in image_alts(scores) and "uv score histogram" not in image_alts(scores)
+    assert "color score histogram" in image_alts(scores) and "uv score histogram" not in image_alts(scores)
     renders = section(colours, "renders")
     assert "vertex colours" in renders.text()
     assert {"split render", "hybrid render", "mvc render"} <= set(image_alts(renders))
@@ -227,7 +227,7 @@ def test_output_into_an_unwritable_place_is_an_error_and_writes_nothing(tmp_path
 
 def test_scores_are_the_lint_rule_values_for_every_quad():
     from affinity.lint import lint_mesh
-    from affinity.report.scores import quad_scores
+    from affinity.lint import quad_scores
     from affinity.scenes import demo_sphere
     from affinity.settings import Settings
 

@@ -146,11 +146,11 @@ def test_pareto_front_keeps_only_unbeaten_candidates():
 
 @pytest.fixture(scope="module")
 def trapezoid_rows():
-    from affinity.study.cases import builtin_cases
+    from affinity.scenes import study_scenes
     from affinity.study.sweep import StudySettings, prepare, study_scene
 
     settings = StudySettings(width=160, height=120, repeat=1, warmup=0, tolerances=(0.5,))
-    case = next(case for case in builtin_cases() if case.name == "trapezoid front")
+    case = next(case for case in study_scenes() if case.name == "trapezoid front")
     rows = study_scene(prepare(case, settings), settings)
     return {row["method"]: row for row in rows if row["method"] != "hybrid" or row["route"] == "view"}
 

@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from affinity.texture import TextureError, checker, load_image, sample_bilinear
+from affinity.draw.texture import TextureError, checker, load_image, sample_bilinear
 
 
 def test_sampling_at_texel_centres_returns_the_texels():

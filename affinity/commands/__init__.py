@@ -7,14 +7,19 @@ for NumPy and nothing heavier.
 EXIT_CLEAN, EXIT_FINDINGS, EXIT_ERROR = 0, 1, 2
 
 
+def spelling(text: str) -> str:
+    """An argparse ``type`` for attribute names: ``color`` everywhere, ``colour`` accepted."""
+    return "color" if text == "colour" else text
+
+
 def require(modules: tuple[str, ...], extra: str) -> None:
     """Stop with one line naming the missing modules and the extra that installs them.
 
-    Raises ``affinity.check.UsageError`` (exit 2) instead of an ImportError traceback.
+    Raises ``affinity.errors.UsageError`` (exit 2) instead of an ImportError traceback.
     """
     import importlib.util
 
-    from ..check import UsageError
+    from ..errors import UsageError
 
     missing = [name for name in modules if importlib.util.find_spec(name) is None]
     if missing:

@@ -1,8 +1,7 @@
 """``affinity bench [MESH...] [--quick] -o DIR``: error against run time, every method and hybrid setting.
 
 Without MESH it studies the built-in scenes (the paper's figures and a
-nonplanar quad strip) and every mesh of ``../shared/meshes`` when that folder
-is there; ``--quick`` keeps three small built-in scenes at a small size and
+nonplanar quad strip); MESH may name files or folders of meshes. ``--quick`` keeps three small built-in scenes at a small size and
 finishes in seconds (for CI). Writes ``study.csv``, ``summary.md`` and PNG
 charts into DIR.
 """
@@ -11,7 +10,7 @@ from __future__ import annotations
 
 import sys
 
-from ..check import UsageError
+from ..errors import UsageError
 from . import EXIT_CLEAN, require
 from .render import _size as image_size
 
@@ -23,7 +22,7 @@ def add_parser(sub) -> None:
                     "settings; time them and compare each with exact. Writes study.csv, summary.md and charts.",
     )
     p.add_argument("meshes", nargs="*", metavar="MESH",
-                   help="meshes to study (default: the built-in scenes and ../shared/meshes when present)")
+                   help="mesh files or folders to study (default: the built-in scenes)")
     p.add_argument("-o", "--output", required=True, metavar="DIR", help="folder for the CSV, summary and charts")
     p.add_argument("--quick", action="store_true", help="three small built-in scenes, small images, two repeats")
     p.add_argument("--route", choices=["view", "lint"], default="view",
@@ -49,7 +48,9 @@ def run(args) -> int:
 
     require(("PIL", "matplotlib"), "report")
 
-    from ..study.cases import builtin_cases, mesh_cases, shared_mesh_paths
+    from ..pipeline.files import collect_paths
+    from ..scenes import study_scenes
+    from ..study.cases import mesh_cases
     from ..study.run import run_cases, write_outputs
     from ..study.sweep import QUICK, StudySettings
 
@@ -62,10 +63,7 @@ def run(args) -> int:
             raise UsageError(f"--repeat must be at least 1, got {args.repeat}")
         changes["repeat"] = args.repeat
     settings = dataclasses.replace(settings, **changes)
-    if args.meshes:
-        cases = mesh_cases(args.meshes)
-    else:
-        cases = builtin_cases(quick=args.quick) + ([] if args.quick else mesh_cases(shared_mesh_paths()))
+    cases = mesh_cases(collect_paths(args.meshes)) if args.meshes else study_scenes(quick=args.quick)
 
     def progress(line: str) -> None:
         if not args.quiet:

@@ -13,7 +13,7 @@ import math
 import os
 import sys
 
-from ..check import UsageError
+from ..errors import UsageError
 from . import EXIT_CLEAN, EXIT_ERROR, EXIT_FINDINGS
 
 
@@ -139,7 +139,7 @@ def _progress_bar():
 
 def _tasks(resolver, paths: list[str]) -> list:
     """``(file, settings)`` for every mesh file to check: excluded files dropped, per-file ignores applied."""
-    from ..check import collect_paths
+    from ..pipeline.files import collect_paths
 
     return [
         (path, settings.for_file(path))
@@ -149,7 +149,7 @@ def _tasks(resolver, paths: list[str]) -> list:
 
 
 def _write_baseline(reports, path: str, quiet: bool) -> None:
-    from .. import baseline
+    from ..pipeline import baseline
 
     recorded = baseline.record(reports, path)
     baseline.write(recorded, path)
@@ -159,7 +159,7 @@ def _write_baseline(reports, path: str, quiet: bool) -> None:
 
 
 def run(args) -> int:
-    from ..check import check_files
+    from ..pipeline.check import check_files
     from ..config import Resolver
     from ..loaders.usd import UsdOptions
     from ..output import CheckRun
@@ -180,7 +180,7 @@ def run(args) -> int:
     if not paths:
         raise UsageError("no PATH given (name files or directories, or use --demo)")
     if args.baseline:
-        from .. import baseline
+        from ..pipeline import baseline
 
         known = baseline.read(args.baseline)  # before the check: a bad baseline fails fast
 

@@ -9,11 +9,11 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ..check import UsageError
-from . import EXIT_CLEAN, require
+from ..errors import UsageError
+from . import EXIT_CLEAN, require, spelling
 
 METHODS = ("hybrid", "split", "mvc", "bilinear", "projective", "exact")
-SHOW_MODES = ("uv", "color", "normal", "shaded")  # what affinity.rendering.shade draws
+SHOW_MODES = ("uv", "color", "normal", "shaded")  # what affinity.draw.shading.shade draws
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -52,7 +52,7 @@ def add_parser(sub) -> None:
     p.add_argument("--size", type=_size, default=(800, 600), metavar="WxH")
     p.add_argument("--camera", type=_camera, metavar="EX,EY,EZ,TX,TY,TZ,FOV")
     p.add_argument("--up", choices=["x", "y", "z"], default=None, help="world up axis (default: the stage's upAxis for USD, else y; z for the demo)")
-    p.add_argument("--show", choices=SHOW_MODES,
+    p.add_argument("--show", choices=SHOW_MODES, type=spelling,
                    help="what to draw (default: uv when the mesh has it, else color, else shaded)")
     p.add_argument("--texture", metavar="IMAGE", help="texture image for uv (default: map_Kd, else a checker)")
     p.add_argument("--overlay", choices=["flags"], help="tint the quads sent to mvc")
@@ -63,9 +63,9 @@ def add_parser(sub) -> None:
 
 def run(args) -> int:
     require(("PIL",), "render")
-    from ..hybrid import RenderOptions, render_mesh
-    from ..mesh import MeshError
-    from ..texture import TextureError
+    from ..draw import RenderOptions, render_mesh
+    from ..draw.texture import TextureError
+    from ..errors import MeshError
 
     try:
         options = RenderOptions(

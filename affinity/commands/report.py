@@ -12,7 +12,7 @@ from __future__ import annotations
 import os
 import sys
 
-from ..check import UsageError
+from ..errors import UsageError
 from . import EXIT_CLEAN, EXIT_ERROR, require
 
 
@@ -43,7 +43,7 @@ def _check_writable(path: str) -> None:
 
 
 def _inputs(paths: list[str], resolver) -> list:
-    from ..check import collect_paths
+    from ..pipeline.files import collect_paths
     from ..report.demo import MeshInput, demo_inputs
 
     if not paths:

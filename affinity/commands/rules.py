@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import sys
 
-from ..check import UsageError
+from ..errors import UsageError
 from . import EXIT_CLEAN
 
 

@@ -11,7 +11,7 @@ import sys
 import time
 from pathlib import Path
 
-from ..check import UsageError
+from ..errors import UsageError
 from . import EXIT_CLEAN, EXIT_FINDINGS, require
 
 DEFAULT_DIR = "reports/stability"

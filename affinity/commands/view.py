@@ -6,10 +6,10 @@ of opening a window (the report's overview picture is the same scene).
 
 from __future__ import annotations
 
-from ..check import UsageError
-from . import EXIT_CLEAN, require
+from ..errors import MeshError, SkippedFile, UsageError
+from . import EXIT_CLEAN, require, spelling
 
-ATTRIBUTES = ("uv", "colour", "normal")
+ATTRIBUTES = ("uv", "color", "normal")
 
 
 def add_parser(sub) -> None:
@@ -18,7 +18,7 @@ def add_parser(sub) -> None:
         description="Open MESH in a window, coloured by every quad's affinity score, flagged quads outlined.",
     )
     p.add_argument("mesh", metavar="MESH")
-    p.add_argument("--attribute", choices=ATTRIBUTES,
+    p.add_argument("--attribute", choices=ATTRIBUTES, type=spelling,
                    help="the score to colour by (default: uv, else colour, else normal)")
     p.add_argument("--up", choices=["x", "y", "z"], help="world up axis")
     p.add_argument("--screenshot", metavar="PNG", help="render off-screen into PNG instead of opening a window")
@@ -28,12 +28,12 @@ def add_parser(sub) -> None:
 def _scores(mesh, path: str, attribute: str | None):
     """The chosen attribute's scores under the file's configuration, None when the mesh has nothing to score."""
     from ..config import Resolver
-    from ..report.scores import SCORED_ATTRIBUTES, quad_scores, scored_codes, shown_code
+    from ..lint import quad_scores, scored_code_of, scored_codes
 
     if attribute is None:
-        code = shown_code(mesh)
+        code = next(iter(scored_codes(mesh)), None)  # uv, else colours, else normals
     else:
-        code = next(c for c, (name, _) in SCORED_ATTRIBUTES.items() if name == attribute)
+        code = scored_code_of(attribute)
         if code not in scored_codes(mesh):
             raise UsageError(f"{path}: the mesh has no {attribute} attribute to score")
     if code is None:
@@ -43,7 +43,6 @@ def _scores(mesh, path: str, attribute: str | None):
 
 def run(args) -> int:
     from ..loaders import load
-    from ..mesh import MeshError, SkippedFile
     from ..view import overview_image, show
 
     require(("pyvista",), "view")
@@ -57,7 +56,7 @@ def run(args) -> int:
     if args.screenshot is None:
         show(mesh, scores, args.up)
         return EXIT_CLEAN
-    from ..png import write_png
+    from ..draw.png import write_png
 
     pixels = overview_image(mesh, scores, None, args.up, (800, 600))
     try:

@@ -12,7 +12,8 @@ from __future__ import annotations
 
 import os
 
-from ..mesh import Mesh, MeshError, SkippedFile
+from ..errors import MeshError, SkippedFile
+from ..mesh import Mesh
 from .obj import load_obj
 from .off import load_off
 from .ply import load_ply

@@ -6,7 +6,8 @@ import os
 
 import numpy as np
 
-from ..mesh import Mesh, MeshError
+from ..errors import MeshError
+from ..mesh import Mesh
 
 
 def ragged_positions(starts: np.ndarray, sizes: np.ndarray, stride: int = 1) -> np.ndarray:

@@ -33,7 +33,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..mesh import Mesh, MeshError
+from ..errors import MeshError
+from ..mesh import Mesh
 from .faces import check_indices, ragged_positions
 from .mtl import read_material_textures
 from .numbers import PAD, parse_floats, parse_ints

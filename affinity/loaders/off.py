@@ -12,7 +12,8 @@ import re
 
 import numpy as np
 
-from ..mesh import Mesh, MeshError
+from ..errors import MeshError
+from ..mesh import Mesh
 from .faces import polygon_mesh, ragged_positions, unit_colors
 from .text import read_rows
 

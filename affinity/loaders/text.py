@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..mesh import MeshError
+from ..errors import MeshError
 from .numbers import PAD, parse_floats
 
 #: Bytes read per chunk: large enough that per-chunk overhead vanishes, small

@@ -45,7 +45,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..mesh import Mesh, MeshError
+from ..errors import MeshError
+from ..mesh import Mesh
 
 USD_SUFFIXES = (".usd", ".usda", ".usdc", ".usdz")
 INSTALL = "pip install 'quad-affinity[usd]'"

@@ -39,7 +39,6 @@ SARIF_VERSION = "2.1.0"
 SARIF_SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
 SRCROOT = "%SRCROOT%"
 FINGERPRINT = "quadAffinity/v1"
-_RULE_INDEX = {code: i for i, code in enumerate(RULES)}
 
 
 def _descriptor(rule) -> dict:
@@ -78,6 +77,7 @@ def fingerprint(code: str, uri: str, group: str, value: float, ordinal: int) -> 
 def _results(report: FileReport) -> list[dict]:
     location = artifact_location(report.path)
     seen: dict[tuple, int] = {}
+    rule_index = {code: i for i, code in enumerate(RULES)}  # registered rules, as the driver lists them
     results = []
     for f in file_findings(report)[0]:
         identity = (f.code, f.group, value_token(f.value))
@@ -88,7 +88,7 @@ def _results(report: FileReport) -> list[dict]:
             result_location["logicalLocations"] = [logical]
         results.append({
             "ruleId": f.code,
-            "ruleIndex": _RULE_INDEX[f.code],
+            "ruleIndex": rule_index[f.code],
             "level": RULES[f.code].level,
             "message": {"text": located(f)},
             "locations": [result_location],

@@ -2,7 +2,7 @@
 
 Nothing here decides what the page shows; :mod:`affinity.report.sections` does,
 from the :class:`MeshResult` collected here. Renders go through
-``affinity.hybrid.render_mesh``, so the pictures are exactly what
+``affinity.draw.render_mesh``, so the pictures are exactly what
 ``affinity render`` draws.
 """
 
@@ -17,10 +17,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..findings import FileReport
+from ..lint import QuadScores, quad_scores, scored_codes
 from ..mesh import Mesh
 from ..settings import Settings
-from .demo import MeshInput, View
-from .scores import QuadScores, quad_scores, scored_codes, shown_code
+from ..scenes import View
+from .demo import MeshInput
 
 RENDER_SIZE = (480, 360)
 #: Methods drawn beside the hybrid when it sent quads to mvc (``exact``: the ray / bilinear-patch reference).
@@ -76,7 +77,7 @@ def _texture_label(mesh: Mesh, view: View) -> str:
         return ""
     if view.checks:
         return f"checker texture, {view.checks} squares across"
-    from ..imagesize import image_size
+    from ..loaders.imagesize import image_size
 
     path = mesh.texture_path()
     if path is None:
@@ -87,9 +88,9 @@ def _texture_label(mesh: Mesh, view: View) -> str:
 
 def _render(result: MeshResult, texture: np.ndarray | None, step: Callable[[str], None]) -> None:
     """The hybrid render; when it sent quads to mvc, the compared methods and the overlay too."""
-    from ..hybrid import RenderOptions, render_mesh
-    from ..routing import MVC
-    from ..texture import TextureError
+    from ..draw.drawing import RenderOptions, render_mesh
+    from ..draw.routing import MVC
+    from ..draw.texture import TextureError
 
     view = result.input.view
 
@@ -137,8 +138,8 @@ def _overview(result: MeshResult, step: Callable[[str], None]) -> None:
 
 def collect_mesh(item: MeshInput, settings: Settings, step: Callable[[str], None] = lambda name: None) -> MeshResult:
     """Lint, score, render and picture one mesh; an unreadable file gives a result with ``file.error``."""
-    from ..check import load_and_check
-    from ..texture import checker
+    from ..pipeline.check import load_and_check
+    from ..draw.texture import checker
 
     start = time.perf_counter()
     step("lint")
@@ -147,7 +148,7 @@ def collect_mesh(item: MeshInput, settings: Settings, step: Callable[[str], None
     if result.readable:
         step("scores")
         result.scores = {code: quad_scores(result.mesh, settings, code) for code in scored_codes(result.mesh)}
-        result.shown = shown_code(result.mesh)
+        result.shown = next(iter(result.scores), None)  # uv, else colours, else normals
         result.texture = _texture_label(result.mesh, item.view)
         has_uv = result.mesh.texcoords is not None
         _render(result, checker(512, item.view.checks) if item.view.checks and has_uv else None, step)

@@ -6,10 +6,8 @@ import io
 
 import numpy as np
 
-from ..rendering import OVERLAY_TINT
+from ..draw.shading import FLAG_COLOUR
 
-#: Flagged quads are drawn in the render overlay's tint everywhere in the report.
-FLAG_COLOUR = "#" + "".join(f"{round(c * 255):02x}" for c in OVERLAY_TINT)
 PASS_COLOUR = "#5b7fa6"
 #: Values spanning more than this ratio get a logarithmic x axis.
 LOG_SPAN = 100.0

@@ -9,7 +9,7 @@ import base64
 
 import numpy as np
 
-from ..png import png_bytes, to_pixels
+from ..draw.png import png_bytes, to_pixels
 
 #: A crop never shows less than this many pixels across, so a tiny quad keeps some context.
 MIN_CROP = 16

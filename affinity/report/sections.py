@@ -14,10 +14,10 @@ from pathlib import Path
 
 import numpy as np
 
+from ..mesh import ATTRIBUTE_NAMES
 from ..rules import RULES, resolve_codes, with_unit
 from .build import MeshResult, ReportRun
 from .images import crop_box, data_uri, heatmap_uri, image_uri, png_bytes, zoomed_uri
-from .scores import SCORED_ATTRIBUTES, unit_of
 
 #: Methods in the order the renders are shown.
 METHOD_ORDER = ("split", "hybrid", "mvc", "exact")
@@ -34,10 +34,7 @@ ZOOM_SIZE = 168
 MIN_VISIBLE_PIXELS = 9
 #: Scores below this fraction of the threshold are affine up to rounding; they go in the first bin.
 SCORE_FLOOR = 1e-3
-#: Rules whose worst values are the lowest: the relative areas (flagged at or below
-#: their threshold) and Q302's negative uv area (see affinity.lint).
-LOWEST_IS_WORST = frozenset({"Q201", "Q301", "Q302"})
-MISSING_ATTRIBUTE = {"Q101": "no texture coordinates", "Q102": "no vertex colours", "Q103": "no normals"}
+MISSING_ATTRIBUTE = {"texcoords": "no texture coordinates", "colors": "no vertex colours", "normals": "no normals"}
 #: Where the stability section looks for ``affinity stability``'s table, in order.
 STABILITY_RESULTS = (
     Path("reports/stability/stability.csv"),
@@ -74,7 +71,7 @@ def number(value: float) -> str:
 def _threshold_text(code: str, threshold: float | None, settings) -> str:
     if threshold is None or RULES[code].default_threshold is None:
         return "—"
-    return with_unit(number(threshold), unit_of(code, settings))
+    return with_unit(number(threshold), RULES[code].unit_for(settings.measure))
 
 
 # --- the whole run ----------------------------------------------------------------------------
@@ -140,7 +137,7 @@ def study_section(run: ReportRun) -> Section:
     look; ``affinity bench`` times with warm-up and repeats and sweeps the
     hybrid's settings.
     """
-    from ..hybrid import RenderOptions
+    from ..draw.drawing import RenderOptions
     from ..study.charts import error_against_time
     from ..study.sweep import mark_pareto
 
@@ -150,7 +147,7 @@ def study_section(run: ReportRun) -> Section:
         errors = _errors_against_exact(result) if result.readable and "exact" in result.renders else None
         if errors is None:
             continue
-        unit = unit_of(result.shown, result.settings)
+        unit = RULES[result.shown].unit_for(result.settings.measure)
         of_mesh = [
             {"scene": result.input.label, "method": method, "route": "view" if method == "hybrid" else "",
              "setting": RenderOptions.pixel_tolerance if method == "hybrid" else np.nan,
@@ -197,8 +194,8 @@ def findings_section(result: MeshResult) -> Section:
         return leave_out("findings", title, "nothing flagged: every quad passes every enabled rule")
     rows = []
     for hits in result.file.hits:
-        severity = hits.values if hits.code in LOWEST_IS_WORST else -hits.values
-        unit = unit_of(hits.code, result.settings)
+        severity = hits.values if RULES[hits.code].worst == "lowest" else -hits.values
+        unit = RULES[hits.code].unit_for(result.settings.measure)
         worst = [
             {"face": int(hits.faces[i]), "line": int(hits.lines[i]),
              "group": result.file.group_names[hits.groups[i]], "value": with_unit(number(hits.values[i]), unit)}
@@ -260,7 +257,7 @@ def renders_section(result: MeshResult) -> Section:
     title = "Renders"
     if result.render_error:
         return leave_out("renders", title, f"cannot render: {result.render_error}")
-    from ..routing import MVC
+    from ..draw.routing import MVC
 
     hybrid = result.renders["hybrid"]
     routed = int(np.count_nonzero(hybrid.methods == MVC))
@@ -291,8 +288,8 @@ def overlay_section(result: MeshResult) -> Section:
         reason = (f"cannot render: {result.render_error}" if result.render_error
                   else "nothing was sent to mvc in this view, so there is nothing to tint")
         return leave_out("overlay", title, reason)
-    from ..hybrid import RenderOptions
-    from ..routing import MVC
+    from ..draw.drawing import RenderOptions
+    from ..draw.routing import MVC
 
     overlay = result.overlay
     return Section("overlay", title, {
@@ -315,8 +312,8 @@ def _errors_against_exact(result: MeshResult) -> dict | None:
     (the split may show another quad at a concave or bow-tie one); None for plain shading."""
     if result.shown is None:
         return None
-    from ..imagesize import image_size
-    from .errors import pixel_error
+    from ..loaders.imagesize import image_size
+    from ..measures import pixel_error
 
     exact = result.renders["exact"].frame
     texture_size = image_size(result.mesh.texture_path()) or (result.settings.texture_size,) * 2
@@ -325,7 +322,8 @@ def _errors_against_exact(result: MeshResult) -> dict | None:
         frame = result.renders[method].frame
         covered = (frame.face >= 0) & (frame.face == exact.face)
         error = np.zeros(covered.shape)
-        error[covered] = pixel_error(frame.attrs[covered], exact.attrs[covered], result.shown, texture_size)
+        error[covered] = pixel_error(frame.attrs[covered], exact.attrs[covered], RULES[result.shown].attribute,
+                                      texture_size)
         errors[method] = error, covered
     return errors
 
@@ -339,7 +337,7 @@ def error_heatmaps_section(result: MeshResult) -> Section:
     if errors is None:
         return leave_out("errors", title, "the renders show plain shading: no attribute to compare")
     del errors["exact"]
-    unit = unit_of(result.shown, result.settings)
+    unit = RULES[result.shown].unit_for(result.settings.measure)
     scale = max(float(np.percentile(e[c], 99)) if c.any() else 0.0 for e, c in errors.values())
     figures = [
         {"method": method, "src": heatmap_uri(error, covered, scale),
@@ -356,10 +354,11 @@ def score_histograms_section(result: MeshResult) -> Section:
 
     title = "Affinity scores"
     charts, skipped = [], []
-    for code, (attribute, _) in SCORED_ATTRIBUTES.items():
+    for code in (code for code, rule in RULES.items() if rule.scored):
+        attribute = ATTRIBUTE_NAMES[RULES[code].attribute]
         scores = result.scores.get(code)
         if scores is None:
-            skipped.append(f"{attribute} ({MISSING_ATTRIBUTE[code]})")
+            skipped.append(f"{attribute} ({MISSING_ATTRIBUTE[RULES[code].attribute]})")
             continue
         floor = scores.threshold * SCORE_FLOOR
         if not (scores.values >= floor).any():

@@ -2,8 +2,8 @@
 
 One module per job:
 
-- :mod:`.cases` — the scenes: the paper's figures rebuilt, the nonplanar quad
-  strip, and real meshes (``../shared/meshes`` when present), each with its view;
+- :mod:`.cases` — mesh files as study scenes (the built-in ones are
+  ``affinity.scenes.study_scenes``), each with its view;
 - :mod:`.sweep` — one scene: every method and hybrid setting drawn, timed and
   compared with the ``exact`` reference; the Pareto front;
 - :mod:`.metrics` — attribute error (RMS, p99, max), PSNR, SSIM, crease;

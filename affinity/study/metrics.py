@@ -4,7 +4,7 @@ All functions are vectorised over pixels (and over quads for the crease) and
 work on the pixels that both renders cover.
 
 - :func:`error_summary` — RMS, 99th percentile and maximum of a per-pixel error
-  (``affinity.report.errors.pixel_error`` gives it in the lint's units:
+  (``affinity.measures.pixel_error`` gives it in the lint's units:
   texels for uv, 1/255 steps for colours).
 - :func:`psnr` and :func:`ssim` — of the textured images, in [0, 1] RGB.
   SSIM is Wang, Bovik, Sheikh & Simoncelli 2004 (eq. 13, Gaussian window
@@ -88,7 +88,7 @@ def _gaussian_blur(channels: np.ndarray) -> np.ndarray:
 def texels_per_pixel(uv: np.ndarray, face: np.ndarray, texture_size) -> np.ndarray:
     """Local texture density sqrt|det d(u W, v H) / d(column, row)| of a render, (H, W) float64.
 
-    The on-screen scale the hybrid's routing uses per quad (``affinity.routing``:
+    The on-screen scale the hybrid's routing uses per quad (``affinity.draw.routing``:
     sqrt(screen area / uv area)), here per pixel, from differences between
     neighbouring pixels of the same quad (forward where the next pixel belongs
     to it, else backward); NaN where a pixel has no such neighbour in a direction.

@@ -7,7 +7,7 @@ import os
 from collections.abc import Callable
 
 from ..atomic import atomic_write
-from .cases import Case
+from ..scenes import Scene
 from .sweep import StudySettings, prepare, study_scene
 from .timing import machine_facts
 
@@ -16,10 +16,10 @@ SUMMARY_NAME = "summary.md"
 CHART_NAMES = ("error_vs_time.png", "hybrid_sweep.png", "relative_cost.png")
 
 
-def run_cases(cases: list[Case], settings: StudySettings,
+def run_cases(cases: list[Scene], settings: StudySettings,
               progress: Callable[[str], None] = lambda line: None) -> tuple[list[dict], list[str]]:
     """Study every case in order. Returns the rows and one line per case that could not be studied."""
-    from ..mesh import MeshError
+    from ..errors import MeshError
 
     rows, skipped = [], []
     for number, case in enumerate(cases, 1):

@@ -8,7 +8,7 @@ clip-space quads, at the same size):
   quads' corners renumbered 1, 2, 3, 0), for the diagonal dependence;
 - the hybrid routed by view (uv only) at every pixel tolerance: a quad goes to
   mvc when its misplacement times its on-screen scale exceeds the tolerance
-  (``affinity.routing``);
+  (``affinity.draw.routing``);
 - the hybrid routed by the lint (with ``lint_route``, and always for colours,
   which the hybrid routes by the lint): a quad goes to mvc when its rule value
   exceeds the threshold, in the misplacement reading and, for uv, in the
@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..mesh import Mesh
-from .cases import Case
+from ..scenes import Scene
 from .metrics import crease, error_summary, psnr, ssim, texels_per_pixel
 from .timing import time_interleaved
 
@@ -68,17 +68,17 @@ QUICK = StudySettings(width=240, height=180, repeat=2, tolerances=(0.1, 0.5, 2.0
 
 
 @dataclass
-class Scene:
+class PreparedScene:
     """A case ready to draw.
 
     ``faces`` (R,) the mesh face of each render quad; ``clip`` (R, 4, 4);
-    ``inputs`` the attributes drawn (``affinity.rendering.ShadingInputs``);
+    ``inputs`` the attributes drawn (``affinity.draw.shading.ShadingInputs``);
     ``code`` the lint rule of the attribute shown (Q101 uv, Q102 colours);
     ``routes`` maps a hybrid route name to (its per-render-quad values (R,),
     the settings to sweep, the seconds the values took to compute).
     """
 
-    case: Case
+    case: Scene
     mesh: Mesh
     faces: np.ndarray
     clip: np.ndarray
@@ -108,16 +108,17 @@ class Config:
     setup_s: float = np.nan
 
 
-def prepare(case: Case, settings: StudySettings) -> Scene:
+def prepare(case: Scene, settings: StudySettings) -> PreparedScene:
     """Load, frame and convert a case; compute the per-quad measures the hybrid routes on.
 
     Raises ValueError for a mesh without faces, or with neither uv nor vertex colours (nothing to compare).
     """
     from render import to_clip
 
-    from ..hybrid import RenderOptions, camera_for
-    from ..rendering import render_corners, shading_inputs
-    from ..texture import checker
+    from ..draw.framing import camera_for
+    from ..draw.quads import render_corners
+    from ..draw.shading import shading_inputs
+    from ..draw.texture import checker
 
     mesh = case.mesh()
     if mesh.n_faces == 0:
@@ -126,21 +127,19 @@ def prepare(case: Case, settings: StudySettings) -> Scene:
     if show is None:
         raise ValueError(f"{case.name}: no texture coordinates or vertex colours to compare")
     faces, corners = render_corners(mesh)
-    camera = camera_for(mesh, RenderOptions(width=settings.width, height=settings.height, camera=case.camera,
-                                            up=case.up), is_demo=False)
+    camera = camera_for(mesh, settings.width, settings.height, case.view.camera, case.view.up)
     clip = to_clip(mesh.positions, camera.matrix)[mesh.corner_vertex[corners]]
     direction = np.subtract(camera.eye, camera.target)
-    scene = Scene(case, mesh, faces, clip, shading_inputs(mesh, corners, show), show,
+    scene = PreparedScene(case, mesh, faces, clip, shading_inputs(mesh, corners, show), show,
                   "Q101" if show == "uv" else "Q102", checker(settings.texture_size) if show == "uv" else None,
                   direction / np.linalg.norm(direction))
     scene.routes = _routes(scene, settings)
     return scene
 
 
-def _routes(scene: Scene, settings: StudySettings) -> dict:
+def _routes(scene: PreparedScene, settings: StudySettings) -> dict:
     """Route name -> (values per render quad, settings to sweep, seconds to compute the values)."""
-    from ..lint import quad_uv_misplacement
-    from ..report.scores import quad_scores
+    from ..lint import quad_scores, quad_uv_misplacement
     from ..settings import Settings
 
     routes = {}
@@ -162,18 +161,18 @@ def _routes(scene: Scene, settings: StudySettings) -> dict:
     return routes
 
 
-def _per_render_quad(scene: Scene, faces: np.ndarray, values: np.ndarray) -> np.ndarray:
+def _per_render_quad(scene: PreparedScene, faces: np.ndarray, values: np.ndarray) -> np.ndarray:
     """Values given for some mesh faces, spread to the render quads (0 for faces not listed)."""
     per_face = np.zeros(scene.mesh.n_faces)
     per_face[faces] = values
     return per_face[scene.faces]
 
 
-def configurations(scene: Scene, settings: StudySettings) -> list[Config]:
+def configurations(scene: PreparedScene, settings: StudySettings) -> list[Config]:
     """Everything drawn for a scene: the plain methods, then each hybrid route at each setting."""
     from render import rasterize_quads
 
-    from ..routing import MVC
+    from ..draw.routing import MVC
 
     attrs, width, height = scene.inputs.attrs, settings.width, settings.height
     rotated = (scene.clip[:, ROTATED], attrs[:, ROTATED])
@@ -193,9 +192,9 @@ def configurations(scene: Scene, settings: StudySettings) -> list[Config]:
     return configs
 
 
-def _chooser(scene: Scene, route: str, values: np.ndarray, setting: float, width: int, height: int):
+def _chooser(scene: PreparedScene, route: str, values: np.ndarray, setting: float, width: int, height: int):
     """The hybrid's per-frame decision: a function giving the method of every render quad (R,) str."""
-    from ..routing import MVC, SPLIT, route_by_view
+    from ..draw.routing import MVC, SPLIT, route_by_view
 
     if route == "view":
         uv = scene.inputs.attrs[..., scene.inputs.uv]
@@ -203,9 +202,9 @@ def _chooser(scene: Scene, route: str, values: np.ndarray, setting: float, width
     return lambda: np.where(values > setting, MVC, SPLIT)
 
 
-def study_scene(scene: Scene, settings: StudySettings) -> list[dict]:
+def study_scene(scene: PreparedScene, settings: StudySettings) -> list[dict]:
     """Time every configuration (interleaved) and compare each with exact: one row (``COLUMNS``) each."""
-    from ..rendering import shade
+    from ..draw.shading import shade
 
     configs = configurations(scene, settings)
     timings = time_interleaved([config.draw for config in configs], settings.repeat, settings.warmup)
@@ -249,18 +248,20 @@ def _compared(scene, settings, frame, reference):
     """Pixels where both show the same quad (H, W) bool and the per-pixel error (N,) of ``frame``
     against ``reference`` there. (Split and the quad-filling methods may show different quads at a
     pixel of a concave or bow-tie quad: that is coverage, not interpolation, and is left out.)"""
-    from ..report.errors import pixel_error
+    from ..measures import pixel_error
+    from ..rules import RULES
 
     both = (frame.face >= 0) & (frame.face == reference.face)
-    error = pixel_error(frame.attrs[both][:, scene.columns], reference.attrs[both][:, scene.columns], scene.code,
-                        settings.texture_size)
+    error = pixel_error(frame.attrs[both][:, scene.columns], reference.attrs[both][:, scene.columns],
+                        RULES[scene.code].attribute, settings.texture_size)
     return both, error
 
 
 def _errors(scene, settings, frame, exact, image, exact_image, clip, density) -> dict:
     """Attribute error (and, given the texture density (H, W), in screen pixels), PSNR, SSIM
     against exact, and the crease of ``frame``."""
-    from ..report.errors import pixel_error
+    from ..measures import pixel_error
+    from ..rules import RULES
 
     both, error = _compared(scene, settings, frame, exact)
     summary = error_summary(error)
@@ -271,7 +272,7 @@ def _errors(scene, settings, frame, exact, image, exact_image, clip, density) ->
         in_pixels = error_summary(pixels[np.isfinite(pixels)])
     jump, pixels = crease(frame.attrs[..., scene.columns], frame.face, clip)
     fitted = ~np.isnan(jump).any(axis=1)
-    size = pixel_error(jump[fitted], np.zeros_like(jump[fitted]), scene.code, settings.texture_size)
+    size = pixel_error(jump[fitted], np.zeros_like(jump[fitted]), RULES[scene.code].attribute, settings.texture_size)
     measured = bool(both.any())
     return {
         "unit": "texels" if scene.code == "Q101" else "1/255",

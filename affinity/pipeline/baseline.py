@@ -24,10 +24,10 @@ from collections import Counter
 
 import numpy as np
 
-from .atomic import atomic_write
-from .check import UsageError
-from .findings import FileReport, RuleHits
-from .output import group_name, value_token
+from ..atomic import atomic_write
+from ..errors import UsageError
+from ..findings import FileReport, RuleHits
+from ..output import group_name, value_token
 
 SCHEMA = "quad-affinity-baseline"
 VERSION = 1

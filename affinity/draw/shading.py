@@ -1,7 +1,7 @@
-"""Turn a mesh into the renderer's clip-space quads, route them, and shade the result.
+"""Shading: the attributes a render needs per corner, and the colour of every covered pixel.
 
-``render`` takes quads only (design.md): quads pass as they are, triangles as
-quads with a repeated last corner, n-gons are fanned into triangles here.
+Also the palette every picture of the project shares: the background and the
+tint that marks flagged quads (``FLAG_COLOUR`` as a CSS colour).
 """
 
 from __future__ import annotations
@@ -10,43 +10,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .mesh import Mesh
+from ..mesh import Mesh
 
 BACKGROUND = np.array([1.0, 1.0, 1.0], dtype=np.float32)
 OVERLAY_TINT = np.array([1.0, 0.1, 0.6], dtype=np.float32)
-
-
-def render_corners(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
-    """The mesh as renderable quads.
-
-    Returns
-    -------
-    faces : (R,) int64
-        The mesh face each render quad comes from.
-    corners : (R, 4) int64
-        Corner indices; a triangle repeats its last corner, an n-gon becomes
-        the fan (0, i, i+1, i+1) of triangles.
-    """
-    faces, corners = [], []
-    for size in np.unique(mesh.face_sizes).tolist():
-        of_size, face_corners = mesh.faces_of_size(size)
-        if size == 4:
-            quads = face_corners
-            owners = of_size
-        else:
-            fan = np.arange(1, size - 1)
-            quads = np.stack(
-                [np.repeat(face_corners[:, :1], len(fan), 1), face_corners[:, fan],
-                 face_corners[:, fan + 1], face_corners[:, fan + 1]], axis=-1,
-            ).reshape(-1, 4)
-            owners = np.repeat(of_size, len(fan))
-        faces.append(owners)
-        corners.append(quads)
-    if not faces:
-        return np.zeros(0, np.int64), np.zeros((0, 4), np.int64)
-    faces, corners = np.concatenate(faces), np.concatenate(corners)
-    order = np.argsort(faces, kind="stable")
-    return faces[order], corners[order]
+#: Flagged quads are drawn in the overlay's tint everywhere: renders, report charts, the 3-D view.
+FLAG_COLOUR = "#" + "".join(f"{round(c * 255):02x}" for c in OVERLAY_TINT)
 
 
 def flat_normals(positions: np.ndarray) -> np.ndarray:
@@ -54,7 +23,7 @@ def flat_normals(positions: np.ndarray) -> np.ndarray:
 
     (R, 4, 3) -> (R, 4, 3); zero for a quad whose corners are collinear.
     """
-    from .geometry import quad_normals
+    from ..geometry import quad_normals
 
     n = quad_normals(positions)
     length = np.linalg.norm(n, axis=-1, keepdims=True)

@@ -7,8 +7,8 @@ import os
 
 import numpy as np
 
-from .atomic import atomic_write
-from .mesh import Mesh
+from ..atomic import atomic_write
+from ..mesh import Mesh
 
 
 def _rows(keyword: str, values: np.ndarray) -> str:

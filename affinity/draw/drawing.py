@@ -1,8 +1,9 @@
-"""The hybrid render: every quad drawn as two triangles, except those whose split error shows.
+"""A mesh, a view, an image: ``render_mesh`` with its options and result records.
 
-``render_mesh`` loads a mesh, frames it, decides per quad between ``split`` and
-``mvc`` (``affinity.routing``), calls ``render.rasterize_quads`` with that
-per-quad method array, and shades the result.
+``render_mesh`` loads a mesh, frames it (:mod:`.framing`), turns it into the
+renderer's quads (:mod:`.quads`), picks the method of every quad (one method, or
+the hybrid's per-quad routing, :mod:`.routing`), calls ``render.rasterize_quads``
+and shades the result (:mod:`.shading`).
 """
 
 from __future__ import annotations
@@ -10,22 +11,15 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .mesh import Mesh
-from .rendering import OVERLAY_TINT, render_corners, shade, shading_inputs
+from ..mesh import Mesh
+from .framing import camera_for
+from .quads import render_corners
 from .routing import MVC, SPLIT, route_by_view
-
-UP_AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
-#: Default view direction (from the target toward the eye) for each up axis: in front, to the right, above.
-VIEW_DIRECTIONS = {"x": (1.0, 0.6, 0.5), "y": (0.6, 0.5, 1.0), "z": (0.6, -1.0, 0.5)}
-#: The demo: the lat-long sphere (z up) seen from above the equator, the pole rows in view.
-DEMO_CAMERA = ((0.0, -2.9, 2.1), (0.0, 0.0, 0.05), 40.0)
-#: The lint rule that decides ``--route lint`` for each thing shown.
-LINT_RULE_OF_ATTRIBUTE = {"uv": "Q101", "color": "Q102", "normal": "Q103"}
-
+from .shading import OVERLAY_TINT, shade, shading_inputs
 
 @dataclass
 class RenderOptions:
@@ -85,29 +79,6 @@ def default_show(mesh: Mesh) -> str:
     return "color" if mesh.colors is not None else "shaded"
 
 
-def camera_for(mesh: Mesh, options: RenderOptions, is_demo: bool):
-    """The camera of the options, or one that frames the mesh (the demo has its own)."""
-    from render.camera import Camera, frame_bounds
-
-    aspect = options.width / options.height
-    up_axis = options.up or ("z" if is_demo else (mesh.up_axis or "y").lower())
-    up = UP_AXES[up_axis]
-    chosen = options.camera or (DEMO_CAMERA if is_demo else None)
-    if chosen is None:
-        used = np.unique(mesh.corner_vertex)
-        points = mesh.positions[used]
-        return frame_bounds(points.min(axis=0), points.max(axis=0), aspect=aspect, up=up,
-                            direction=VIEW_DIRECTIONS[up_axis])
-    eye, target, fov = chosen
-    distance = float(np.linalg.norm(np.subtract(eye, target)))
-    if not distance > 0:
-        raise ValueError("--camera: the eye and the target coincide")
-    extent = float(np.ptp(mesh.positions, axis=0).max()) if len(mesh.positions) else 1.0
-    far = distance + 2.0 * max(extent, distance)
-    return Camera(eye=tuple(eye), target=tuple(target), up=up, fov_y=fov, aspect=aspect,
-                  near=far * 1e-4, far=far)
-
-
 def choose_methods(mesh: Mesh, faces: np.ndarray, uv: np.ndarray | None, clip: np.ndarray,
                    show: str, options: RenderOptions) -> np.ndarray:
     """The method of every render quad: one name, or the hybrid's per-quad routing.
@@ -121,17 +92,17 @@ def choose_methods(mesh: Mesh, faces: np.ndarray, uv: np.ndarray | None, clip: n
         return np.full(len(faces), options.method)
     routes_uv = uv is not None
     if options.route == "view" and routes_uv:
-        from .lint import quad_uv_misplacement
+        from ..lint import quad_uv_misplacement
 
         quad_faces, m = quad_uv_misplacement(mesh, diagonal="02")
         per_face = np.zeros(mesh.n_faces)
         per_face[quad_faces] = np.nan_to_num(m)
         return route_by_view(per_face[faces], uv, clip, options.width, options.height,
                              options.pixel_tolerance, options.cull)
-    from .lint import lint_mesh
-    from .settings import Settings
+    from ..lint import lint_mesh, scored_code_of
+    from ..settings import Settings
 
-    code = LINT_RULE_OF_ATTRIBUTE["uv" if routes_uv else ("color" if show == "color" else "normal")]
+    code = scored_code_of("uv" if routes_uv else ("color" if show == "color" else "normal"))
     flagged = np.zeros(mesh.n_faces, dtype=bool)
     for hits in lint_mesh(mesh, Settings(select=[code], diagonal="02")):
         flagged[hits.faces] = True
@@ -168,17 +139,20 @@ def render_mesh(source: str | Mesh | None, options: RenderOptions,
     """
     from render import rasterize_quads, to_clip
 
-    from .loaders import load
-    from .scenes import demo_sphere
+    from ..loaders import load
+    from ..scenes import DEMO_SPHERE
 
-    is_demo = source is None
-    mesh = demo_sphere() if is_demo else load(source) if isinstance(source, (str, os.PathLike)) else source
+    if source is None:
+        mesh, view = DEMO_SPHERE.mesh(), DEMO_SPHERE.view
+        options = replace(options, camera=options.camera or view.camera, up=options.up or view.up)
+    else:
+        mesh = load(source) if isinstance(source, (str, os.PathLike)) else source
     if mesh.n_faces == 0:
         raise ValueError(f"{mesh.path}: the mesh has no faces to render")
     show = options.show or default_show(mesh)
     faces, corners = render_corners(mesh)
     inputs = shading_inputs(mesh, corners, show)
-    camera = camera_for(mesh, options, is_demo=is_demo)
+    camera = camera_for(mesh, options.width, options.height, options.camera, options.up)
     clip = to_clip(mesh.positions, camera.matrix)[mesh.corner_vertex[corners]]
     if not (clip[..., 3] > 0).any():
         raise ValueError(f"{mesh.path}: all geometry is behind the camera")

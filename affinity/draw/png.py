@@ -24,7 +24,7 @@ def png_bytes(pixels: np.ndarray) -> bytes:
 
 def write_png(path: str | os.PathLike, pixels: np.ndarray) -> None:
     """Write (H, W, 3) uint8 pixels as a PNG file, atomically (raises OSError)."""
-    from .atomic import atomic_write
+    from ..atomic import atomic_write
 
     with atomic_write(path, binary=True) as out:
         out.write(png_bytes(pixels))

@@ -1,4 +1,4 @@
-"""``affinity check``: find the mesh files, lint each one, collect one report per file.
+"""Check files: lint each one, collect one report per file.
 
 Each file is checked independently; an unreadable file becomes a report with an
 ``error`` and never stops the others. Files are checked in parallel across
@@ -11,41 +11,11 @@ from __future__ import annotations
 import os
 from collections.abc import Callable, Iterable, Iterator
 from functools import partial
-from pathlib import Path
 
-from .findings import FileReport
-from .mesh import Mesh, MeshError, SkippedFile
-from .settings import Settings
-
-MESH_SUFFIXES = (".obj", ".ply", ".off", ".usd", ".usda", ".usdc", ".usdz")
-
-
-class UsageError(Exception):
-    """Bad command-line input that is not about one mesh file (exit 2)."""
-
-
-def collect_paths(paths: list[str]) -> list[str]:
-    """Expand directories (recursively, sorted) into their mesh files.
-
-    Files named explicitly are kept whatever their extension, so the loader can
-    say what is wrong with them. A directory with no mesh file in it, or a path
-    that does not exist, is a :class:`UsageError`.
-    """
-    files: list[str] = []
-    for given in paths:
-        if os.path.isdir(given):
-            found = sorted(
-                str(p) for p in Path(given).rglob("*")
-                if p.suffix.lower() in MESH_SUFFIXES and p.is_file()
-            )
-            if not found:
-                raise UsageError(f"{given}: no mesh files ({', '.join(MESH_SUFFIXES)}) in this directory")
-            files.extend(found)
-        elif os.path.exists(given):
-            files.append(given)
-        else:
-            raise UsageError(f"{given}: no such file or directory")
-    return list(dict.fromkeys(files))
+from ..errors import MeshError, SkippedFile
+from ..findings import FileReport
+from ..mesh import Mesh
+from ..settings import Settings
 
 
 def check_file(path: str, settings: Settings, usd=None) -> FileReport:
@@ -58,8 +28,8 @@ def check_file(path: str, settings: Settings, usd=None) -> FileReport:
 
 def load_and_check(path: str, settings: Settings, usd=None) -> tuple[FileReport, Mesh | None]:
     """:func:`check_file`, also handing back the loaded mesh (None when it could not be read)."""
-    from .lint import lint_mesh
-    from .loaders import load
+    from ..lint import lint_mesh
+    from ..loaders import load
 
     try:
         mesh = load(path, usd)
@@ -126,7 +96,7 @@ def check_files(
 
     from concurrent.futures import ProcessPoolExecutor
 
-    from . import lint, loaders  # noqa: F401  imported before the workers fork, so each inherits them
+    from .. import lint, loaders  # noqa: F401  imported before the workers fork, so each inherits them
 
     # Small chunks balance uneven file sizes; a few per worker keep the pickling overhead low.
     chunksize = max(1, len(tasks) // (workers * 8))

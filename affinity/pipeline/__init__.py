@@ -1,0 +1,7 @@
+"""Running the check over many files: collecting them, checking each (in parallel), the baseline.
+
+- :mod:`.files`: the paths given, directories expanded into their mesh files;
+- :mod:`.check`: one file's check (``check_file``, never raising for bad input)
+  and many files' (``check_files``, ``--jobs``);
+- :mod:`.baseline`: today's findings recorded, so later runs fail only on new ones.
+"""

@@ -1,0 +1,29 @@
+"""The rules: one registry (:mod:`.registry`), each rule's record beside its check.
+
+- :mod:`.affinity`: Q101-Q103, the attribute is not an affine image of the positions;
+- :mod:`.shape`: Q201-Q204, the quad's own shape;
+- :mod:`.file`: Q205 no-faces, and Q901 unreadable (documented, never linted);
+- :mod:`.texture`: Q301-Q302, the quad in texture space;
+- :mod:`.docs`: a rule's page and the README's table, from the registry.
+
+Adding a rule touches its module (record and check) only: lint, the report,
+SARIF, ``affinity rules`` and the README table read :data:`RULES`.
+"""
+
+from . import affinity, file, shape, texture  # noqa: F401  each registers its rules
+from .docs import SECTIONS, rule_page, rules_table, threshold_text, with_unit
+from .file import UNREADABLE
+from .registry import LEVELS, RULES, Rule, register, resolve_codes, unregister
+
+
+def find_rule(key: str) -> Rule | None:
+    """The rule (Q901 included) with code or name ``key`` (case-insensitive), or None."""
+    key = key.strip()
+    for rule in (*RULES.values(), UNREADABLE):
+        if key.upper() == rule.code or key.lower() == rule.name:
+            return rule
+    return None
+
+
+__all__ = ["LEVELS", "RULES", "SECTIONS", "UNREADABLE", "Rule", "find_rule", "register", "resolve_codes",
+           "rule_page", "rules_table", "threshold_text", "unregister", "with_unit"]

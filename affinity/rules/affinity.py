@@ -1,0 +1,148 @@
+"""Q101-Q103: is the attribute an affine image of the positions? (Bloomenthal 2022, §2 and Listing 3)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..measures import barycentric_score, color_steps, normal_degrees, texels
+from .registry import Rule, register
+
+#: The paper's own tolerance for its dimensionless barycentric reading.
+BARYCENTRIC_TOLERANCE = 0.01
+
+CREASE = (
+    "A GPU draws every quad as two triangles and interpolates each triangle "
+    "linearly. When the attribute is not an affine image of the positions, the two "
+    "triangles disagree about its gradient and a crease appears along the diagonal: "
+    "picture a checker texture on the quad whose lines run straight across one "
+    "triangle, kink where they meet the diagonal and run straight again at another "
+    "angle across the other triangle. The same kink shows as a colour seam or a bend "
+    "in the shading. Which diagonal the engine or baker picks changes the picture, "
+    "so the asset looks different in every tool."
+)
+REFERENCES = (
+    "Bloomenthal 2022, Barycentric quad rasterization (JCGT 11(3)), §2 and Listing 3 (the affinity test); "
+    "Hormann & Tarini 2004, A quadrilateral rendering primitive (mean value coordinates, the fix a renderer applies)."
+)
+
+
+def uv_disaffinity(quads) -> tuple:
+    """Q101: the uv misplacement in texels (or the paper's score with ``measure = "barycentric"``)."""
+    rows, uv = quads.uv
+    diagonal = quads.settings.diagonal
+    if quads.settings.measure == "barycentric":
+        return rows, barycentric_score(quads.planar.take(rows), quads.uv_planar, diagonal)
+    return rows, texels(quads.misplacement(rows, uv).T, quads.texture_size)
+
+
+def color_disaffinity(quads) -> tuple:
+    """Q102: the colour misplacement in 1/255 steps."""
+    rows, colors = quads.complete("colors")
+    return rows, color_steps(quads.misplacement(rows, colors).T)
+
+
+def normal_disaffinity(quads) -> tuple:
+    """Q103: the angle the misplacement turns the mean corner normal by, in degrees."""
+    rows, unit = quads.complete("normals")  # unit length already (see affinity.lint.CornerTables.gather)
+    m = quads.misplacement(rows, unit)
+    # The angle atan2(|m|, |mean normal|) exceeds the threshold only where
+    # |m| > tan(threshold) |mean normal|: the arctangent is taken for those only.
+    threshold = quads.settings.threshold("Q103")
+    picked = slice(None)
+    if 0 <= threshold < 89:  # a negative threshold (every value wanted) picks every quad
+        m_length = np.sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2])
+        mean = unit.sum(axis=1)
+        mean_length = np.sqrt(mean[0] * mean[0] + mean[1] * mean[1] + mean[2] * mean[2]) / 4
+        picked = np.flatnonzero(m_length >= mean_length * (np.tan(np.radians(threshold)) * (1 - 1e-9)))
+    rows = np.arange(len(quads))[rows][picked]
+    degrees = normal_degrees(m.T[picked], np.transpose(unit, (2, 1, 0))[picked])
+    return rows, degrees
+
+
+register(Rule(
+    code="Q101", name="uv-disaffine",
+    summary="texture coordinates are not an affine image of the positions",
+    unit="texels", default_threshold=0.5, attribute="texcoords", scored=True,
+    readings={"barycentric": ("barycentric score", BARYCENTRIC_TOLERANCE)},
+    check=uv_disaffinity,
+    what=(
+        "Measures, per quad, how far the two-triangle split moves the texture "
+        "coordinate at the quad's centre, in texels (texture size from the "
+        "material's map_Kd image, else the texture-size setting), and flags quads "
+        "above the threshold. With --measure barycentric it uses the paper's "
+        "dimensionless score at .01 instead."
+    ),
+    why=CREASE,
+    example=(
+        "# a trapezoid (a quad near the pole of a lat-long sphere) carrying the unit square of uv\n"
+        "v -1 0 0\nv 1 0 0\nv 0.5 1 0\nv -0.5 1 0\n"
+        "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+        "f 1/1 2/2 3/3 4/4\n"
+    ),
+    example_output=(
+        'example.obj:10:1: Q101 uv-disaffine: texture coordinates are not an affine image of the positions'
+        ' (256 vs 0.5 texels)\n'
+    ),
+    fix=(
+        "Re-UV the quad as a parallelogram matching its shape (Blender: UV > "
+        "Follow Active Quads, or straighten the island), subdivide it so each "
+        "piece is closer to a parallelogram, or triangulate before baking so every "
+        "tool uses the same diagonal."
+    ),
+    references=REFERENCES,
+))
+
+register(Rule(
+    code="Q102", name="color-disaffine",
+    summary="vertex colours are not an affine image of the positions",
+    unit="1/255", default_threshold=2.0, attribute="colors", scored=True,
+    check=color_disaffinity,
+    what=(
+        "Measures how far the split moves the vertex colour at the quad's centre, "
+        "in 1/255 steps, and flags quads above the threshold."
+    ),
+    why=CREASE,
+    example=(
+        "# a unit square with corner colours blue, red, green, black: no parallelogram in colour space\n"
+        "v 0 0 0 0 0 1\nv 1 0 0 1 0 0\nv 1 1 0 0 1 0\nv 0 1 0 0 0 0\n"
+        "f 1 2 3 4\n"
+    ),
+    example_output=(
+        'example.obj:6:1: Q102 color-disaffine: vertex colours are not an affine image of the positions'
+        ' (110.4 vs 2/255)\n'
+    ),
+    fix=(
+        "Repaint the corner colours so opposite corners average to the same "
+        "colour, subdivide the quad, or triangulate before baking so the "
+        "diagonal is explicit."
+    ),
+    references=REFERENCES,
+))
+
+register(Rule(
+    code="Q103", name="normal-disaffine",
+    summary="normals are not an affine image of the positions",
+    unit="degrees", default_threshold=2.0, attribute="normals", scored=True,
+    check=normal_disaffinity,
+    what=(
+        "Measures how far the split turns the interpolated normal at the quad's "
+        "centre, in degrees, and flags quads above the threshold."
+    ),
+    why=CREASE,
+    example=(
+        "# a flat square whose corner normals lean out unevenly: the lighting bends along the diagonal\n"
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+        "vn 0 0 1\nvn 0.5 0 1\nvn 0 0 1\nvn 0 0.5 1\n"
+        "f 1//1 2//2 3//3 4//4\n"
+    ),
+    example_output=(
+        'example.obj:10:1: Q103 normal-disaffine: normals are not an affine image of the positions'
+        ' (9.847 vs 2 degrees)\n'
+    ),
+    fix=(
+        "Subdivide the quad or even out its corners (Blender: Mesh > Clean Up, or "
+        "relax the loop), or triangulate before baking normals so the split "
+        "diagonal is fixed."
+    ),
+    references=REFERENCES,
+))

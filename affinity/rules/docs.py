@@ -1,0 +1,83 @@
+"""A rule's page and the README's rule table, written from the registry.
+
+The page follows ruff's layout: What it does / Why it matters / Example (the
+rule's OBJ and the line ``affinity check`` prints for it) / References / How to
+fix; it ends with the fix a modelling tool can apply (design.md).
+"""
+
+from __future__ import annotations
+
+import textwrap
+
+from .file import UNREADABLE
+from .registry import RULES, Rule
+
+#: The prose sections of every page, in order: (heading, Rule attribute).
+SECTIONS = (
+    ("What it does", "what"),
+    ("Why it matters", "why"),
+    ("Example", "example"),
+    ("References", "references"),
+    ("How to fix", "fix"),
+)
+
+
+def threshold_text(rule: Rule) -> str:
+    """``"0.5 texels"``, or ``""`` for a rule without a threshold."""
+    return "" if rule.default_threshold is None else with_unit(f"{rule.default_threshold:g}", rule.unit)
+
+
+def with_unit(number: str, unit: str) -> str:
+    """``"0.5 texels"``; a unit ``1/N`` reads as a fraction (``"2/255"``, not ``"2 1/255"``)."""
+    if unit.startswith("1/"):
+        return number + unit[1:]
+    return f"{number} {unit}".rstrip()
+
+
+def _example(rule: Rule, markdown: bool) -> str:
+    """The example OBJ, then what ``affinity check example.obj`` prints for it."""
+    obj, output = rule.example.rstrip("\n"), rule.example_output.rstrip("\n")
+    if markdown:
+        text = f"```\n{obj}\n```"
+        return text + (f"\n\n`affinity check example.obj` prints:\n\n```\n{output}\n```" if output else "")
+    indent = lambda block: textwrap.indent(block, "        ")  # noqa: E731
+    return indent(obj) + (f"\n\n    affinity check example.obj prints:\n\n{indent(output)}" if output else "")
+
+
+def rule_page(rule: Rule, markdown: bool = False) -> str:
+    """The rule's documentation page: title, summary, level and threshold, then :data:`SECTIONS`.
+
+    Plain text for ``affinity rule``, Markdown for SARIF ``help.markdown``.
+    Sections a rule leaves empty (References on Q205) are left out.
+    """
+    facts = f"Level: {rule.level}."
+    if threshold_text(rule):
+        facts += f" Default threshold: {threshold_text(rule)} (setting thresholds.{rule.code})."
+    sections = [(title, getattr(rule, attr)) for title, attr in SECTIONS if getattr(rule, attr)]
+    if markdown:
+        head = [f"## {rule.code} {rule.name}", "", f"*{rule.summary}*", "", facts]
+        body = [part for title, text in sections
+                for part in ("", f"### {title}", "", _example(rule, True) if title == "Example" else text)]
+    else:
+        head = [f"{rule.code} {rule.name}: {rule.summary}", facts]
+        fill = lambda text: textwrap.fill(text, 79, initial_indent="    ", subsequent_indent="    ")  # noqa: E731
+        body = [part for title, text in sections
+                for part in ("", title, _example(rule, False) if title == "Example" else fill(text))]
+    return "\n".join(head + body) + "\n"
+
+
+def rules_table() -> str:
+    """The Markdown rule table of the README (generated, never edited by hand): every rule, then Q901."""
+    rows = [
+        "`affinity rules` lists the rules; `affinity rule CODE` prints a rule's page: what it does, "
+        "why it matters, an example and how to fix it.",
+        "",
+        "| Code | Name | Level | Default threshold | Flags | How to fix |",
+        "|---|---|---|---|---|---|",
+    ]
+    for rule in (*RULES.values(), UNREADABLE):
+        rows.append(
+            f"| {rule.code} | `{rule.name}` | {rule.level} | {threshold_text(rule) or '-'} "
+            f"| {rule.summary} | {rule.fix} |"
+        )
+    return "\n".join(rows) + "\n"

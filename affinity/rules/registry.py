@@ -1,0 +1,119 @@
+"""The rule registry: one :class:`Rule` record per code carries everything that varies by rule.
+
+Lint (:mod:`affinity.lint`), the report, routing by lint, the SARIF rule
+descriptions, ``affinity rules``/``affinity rule`` and the README's rule table all
+read :data:`RULES`; nothing else lists rules. A rule is added by registering its
+record beside its check (as ruff keeps a rule's doc and check in one file):
+
+    register(Rule(code="Q999", name="my-rule", ..., check=my_check))
+
+Codes never change; names are kebab-case.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+LEVELS = ("error", "warning", "info")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Rule:
+    """Everything about one rule.
+
+    Attributes
+    ----------
+    code, name : ``"Q101"``, ``"uv-disaffine"``
+    summary : one line: what a finding means
+    level : ``"error"``, ``"warning"`` or ``"info"`` (overridable per rule)
+    unit : the unit of the measured values (``"texels"``, ``"1/255"``, ``"degrees"``)
+    default_threshold : the threshold in ``unit``; None for a rule without one
+    flags : ``"above"`` (values above the threshold are flagged) or ``"at-or-below"``
+    worst : ``"highest"`` or ``"lowest"``: which end of the values is the worst
+    attribute : the Mesh field read besides the positions (``"texcoords"``,
+        ``"colors"``, ``"normals"``), or None
+    scored : the rule is an affinity score of its attribute: every quad gets a value
+        (the report's histograms, the hybrid's ``--route lint``)
+    readings : measure -> (unit, default threshold) where a ``--measure`` reading
+        changes them (Q101's dimensionless barycentric score)
+    scope : ``"quad"``: ``check(quads) -> (rows, values)`` over a batch of quads
+        (``affinity.lint.QuadBatch``; ``rows`` index the batch, a slice for all);
+        ``"mesh"``: ``check(mesh, settings) -> (faces, lines, values)`` or None
+    check : the measure, vectorized
+    what, why, fix : the page's *What it does*, *Why it matters*, *How to fix*
+    example : a 4- to 8-line OBJ that triggers this rule and no other
+    example_output : the text lines ``affinity check`` prints for ``example``
+        saved as ``example.obj`` (a test lints it and compares)
+    references : the paper and section the rule comes from
+    """
+
+    code: str
+    name: str
+    summary: str
+    level: str = "warning"
+    unit: str = ""
+    default_threshold: float | None = None
+    flags: str = "above"
+    worst: str = "highest"
+    attribute: str | None = None
+    scored: bool = False
+    readings: Mapping[str, tuple[str, float]] = field(default_factory=dict)
+    scope: str = "quad"
+    check: Callable | None = None
+    what: str
+    why: str
+    example: str
+    example_output: str = ""
+    fix: str
+    references: str = ""
+
+    @property
+    def has_threshold(self) -> bool:
+        return self.default_threshold is not None
+
+    def unit_for(self, measure: str) -> str:
+        """The unit of the values under the ``measure`` reading."""
+        return self.readings.get(measure, (self.unit, None))[0]
+
+    def default_for(self, measure: str) -> float | None:
+        """The default threshold under the ``measure`` reading."""
+        return self.readings.get(measure, (None, self.default_threshold))[1]
+
+    def flagged(self, values: np.ndarray, threshold: float) -> np.ndarray:
+        """(n,) bool: which of ``values`` (n,) the rule flags at ``threshold``."""
+        return values <= threshold if self.flags == "at-or-below" else values > threshold
+
+
+#: Every lint rule by code, in code order.
+RULES: dict[str, Rule] = {}
+
+
+def register(rule: Rule) -> Rule:
+    """Add ``rule`` to :data:`RULES` (kept in code order); a code is registered once."""
+    if rule.code in RULES:
+        raise ValueError(f"rule {rule.code} is registered already")
+    if rule.level not in LEVELS or rule.scope not in ("quad", "mesh") or rule.flags not in ("above", "at-or-below"):
+        raise ValueError(f"rule {rule.code}: level, scope or flags out of range")
+    RULES[rule.code] = rule
+    ordered = sorted(RULES.items())
+    RULES.clear()
+    RULES.update(ordered)
+    return rule
+
+
+def unregister(code: str) -> None:
+    """Remove a rule registered at run time (tests, plug-ins)."""
+    del RULES[code]
+
+
+def resolve_codes(select: list[str] | None, ignore: list[str] | None) -> list[str]:
+    """Rule codes enabled by ``select``/``ignore`` prefixes (``"Q1"``, ``"Q101"``, ``"ALL"``)."""
+
+    def matches(code: str, prefixes: list[str]) -> bool:
+        return any(p == "ALL" or code.startswith(p.upper()) for p in prefixes)
+
+    codes = [c for c in RULES if select is None or matches(c, select)]
+    return [c for c in codes if not (ignore and matches(c, ignore))]
