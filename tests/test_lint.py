@@ -276,3 +276,13 @@ def test_a_threshold_of_minus_infinity_reports_every_quad_for_every_rule():
         hits = lint_mesh(sphere, Settings(select=[code], thresholds={code: -np.inf}))
         assert len(hits) == 1 and len(hits[0]) == 128, code
         assert np.isfinite(hits[0].values).all()
+
+
+def test_uv_flipped_leaves_what_a_configured_uv_degenerate_threshold_calls_degenerate():
+    quad = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
+    thin_mirror = np.array(SQUARE_UV)[:, ::-1] * [1.0, 1e-4]  # clockwise, area 1e-4 of its size squared
+    mesh = quads_mesh(quad, texcoords=[thin_mirror])
+    default = found(mesh, select=["Q3"])
+    assert "Q301" not in default and default["Q302"][0] == [0]
+    configured = found(mesh, select=["Q3"], thresholds={"Q301": 1e-2})
+    assert configured["Q301"][0] == [0] and "Q302" not in configured

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..geometry import relative_signed_area
-from .registry import RULES, Rule, register
+from .registry import Rule, register
 
 
 def uv_degenerate(quads) -> tuple:
@@ -14,10 +14,13 @@ def uv_degenerate(quads) -> tuple:
 
 
 def uv_flipped(quads) -> tuple:
-    """Q302: the negative relative uv area of the quads whose uv winds against the face."""
+    """Q302: the negative relative uv area of the quads whose uv winds against the face.
+
+    Quads whose |area| is within Q301's threshold (as configured) are Q301's: degenerate, not flipped.
+    """
     rows = np.arange(len(quads))[quads.uv[0]]
     area = relative_signed_area(quads.uv_planar)
-    flipped = area < -RULES["Q301"].default_threshold
+    flipped = area < -quads.settings.threshold("Q301")
     return rows[flipped], area[flipped]
 
 
