@@ -359,14 +359,14 @@ def bilinear_parameters(px, py, qx, qy):
     scale = functools.reduce(np.maximum, [np.abs(v) for v in (*a, *b, *c, *d)])
     scale[scale == 0] = 1.0
     a, b, c, d = ((x / scale, y / scale) for x, y in (a, b, c, d))
-    k2 = _cross(c, d)
-    k1 = _cross(a, d) + _cross(c, b)
-    k0 = _cross(a, b)
+    k2 = cross2(c, d)
+    k1 = cross2(a, d) + cross2(c, b)
+    k0 = cross2(a, b)
     root = np.sqrt(np.maximum(k1 * k1 - 4.0 * k2 * k0, 0.0))
     Q = -0.5 * (k1 + np.copysign(root, k1))
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         t_near, t_far = k0 / Q, Q / k2
-        s_near, s_far = _s_given_t(a, b, c, d, t_near), _s_given_t(a, b, c, d, t_far)
+        s_near, s_far = s_given_t(a, b, c, d, t_near), s_given_t(a, b, c, d, t_far)
     far = _outside_unit_square(s_far, t_far) < _outside_unit_square(s_near, t_near)
     s, t = np.where(far, s_far, s_near), np.where(far, t_far, t_near)
     # p at the frame's corner q0 (a = 0) gets exactly (0, 0): the Lagrange property,
@@ -375,7 +375,7 @@ def bilinear_parameters(px, py, qx, qy):
     s[start_at_corner] = 0.0
     t[start_at_corner] = 0.0
     for _ in range(NEWTON_STEPS):
-        s, t = _newton_step(a, b, c, d, s, t)
+        s, t = newton_step(a, b, c, d, s, t)
     return np.where(FLIPS_S[nearest], 1 - s, s), np.where(FLIPS_T[nearest], 1 - t, t)
 
 
@@ -385,7 +385,7 @@ def bilinear_weights(s, t) -> np.ndarray:
     return np.stack([(1 - s) * (1 - t), s * (1 - t), s * t, (1 - s) * t])
 
 
-def _s_given_t(a, b, c, d, t):
+def s_given_t(a, b, c, d, t):
     """Least-squares s of (a + t c) + s (b + t d) = 0; NaN where b + t d = 0
     (a collapsed edge, every s the same point). Components (N,) -> (N,)."""
     ux, uy = b[0] + t * d[0], b[1] + t * d[1]  # dP/ds
@@ -400,7 +400,7 @@ def _outside_unit_square(s, t):
     return np.where(np.isfinite(out), out, np.inf)
 
 
-def _newton_step(a, b, c, d, s, t):
+def newton_step(a, b, c, d, s, t):
     """One safeguarded Newton step for F = a + s b + t c + s t d = 0 (components).
 
     The step is kept only where it lowers the backward error of ``_residual``.
@@ -409,9 +409,9 @@ def _newton_step(a, b, c, d, s, t):
     Js = (b[0] + t * d[0], b[1] + t * d[1])
     Jt = (c[0] + s * d[0], c[1] + s * d[1])
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        det = _cross(Js, Jt)
-        s1 = s + _cross(Jt, F) / det
-        t1 = t + _cross(F, Js) / det
+        det = cross2(Js, Jt)
+        s1 = s + cross2(Jt, F) / det
+        t1 = t + cross2(F, Js) / det
         better = _residual(a, b, c, d, s1, t1)[1] < error
     return np.where(better, s1, s), np.where(better, t1, t)
 
@@ -432,7 +432,7 @@ def _residual(a, b, c, d, s, t):
     return tuple(F), error
 
 
-def _cross(u, v) -> np.ndarray:
+def cross2(u, v) -> np.ndarray:
     """z-component of u x v for component pairs u = (ux, uy), v = (vx, vy)."""
     return u[0] * v[1] - u[1] * v[0]
 

@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from render.coords import NEWTON_STEPS, _cross, _newton_step, _s_given_t, bilinear_weights
+from render.coords import NEWTON_STEPS, bilinear_weights, cross2, newton_step, s_given_t
 
 #: (s, t) this far outside the unit square still count as on the patch: pixel
 #: centres on a quad's edge come out a few ulps outside by rounding.
@@ -94,18 +94,18 @@ def ray_patch_parameters(corners, px, py):
     scale = np.abs(h).max(axis=(0, 1))  # the system is homogeneous: scale it to O(1)
     scale[scale == 0] = 1.0
     a, b, c, d = (v / scale for v in (a, b, c, d))
-    k2 = _cross(c, d)
-    k1 = _cross(a, d) + _cross(c, b)
-    k0 = _cross(a, b)
+    k2 = cross2(c, d)
+    k1 = cross2(a, d) + cross2(c, b)
+    k0 = cross2(a, b)
     Q = -0.5 * (k1 + np.copysign(np.sqrt(np.maximum(k1 * k1 - 4.0 * k2 * k0, 0.0)), k1))
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         t = np.stack([k0 / Q, Q / k2])  # (2, N): both roots
-        s = _s_given_t(a, b, c, d, t)
+        s = s_given_t(a, b, c, d, t)
         s = np.where(np.isnan(s) & np.isfinite(t), 0.5, s)  # a collapsed edge: every s is the same point
         finite = np.isfinite(s) & np.isfinite(t)
         s, t = np.where(finite, s, 0.5), np.where(finite, t, 0.5)
         for _ in range(NEWTON_STEPS):
-            s, t = _newton_step(a, b, c, d, s, t)
+            s, t = newton_step(a, b, c, d, s, t)
         weights = bilinear_weights(s, t)  # (4, 2, N)
         w_hit = np.einsum("kmn,kn->mn", weights, W)
         z_hit = np.einsum("kmn,kn->mn", weights, Z)

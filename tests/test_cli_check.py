@@ -10,7 +10,6 @@ from pathlib import Path
 
 import pytest
 
-SHARED_MESHES = Path(__file__).resolve().parents[1].parent / "shared" / "meshes"
 
 SQUARE = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n"
 TRAPEZOID = "v -1 0 0\nv 1 0 0\nv 0.5 1 0\nv -0.5 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n"
@@ -182,10 +181,9 @@ def test_demo_meshes_are_checked():
     assert {"Q101", "Q102"} <= codes
 
 
-@pytest.mark.skipif(not (SHARED_MESHES / "MANIFEST.json").exists(), reason="../shared/meshes is absent")
-def test_counts_match_the_manifest_on_every_shared_mesh():
-    manifest = json.loads((SHARED_MESHES / "MANIFEST.json").read_text())
-    result = run("check", "--format", "json", *(str(SHARED_MESHES / m["file"]) for m in manifest))
+def test_counts_match_the_manifest_on_every_shared_mesh(shared_meshes):
+    manifest = json.loads((shared_meshes / "MANIFEST.json").read_text())
+    result = run("check", "--format", "json", *(str(shared_meshes / m["file"]) for m in manifest))
     assert result.returncode in (0, 1), result.stderr
     entries = {Path(f["path"]).name: f for f in json.loads(result.stdout)["files"]}
     for m in manifest:

@@ -1,7 +1,5 @@
 """lint_mesh on small hand-made meshes, texture sizes from image headers, and the real corpus."""
 
-import json
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -9,10 +7,9 @@ import pytest
 import affinity.lint
 from affinity.loaders.imagesize import image_size
 from affinity.lint import lint_mesh, quad_uv_misplacement
+from affinity.loaders import load
 from affinity.mesh import Mesh
 from affinity.settings import Settings
-
-MESHES = Path(__file__).resolve().parents[2] / "shared" / "meshes"
 
 SQUARE_UV = [[0, 0], [1, 0], [1, 1], [0, 1]]
 TRAPEZOID = [[-1, 0, 0], [1, 0, 0], [0.5, 1, 0], [-0.5, 1, 0]]  # r = 1/2: m = (1/4, 0) uv
@@ -227,22 +224,13 @@ def test_check_path_does_not_import_pillow():
 # --- the real corpus ---------------------------------------------------------------
 
 
-def load_corpus_mesh(name):
-    loaders = pytest.importorskip("affinity.loaders")
-    if not hasattr(loaders, "load"):
-        pytest.skip("affinity.loaders.load does not exist yet")
-    if not (MESHES / name).exists():
-        pytest.skip(f"{MESHES / name} is absent")
-    return loaders.load(str(MESHES / name))
+@pytest.fixture
+def load_corpus_mesh(shared_meshes):
+    return lambda name: load(str(shared_meshes / name))
 
 
-def manifest():
-    path = MESHES / "MANIFEST.json"
-    return json.loads(path.read_text()) if path.exists() else []
-
-
-@pytest.mark.parametrize("entry", manifest(), ids=lambda entry: entry["file"])
-def test_corpus_uv_flips_match_the_manifest_winding(entry):
+def test_corpus_uv_flips_match_the_manifest_winding(manifest_entry, load_corpus_mesh):
+    entry = manifest_entry
     mesh = load_corpus_mesh(entry["file"])
     hits = found(mesh, select=["Q301", "Q302"])
     assert len(hits.get("Q302", ([], []))[0]) == entry["uv_quad_winding"]["cw"]
@@ -251,7 +239,7 @@ def test_corpus_uv_flips_match_the_manifest_winding(entry):
         assert np.isfinite(h.values).all()
 
 
-def test_corpus_makehuman_paper_score_flags_most_quads_but_few_move_a_texel():
+def test_corpus_makehuman_paper_score_flags_most_quads_but_few_move_a_texel(load_corpus_mesh):
     mesh = load_corpus_mesh("makehuman_base_hm08.obj")
     quads = mesh.counts()["quads"]
     paper = found(mesh, measure="barycentric", select=["Q101"])["Q101"][0]
@@ -260,7 +248,7 @@ def test_corpus_makehuman_paper_score_flags_most_quads_but_few_move_a_texel():
     assert 0.004 < len(visible) / quads < 0.008  # measured 0.60%
 
 
-def test_corpus_sphere_pole_quads_are_degenerate_and_scored_finitely():
+def test_corpus_sphere_pole_quads_are_degenerate_and_scored_finitely(load_corpus_mesh):
     mesh = load_corpus_mesh("gen_uv_sphere_64x32.obj")
     assert len(found(mesh, select=["Q201"])["Q201"][0]) == 128
     faces, m = quad_uv_misplacement(mesh, diagonal="both")

@@ -1,31 +1,15 @@
 """The shared real meshes load with exactly the counts MANIFEST.json records, and
 positions/faces agree with independent readers (trimesh, libigl)."""
 
-import json
-from pathlib import Path
-
 import numpy as np
 import pytest
 
 from affinity.loaders import load
 
-MESHES = Path(__file__).resolve().parents[1] / ".." / "shared" / "meshes"
-
-
-def manifest():
-    if not (MESHES / "MANIFEST.json").is_file():
-        return []
-    return json.loads((MESHES / "MANIFEST.json").read_text())
-
-
-def entry_id(entry):
-    return entry["file"]
-
 
 @pytest.fixture(autouse=True)
-def require_meshes():
-    if not (MESHES / "MANIFEST.json").is_file():
-        pytest.skip("../shared/meshes is not available")
+def meshes(shared_meshes):
+    return shared_meshes
 
 
 def uv_winding(mesh):
@@ -37,9 +21,9 @@ def uv_winding(mesh):
     return {"ccw": int((area > 0).sum()), "cw": int((area < 0).sum()), "zero_area": int((area == 0).sum())}
 
 
-@pytest.mark.parametrize("entry", manifest() or [{"file": "none"}], ids=entry_id)
-def test_counts_match_manifest(entry):
-    mesh = load(MESHES / entry["file"])
+def test_counts_match_manifest(manifest_entry, meshes):
+    entry = manifest_entry
+    mesh = load(meshes / entry["file"])
     assert mesh.counts() == {k: entry[k] for k in ("faces", "quads", "triangles", "ngons")}
     assert len(mesh.positions) == entry["vertices"]
     assert (0 if mesh.texcoords is None else len(mesh.texcoords)) == entry["texcoords"]
@@ -52,10 +36,10 @@ def test_counts_match_manifest(entry):
 
 
 @pytest.mark.parametrize("name", ["gen_uv_sphere_64x32.obj", "osd_catmark_torus.obj", "makehuman_base_hm08.obj"])
-def test_all_quad_meshes_match_libigl(name):
+def test_all_quad_meshes_match_libigl(name, meshes):
     igl = pytest.importorskip("igl")
-    mesh = load(MESHES / name)
-    vertices, texcoords, normals, faces, face_texcoords, face_normals = igl.readOBJ(str(MESHES / name))
+    mesh = load(meshes / name)
+    vertices, texcoords, normals, faces, face_texcoords, face_normals = igl.readOBJ(str(meshes / name))
     np.testing.assert_array_equal(mesh.positions, vertices)
     np.testing.assert_array_equal(mesh.corner_vertex.reshape(-1, 4), faces)
     np.testing.assert_array_equal(mesh.texcoords, texcoords)
@@ -71,9 +55,9 @@ def sorted_rows(triangles):
 
 
 @pytest.mark.parametrize("name", ["osd_catmark_bishop.obj", "gen_vase_revolution.obj", "spot_control_mesh.obj"])
-def test_positions_and_triangles_match_trimesh(name):
+def test_positions_and_triangles_match_trimesh(name, meshes):
     trimesh = pytest.importorskip("trimesh")
-    path = MESHES / name
+    path = meshes / name
     mesh = load(path)
     reference = trimesh.load(str(path), process=False, maintain_order=True, skip_materials=True, force="mesh")
     np.testing.assert_array_equal(mesh.positions, reference.vertices)

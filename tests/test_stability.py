@@ -13,7 +13,8 @@ import pytest
 from affinity.stability import condition as condition_module
 from affinity.stability import reference, table
 from affinity.stability.cases import catalogue
-from affinity.stability.run import METHODS, Row, exact_results, run
+from affinity.stability.rows import Row
+from affinity.stability.run import METHODS, exact_results, run
 from render.coords import inverse_bilinear, mean_value
 
 REPO = Path(__file__).resolve().parents[1]
@@ -254,3 +255,23 @@ def test_report_section_shows_the_summary(tmp_path, monkeypatch, rows64):
     assert section.data["cases"] == len(catalogue())
     assert [(s["method"], s["passed"]) for s in section.data["methods"]] == [
         ("mean_value", len(catalogue())), ("inverse_bilinear", sum(c.bilinear for c in catalogue()))]
+
+
+def test_reading_a_committed_table_needs_no_mpmath(tmp_path):
+    """The report reads stability.csv; mpmath is for computing references, not for reading rows."""
+    import subprocess
+    import sys
+
+    from affinity.stability import table
+
+    row = Row("needle", "needles", "mean_value", False, "float64", 3, 1e-17, 1e-14, 1e-3, 0.0, 0.0, 0.0, "pass")
+    path = tmp_path / "stability.csv"
+    path.write_text(table.to_csv([row]))
+    code = ("import sys; sys.modules['mpmath'] = None\n"
+            "from affinity.stability.table import from_csv\n"
+            f"rows = from_csv(open({str(path)!r}).read())\n"
+            "assert 'mpmath' not in [m for m in sys.modules if sys.modules[m] is not None]\n"
+            "print(rows[0].case, rows[0].status)")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.split() == ["needle", "pass"]

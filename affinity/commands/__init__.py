@@ -4,6 +4,8 @@ Subcommands import what they need inside ``run``, so ``affinity check`` pays
 for NumPy and nothing heavier.
 """
 
+import argparse
+
 EXIT_CLEAN, EXIT_FINDINGS, EXIT_ERROR = 0, 1, 2
 
 
@@ -24,3 +26,26 @@ def require(modules: tuple[str, ...], extra: str) -> None:
     missing = [name for name in modules if importlib.util.find_spec(name) is None]
     if missing:
         raise UsageError(f"needs {', '.join(missing)}, the {extra} extra: pip install 'quad-affinity[{extra}]'")
+
+
+def image_size(text: str) -> tuple[int, int]:
+    """An argparse ``type``: ``"800x600"`` -> (800, 600)."""
+    width, _, height = text.lower().partition("x")
+    try:
+        size = int(width), int(height)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not an image size: {text!r} (use e.g. 800x600)") from None
+    if min(size) < 1:
+        raise argparse.ArgumentTypeError(f"image size must be at least 1x1, got {text!r}")
+    return size
+
+
+def camera(text: str) -> tuple[tuple[float, ...], tuple[float, ...], float]:
+    """An argparse ``type``: ``"EX,EY,EZ,TX,TY,TZ,FOV"`` -> ((ex, ey, ez), (tx, ty, tz), fov)."""
+    try:
+        values = [float(v) for v in text.split(",")]
+    except ValueError:
+        values = []
+    if len(values) != 7:
+        raise argparse.ArgumentTypeError("use --camera EX,EY,EZ,TX,TY,TZ,FOV (eye, target, vertical fov in degrees)")
+    return tuple(values[:3]), tuple(values[3:6]), values[6]

@@ -11,8 +11,7 @@ from __future__ import annotations
 import sys
 
 from ..errors import UsageError
-from . import EXIT_CLEAN, require
-from .render import _size as image_size
+from . import EXIT_CLEAN, image_size, require
 
 
 def add_parser(sub) -> None:

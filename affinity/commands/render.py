@@ -6,35 +6,13 @@ the equator so that the trapezoids near the pole show the split's crease.
 
 from __future__ import annotations
 
-import argparse
 import sys
 
 from ..errors import UsageError
-from . import EXIT_CLEAN, require, spelling
+from . import EXIT_CLEAN, camera, image_size, require, spelling
 
 METHODS = ("hybrid", "split", "mvc", "bilinear", "projective", "exact")
 SHOW_MODES = ("uv", "color", "normal", "shaded")  # what affinity.draw.shading.shade draws
-
-
-def _size(text: str) -> tuple[int, int]:
-    width, _, height = text.lower().partition("x")
-    try:
-        size = int(width), int(height)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not an image size: {text!r} (use e.g. 800x600)") from None
-    if min(size) < 1:
-        raise argparse.ArgumentTypeError(f"image size must be at least 1x1, got {text!r}")
-    return size
-
-
-def _camera(text: str) -> tuple[tuple[float, ...], tuple[float, ...], float]:
-    try:
-        values = [float(v) for v in text.split(",")]
-    except ValueError:
-        values = []
-    if len(values) != 7:
-        raise argparse.ArgumentTypeError("use --camera EX,EY,EZ,TX,TY,TZ,FOV (eye, target, vertical fov in degrees)")
-    return tuple(values[:3]), tuple(values[3:6]), values[6]
 
 
 def add_parser(sub) -> None:
@@ -49,8 +27,8 @@ def add_parser(sub) -> None:
                    help="hybrid routing: visible split error in this view (default) or the lint flags")
     p.add_argument("--pixel-tolerance", type=float, default=0.5, metavar="PX",
                    help="route a quad to mvc when the split moves its texture by more than PX pixels")
-    p.add_argument("--size", type=_size, default=(800, 600), metavar="WxH")
-    p.add_argument("--camera", type=_camera, metavar="EX,EY,EZ,TX,TY,TZ,FOV")
+    p.add_argument("--size", type=image_size, default=(800, 600), metavar="WxH")
+    p.add_argument("--camera", type=camera, metavar="EX,EY,EZ,TX,TY,TZ,FOV")
     p.add_argument("--up", choices=["x", "y", "z"], default=None, help="world up axis (default: the stage's upAxis for USD, else y; z for the demo)")
     p.add_argument("--show", choices=SHOW_MODES, type=spelling,
                    help="what to draw (default: uv when the mesh has it, else color, else shaded)")

@@ -24,10 +24,8 @@ from __future__ import annotations
 import mpmath
 
 from .reference import DIGITS
+from .rows import TOLERANCE_FACTOR, TOLERANCE_FLOOR, UNIT_ROUNDOFF
 
-UNIT_ROUNDOFF = {"float64": 2.0**-53, "float32": 2.0**-24}
-TOLERANCE_FLOOR = 64
-TOLERANCE_FACTOR = 16
 
 
 def condition(exact, s, w, u, relative=False) -> float:

@@ -19,7 +19,7 @@ from render import coords
 
 from . import naive, properties
 from .cases import Case, catalogue
-from .condition import TOLERANCE_FLOOR, UNIT_ROUNDOFF, condition, tolerance
+from .condition import condition, tolerance
 from .reference import (
     Undefined,
     check_inverse_bilinear,
@@ -29,6 +29,7 @@ from .reference import (
     mean_value_exact,
     offsets,
 )
+from .rows import TOLERANCE_FLOOR, UNIT_ROUNDOFF, Row
 
 #: float64 gates the command; float32 is reported.
 PRECISIONS = ("float64", "float32")
@@ -66,33 +67,6 @@ METHODS = (
     Method("naive_textbook", "inverse_bilinear", naive.inverse_bilinear_textbook, naive=True),
     Method("naive_thresholded", "inverse_bilinear", naive.inverse_bilinear_thresholded, naive=True),
 )
-
-
-@dataclass(frozen=True)
-class Row:
-    """One case, method and precision.
-
-    ``points``: points with an exact result (a float32 rounding can leave
-    none); ``error`` and ``tolerance`` at the point with the worst ``ratio``
-    (error / tolerance, inf for a non-finite result); ``unity``, ``linear``,
-    ``lagrange``: worst defects (``properties``; unity is NaN for (s, t)).
-    ``status``: "pass" (finite, ratio <= 1, every defect <= 64 u), "fail", or
-    "skip" (no point has an exact result: only after rounding to float32).
-    """
-
-    case: str
-    group: str
-    method: str
-    naive: bool
-    precision: str
-    points: int
-    error: float
-    tolerance: float
-    ratio: float
-    unity: float
-    linear: float
-    lagrange: float
-    status: str
 
 
 @dataclass

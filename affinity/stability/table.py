@@ -10,8 +10,7 @@ from dataclasses import astuple, fields
 import numpy as np
 
 from .cases import catalogue
-from .condition import TOLERANCE_FACTOR, TOLERANCE_FLOOR
-from .run import Row
+from .rows import TOLERANCE_FACTOR, TOLERANCE_FLOOR, Row
 
 COLUMNS = tuple(f.name for f in fields(Row))
 #: Columns of the printed table and of the markdown's full table.
