@@ -24,10 +24,9 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def check_json(tree: Path, meshes: list[str], extra: list[str]) -> dict:
-    env = {**os.environ, "PYTHONPATH": str(tree), "AFFINITY_CACHE_DIR": tempfile.mkdtemp()}
+    env = {**os.environ, "PYTHONPATH": str(tree)}
     result = subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--format", "json", "--select", "ALL",
-                             "--no-cache" if "--no-cache" in extra else "", *[a for a in extra if a != "--no-cache"],
-                             *meshes], capture_output=True, text=True, env=env, cwd=tree)
+                             *extra, *meshes], capture_output=True, text=True, env=env, cwd=tree)
     if result.returncode not in (0, 1):
         raise SystemExit(f"{tree}: exit {result.returncode}: {result.stderr.strip()}")
     return json.loads(result.stdout)
@@ -55,7 +54,7 @@ def main() -> int:
             tree = Path(scratch) / label
             subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", "-q", str(tree), revision], check=True)
             try:
-                results[label] = by_file(check_json(tree, meshes, [a for a in args.arg if a]))
+                results[label] = by_file(check_json(tree, meshes, args.arg))
             finally:
                 subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(tree)], check=True)
     differing = 0
