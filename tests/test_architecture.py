@@ -144,3 +144,13 @@ def test_the_design_contract_call(tmp_path):
     assert np.all(np.diff(u[rows == rows[0]]) > 0), "u grows to the right"
     v = result.frame.attrs[rows, cols, 1]
     assert v[rows == rows.min()].mean() > v[rows == rows.max()].mean(), "v grows upward (row 0 is the top)"
+
+
+def test_no_private_name_is_imported_across_modules():
+    private = []
+    for path in project_modules():
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and (node.module or "").split(".")[0] in ("affinity", "render", ""):
+                private += [f"{path.relative_to(ROOT)}:{node.lineno}: {alias.name}" for alias in node.names
+                            if alias.name.startswith("_") and alias.name != "__version__"]
+    assert not private, "\n".join(private)

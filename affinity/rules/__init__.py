@@ -6,24 +6,26 @@
 - :mod:`.texture`: Q301-Q302, the quad in texture space;
 - :mod:`.docs`: a rule's page and the README's table, from the registry.
 
-Adding a rule touches its module (record and check) only: lint, the report,
-SARIF, ``affinity rules`` and the README table read :data:`RULES`.
+A rule is its check decorated with ``@rule(code=..., name=..., ...)``; the check's
+docstring is the rule's page (:func:`.registry.page_fields`). Adding a rule touches
+its module only: lint, the report, SARIF, ``affinity rules`` and the README table
+read :data:`RULES`.
 """
 
 from . import affinity, file, shape, texture  # noqa: F401  each registers its rules
 from .docs import SECTIONS, rule_page, rules_table, threshold_text, with_unit
 from .file import UNREADABLE
-from .registry import LEVELS, RULES, Rule, register, resolve_codes, unregister
+from .registry import LEVELS, RULES, Rule, page_fields, register, resolve_codes, rule, unregister
 
 
 def find_rule(key: str) -> Rule | None:
     """The rule (Q901 included) with code or name ``key`` (case-insensitive), or None."""
     key = key.strip()
-    for rule in (*RULES.values(), UNREADABLE):
-        if key.upper() == rule.code or key.lower() == rule.name:
-            return rule
+    for candidate in (*RULES.values(), UNREADABLE):
+        if key.upper() == candidate.code or key.lower() == candidate.name:
+            return candidate
     return None
 
 
-__all__ = ["LEVELS", "RULES", "SECTIONS", "UNREADABLE", "Rule", "find_rule", "register", "resolve_codes",
-           "rule_page", "rules_table", "threshold_text", "unregister", "with_unit"]
+__all__ = ["LEVELS", "RULES", "SECTIONS", "UNREADABLE", "Rule", "find_rule", "page_fields", "register",
+           "resolve_codes", "rule", "rule_page", "rules_table", "threshold_text", "unregister", "with_unit"]

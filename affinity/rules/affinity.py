@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..measures import barycentric_score, color_steps, normal_degrees, texels
-from .registry import Rule, register
+from .registry import rule
 
 #: The paper's own tolerance for its dimensionless barycentric reading.
 BARYCENTRIC_TOLERANCE = 0.01
@@ -26,8 +26,39 @@ REFERENCES = (
 )
 
 
+@rule(code="Q101", name="uv-disaffine", unit="texels", default_threshold=0.5, attribute="texcoords", scored=True,
+      readings={"barycentric": ("barycentric score", BARYCENTRIC_TOLERANCE)}, why=CREASE, references=REFERENCES)
 def uv_disaffinity(quads) -> tuple:
-    """Q101: the uv misplacement in texels (or the paper's score with ``measure = "barycentric"``)."""
+    """Texture coordinates are not an affine image of the positions.
+
+    What it does:
+        Measures, per quad, how far the two-triangle split moves the texture
+        coordinate at the quad's centre, in texels (texture size from the
+        material's map_Kd image, else the texture-size setting), and flags quads
+        above the threshold. With --measure barycentric it uses the paper's
+        dimensionless score at .01 instead.
+
+    Example:
+        # a trapezoid (a quad near the pole of a lat-long sphere) carrying the unit square of uv
+        v -1 0 0
+        v 1 0 0
+        v 0.5 1 0
+        v -0.5 1 0
+        vt 0 0
+        vt 1 0
+        vt 1 1
+        vt 0 1
+        f 1/1 2/2 3/3 4/4
+
+    Prints:
+        example.obj:10:1: Q101 uv-disaffine: texture coordinates are not an affine image of the positions (256 vs 0.5 texels)
+
+    How to fix:
+        Re-UV the quad as a parallelogram matching its shape (Blender: UV > Follow
+        Active Quads, or straighten the island), subdivide it so each piece is
+        closer to a parallelogram, or triangulate before baking so every tool uses
+        the same diagonal.
+    """
     rows, uv = quads.uv
     diagonal = quads.settings.diagonal
     if quads.settings.measure == "barycentric":
@@ -35,14 +66,64 @@ def uv_disaffinity(quads) -> tuple:
     return rows, texels(quads.misplacement(rows, uv).T, quads.texture_size)
 
 
+@rule(code="Q102", name="color-disaffine", unit="1/255", default_threshold=2.0, attribute="colors", scored=True,
+      why=CREASE, references=REFERENCES)
 def color_disaffinity(quads) -> tuple:
-    """Q102: the colour misplacement in 1/255 steps."""
+    """Vertex colours are not an affine image of the positions.
+
+    What it does:
+        Measures how far the split moves the vertex colour at the quad's centre,
+        in 1/255 steps, and flags quads above the threshold.
+
+    Example:
+        # a unit square with corner colours blue, red, green, black: no parallelogram in colour space
+        v 0 0 0 0 0 1
+        v 1 0 0 1 0 0
+        v 1 1 0 0 1 0
+        v 0 1 0 0 0 0
+        f 1 2 3 4
+
+    Prints:
+        example.obj:6:1: Q102 color-disaffine: vertex colours are not an affine image of the positions (110.4 vs 2/255)
+
+    How to fix:
+        Repaint the corner colours so opposite corners average to the same colour,
+        subdivide the quad, or triangulate before baking so the diagonal is explicit.
+    """
     rows, colors = quads.complete("colors")
     return rows, color_steps(quads.misplacement(rows, colors).T)
 
 
+@rule(code="Q103", name="normal-disaffine", unit="degrees", default_threshold=2.0, attribute="normals", scored=True,
+      why=CREASE, references=REFERENCES)
 def normal_disaffinity(quads) -> tuple:
-    """Q103: the angle the misplacement turns the mean corner normal by, in degrees."""
+    """Normals are not an affine image of the positions.
+
+    What it does:
+        Measures how far the split turns the interpolated normal at the quad's
+        centre, in degrees (the angle the misplacement turns the mean corner normal
+        by), and flags quads above the threshold.
+
+    Example:
+        # a flat square whose corner normals lean out unevenly: the lighting bends along the diagonal
+        v 0 0 0
+        v 1 0 0
+        v 1 1 0
+        v 0 1 0
+        vn 0 0 1
+        vn 0.5 0 1
+        vn 0 0 1
+        vn 0 0.5 1
+        f 1//1 2//2 3//3 4//4
+
+    Prints:
+        example.obj:10:1: Q103 normal-disaffine: normals are not an affine image of the positions (9.847 vs 2 degrees)
+
+    How to fix:
+        Subdivide the quad or even out its corners (Blender: Mesh > Clean Up, or
+        relax the loop), or triangulate before baking normals so the split diagonal
+        is fixed.
+    """
     rows, unit = quads.complete("normals")  # unit length already (see affinity.lint.CornerTables.gather)
     m = quads.misplacement(rows, unit)
     # The angle atan2(|m|, |mean normal|) exceeds the threshold only where
@@ -57,92 +138,3 @@ def normal_disaffinity(quads) -> tuple:
     rows = np.arange(len(quads))[rows][picked]
     degrees = normal_degrees(m.T[picked], np.transpose(unit, (2, 1, 0))[picked])
     return rows, degrees
-
-
-register(Rule(
-    code="Q101", name="uv-disaffine",
-    summary="texture coordinates are not an affine image of the positions",
-    unit="texels", default_threshold=0.5, attribute="texcoords", scored=True,
-    readings={"barycentric": ("barycentric score", BARYCENTRIC_TOLERANCE)},
-    check=uv_disaffinity,
-    what=(
-        "Measures, per quad, how far the two-triangle split moves the texture "
-        "coordinate at the quad's centre, in texels (texture size from the "
-        "material's map_Kd image, else the texture-size setting), and flags quads "
-        "above the threshold. With --measure barycentric it uses the paper's "
-        "dimensionless score at .01 instead."
-    ),
-    why=CREASE,
-    example=(
-        "# a trapezoid (a quad near the pole of a lat-long sphere) carrying the unit square of uv\n"
-        "v -1 0 0\nv 1 0 0\nv 0.5 1 0\nv -0.5 1 0\n"
-        "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
-        "f 1/1 2/2 3/3 4/4\n"
-    ),
-    example_output=(
-        'example.obj:10:1: Q101 uv-disaffine: texture coordinates are not an affine image of the positions'
-        ' (256 vs 0.5 texels)\n'
-    ),
-    fix=(
-        "Re-UV the quad as a parallelogram matching its shape (Blender: UV > "
-        "Follow Active Quads, or straighten the island), subdivide it so each "
-        "piece is closer to a parallelogram, or triangulate before baking so every "
-        "tool uses the same diagonal."
-    ),
-    references=REFERENCES,
-))
-
-register(Rule(
-    code="Q102", name="color-disaffine",
-    summary="vertex colours are not an affine image of the positions",
-    unit="1/255", default_threshold=2.0, attribute="colors", scored=True,
-    check=color_disaffinity,
-    what=(
-        "Measures how far the split moves the vertex colour at the quad's centre, "
-        "in 1/255 steps, and flags quads above the threshold."
-    ),
-    why=CREASE,
-    example=(
-        "# a unit square with corner colours blue, red, green, black: no parallelogram in colour space\n"
-        "v 0 0 0 0 0 1\nv 1 0 0 1 0 0\nv 1 1 0 0 1 0\nv 0 1 0 0 0 0\n"
-        "f 1 2 3 4\n"
-    ),
-    example_output=(
-        'example.obj:6:1: Q102 color-disaffine: vertex colours are not an affine image of the positions'
-        ' (110.4 vs 2/255)\n'
-    ),
-    fix=(
-        "Repaint the corner colours so opposite corners average to the same "
-        "colour, subdivide the quad, or triangulate before baking so the "
-        "diagonal is explicit."
-    ),
-    references=REFERENCES,
-))
-
-register(Rule(
-    code="Q103", name="normal-disaffine",
-    summary="normals are not an affine image of the positions",
-    unit="degrees", default_threshold=2.0, attribute="normals", scored=True,
-    check=normal_disaffinity,
-    what=(
-        "Measures how far the split turns the interpolated normal at the quad's "
-        "centre, in degrees, and flags quads above the threshold."
-    ),
-    why=CREASE,
-    example=(
-        "# a flat square whose corner normals lean out unevenly: the lighting bends along the diagonal\n"
-        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
-        "vn 0 0 1\nvn 0.5 0 1\nvn 0 0 1\nvn 0 0.5 1\n"
-        "f 1//1 2//2 3//3 4//4\n"
-    ),
-    example_output=(
-        'example.obj:10:1: Q103 normal-disaffine: normals are not an affine image of the positions'
-        ' (9.847 vs 2 degrees)\n'
-    ),
-    fix=(
-        "Subdivide the quad or even out its corners (Blender: Mesh > Clean Up, or "
-        "relax the loop), or triangulate before baking normals so the split "
-        "diagonal is fixed."
-    ),
-    references=REFERENCES,
-))

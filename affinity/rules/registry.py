@@ -2,10 +2,28 @@
 
 Lint (:mod:`affinity.lint`), the report, routing by lint, the SARIF rule
 descriptions, ``affinity rules``/``affinity rule`` and the README's rule table all
-read :data:`RULES`; nothing else lists rules. A rule is added by registering its
-record beside its check (as ruff keeps a rule's doc and check in one file):
+read :data:`RULES`; nothing else lists rules. A rule is its check, decorated with
+its facts; the check's docstring is the rule's page (as ruff keeps a rule's doc
+and check in one file)::
 
-    register(Rule(code="Q999", name="my-rule", ..., check=my_check))
+    @rule(code="Q999", name="my-rule", unit="texels", default_threshold=1.0)
+    def my_check(quads):
+        '''What a finding means, as one line.
+
+        What it does:
+            ...
+        Why it matters:
+            ...
+        Example:
+            v 0 0 0
+            ...
+        Prints:
+            example.obj:5:1: Q999 my-rule: ...
+        References:
+            ...
+        How to fix:
+            ...
+        '''
 
 Codes never change; names are kebab-case.
 """
@@ -102,6 +120,62 @@ def register(rule: Rule) -> Rule:
     RULES.clear()
     RULES.update(ordered)
     return rule
+
+
+#: The page's headings in a check's docstring -> the Rule field each fills.
+PAGE_HEADINGS = {
+    "What it does": "what", "Why it matters": "why", "Example": "example", "Prints": "example_output",
+    "References": "references", "How to fix": "fix",
+}
+#: Sections kept line by line (files and output); the others are prose, joined into one paragraph.
+VERBATIM = frozenset({"example", "example_output"})
+
+
+def page_fields(doc: str) -> dict[str, str]:
+    r"""The Rule fields a rule's page gives: ``summary`` (the first line, as a message reads
+    it: lower-case start, no full stop) and one field per heading of :data:`PAGE_HEADINGS`.
+
+    >>> page = page_fields('''Two triangles disagree.
+    ...
+    ...     What it does:
+    ...         Measures the
+    ...         disagreement.
+    ...     Example:
+    ...         v 0 0 0
+    ...         f 1 1 1
+    ...     ''')
+    >>> page["summary"], page["what"], page["example"]
+    ('two triangles disagree', 'Measures the disagreement.', 'v 0 0 0\nf 1 1 1\n')
+    """
+    import inspect
+
+    first, *rest = inspect.cleandoc(doc).splitlines()
+    fields: dict[str, list[str]] = {}
+    current = None
+    for line in rest:
+        heading = line.strip().rstrip(":")
+        if line and not line.startswith(" ") and heading in PAGE_HEADINGS:
+            current = PAGE_HEADINGS[heading]
+            fields[current] = []
+        elif current is not None:
+            fields[current].append(line[4:] if line.startswith("    ") else line.strip())
+    page = {"summary": first[:1].lower() + first[1:].rstrip(".")}
+    for name, lines in fields.items():
+        while lines and not lines[-1].strip():
+            lines.pop()
+        page[name] = "\n".join(lines) + "\n" if name in VERBATIM else " ".join(x.strip() for x in lines if x.strip())
+    return page
+
+
+def rule(**facts) -> Callable[[Callable], Callable]:
+    """Register the decorated check as a rule: ``facts`` are the Rule's fields, the check's
+    docstring its page (:func:`page_fields`); a field given in ``facts`` wins over the page."""
+
+    def register_check(check: Callable) -> Callable:
+        register(Rule(**{**page_fields(check.__doc__ or ""), **facts, "check": check}))
+        return check
+
+    return register_check
 
 
 def unregister(code: str) -> None:

@@ -5,23 +5,101 @@ from __future__ import annotations
 import numpy as np
 
 from ..geometry import degeneracy, folded_fraction, interior_angles, is_bowtie
-from .registry import Rule, register
+from .registry import rule
 
-REFERENCES = "Bloomenthal 2022, §3.4 (nonplanar and degenerate quads); Hormann & Tarini 2004, §4 (concave and self-crossing quads)."
+REFERENCES = ("Bloomenthal 2022, §3.4 (nonplanar and degenerate quads); "
+              "Hormann & Tarini 2004, §4 (concave and self-crossing quads).")
 
 
+@rule(code="Q201", name="degenerate-quad", unit="relative area", default_threshold=1e-9, flags="at-or-below",
+      worst="lowest", references=REFERENCES)
 def degenerate(quads) -> tuple:
-    """Q201: the quad's area relative to its size."""
+    """Zero area, collapsed edge or repeated corner.
+
+    What it does:
+        Flags quads with a repeated corner, a collapsed edge or an area at or below
+        the threshold relative to their size.
+
+    Why it matters:
+        One of the two triangles of the split covers no pixels, so the half of the
+        attribute it carries is lost, and any test or interpolation that divides by
+        its area is undefined (the pole rows of a lat-long sphere).
+
+    Example:
+        # a quad with a repeated corner
+        v 0 0 0
+        v 1 0 0
+        v 1 1 0
+        f 1 2 3 3
+
+    Prints:
+        example.obj:5:1: Q201 degenerate-quad: zero area, collapsed edge or repeated corner (0 vs 1e-09 relative area)
+
+    How to fix:
+        Merge the collapsed corners (Blender: Mesh > Clean Up > Merge by Distance)
+        so the face becomes the triangle it really is.
+    """
     return slice(None), degeneracy(quads.planar)
 
 
+@rule(code="Q202", name="nonplanar-quad", unit="relative warp", default_threshold=0.01, references=REFERENCES)
 def nonplanar(quads) -> tuple:
-    """Q202: the distance between the diagonals relative to their mean length."""
+    """Corners do not lie in one plane (warp above tolerance).
+
+    What it does:
+        Measures the distance between the two diagonals relative to their mean
+        length and flags quads above the threshold; the affinity test runs on the
+        projection onto the quad's plane.
+
+    Why it matters:
+        A warped quad has no single flat shape: each diagonal split gives a
+        different surface and lighting, and no interpolation is exact.
+
+    Example:
+        # the unit square with one corner lifted by 0.2
+        v 0 0 0
+        v 1 0 0
+        v 1 1 0.2
+        v 0 1 0
+        f 1 2 3 4
+
+    Prints:
+        example.obj:6:1: Q202 nonplanar-quad: corners do not lie in one plane (warp above tolerance) (0.06967 vs 0.01 relative warp)
+
+    How to fix:
+        Flatten the quad (Blender: Mesh > Clean Up > Make Planar Faces) or
+        triangulate it along the intended diagonal.
+    """
     return slice(None), quads.planar.warp
 
 
+@rule(code="Q203", name="concave-quad", unit="degrees", default_threshold=180.0, references=REFERENCES)
 def concave(quads) -> tuple:
-    """Q203: the largest interior angle, in degrees, of the quads that are not bow-ties."""
+    """One corner is reflex.
+
+    What it does:
+        Flags quads whose largest interior angle, in their own plane, is above the
+        threshold (180 degrees: a reflex corner).
+
+    Why it matters:
+        Splitting along the wrong diagonal folds a triangle outside the quad;
+        bilinear inversion is ambiguous.
+
+    Example:
+        # a dart: the corner at (0.5, 0.5) points inward
+        v 0 0 0
+        v 2 0 0
+        v 0.5 0.5 0
+        v 0 2 0
+        f 1 2 3 4
+
+    Prints:
+        example.obj:6:1: Q203 concave-quad: one corner is reflex (233.1 vs 180 degrees)
+
+    How to fix:
+        Move the reflex corner outward, or split the quad into two triangles along
+        the diagonal through the reflex corner (Blender: Face > Triangulate).
+    """
     planar = quads.planar
     candidates = ~is_bowtie(planar)
     if quads.settings.threshold("Q203") >= 180:
@@ -34,103 +112,32 @@ def concave(quads) -> tuple:
     return rows, interior_angles(planar.take(rows)).max(axis=1)
 
 
+@rule(code="Q204", name="bowtie-quad", level="error", references=REFERENCES)
 def bowtie(quads) -> tuple:
-    """Q204: the folded fraction of the self-crossing quads."""
+    """The quad crosses itself.
+
+    What it does:
+        Flags quads whose edges cross (a bow-tie) in their own plane; the value
+        reported is the folded fraction of the quad.
+
+    Why it matters:
+        A self-crossing quad has no consistent orientation; one half renders
+        back-facing.
+
+    Example:
+        # the unit square with its corners in the order (0,0), (1,1), (1,0), (0,1)
+        v 0 0 0
+        v 1 1 0
+        v 1 0 0
+        v 0 1 0
+        f 1 2 3 4
+
+    Prints:
+        example.obj:6:1: Q204 bowtie-quad: the quad crosses itself (0.5)
+
+    How to fix:
+        Reorder the corners (flip the crossing edge) or delete and refill the face
+        (Blender: select the four vertices, F).
+    """
     rows = np.flatnonzero(is_bowtie(quads.planar))
     return rows, folded_fraction(quads.planar.take(rows))
-
-
-register(Rule(
-    code="Q201", name="degenerate-quad",
-    summary="zero area, collapsed edge or repeated corner",
-    unit="relative area", default_threshold=1e-9, flags="at-or-below", worst="lowest",
-    check=degenerate,
-    what=(
-        "Flags quads with a repeated corner, a collapsed edge or an area at or "
-        "below the threshold relative to their size."
-    ),
-    why=(
-        "One of the two triangles of the split covers no pixels, so the half of the "
-        "attribute it carries is lost, and any test or interpolation that divides "
-        "by its area is undefined (the pole rows of a lat-long sphere)."
-    ),
-    example="# a quad with a repeated corner\nv 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3 3\n",
-    example_output=(
-        'example.obj:5:1: Q201 degenerate-quad: zero area, collapsed edge or repeated corner'
-        ' (0 vs 1e-09 relative area)\n'
-    ),
-    fix=(
-        "Merge the collapsed corners (Blender: Mesh > Clean Up > Merge by "
-        "Distance) so the face becomes the triangle it really is."
-    ),
-    references=REFERENCES,
-))
-
-register(Rule(
-    code="Q202", name="nonplanar-quad",
-    summary="corners do not lie in one plane (warp above tolerance)",
-    unit="relative warp", default_threshold=0.01,
-    check=nonplanar,
-    what=(
-        "Measures the distance between the two diagonals relative to their mean "
-        "length and flags quads above the threshold; the affinity test runs on the "
-        "projection onto the quad's plane."
-    ),
-    why=(
-        "A warped quad has no single flat shape: each diagonal split gives a "
-        "different surface and lighting, and no interpolation is exact."
-    ),
-    example="# the unit square with one corner lifted by 0.2\nv 0 0 0\nv 1 0 0\nv 1 1 0.2\nv 0 1 0\nf 1 2 3 4\n",
-    example_output=(
-        'example.obj:6:1: Q202 nonplanar-quad: corners do not lie in one plane'
-        ' (warp above tolerance) (0.06967 vs 0.01 relative warp)\n'
-    ),
-    fix=(
-        "Flatten the quad (Blender: Mesh > Clean Up > Make Planar Faces) or "
-        "triangulate it along the intended diagonal."
-    ),
-    references=REFERENCES,
-))
-
-register(Rule(
-    code="Q203", name="concave-quad",
-    summary="one corner is reflex",
-    unit="degrees", default_threshold=180.0,
-    check=concave,
-    what=(
-        "Flags quads whose largest interior angle, in their own plane, is above "
-        "the threshold (180 degrees: a reflex corner)."
-    ),
-    why=(
-        "Splitting along the wrong diagonal folds a triangle outside the quad; "
-        "bilinear inversion is ambiguous."
-    ),
-    example="# a dart: the corner at (0.5, 0.5) points inward\nv 0 0 0\nv 2 0 0\nv 0.5 0.5 0\nv 0 2 0\nf 1 2 3 4\n",
-    example_output='example.obj:6:1: Q203 concave-quad: one corner is reflex (233.1 vs 180 degrees)\n',
-    fix=(
-        "Move the reflex corner outward, or split the quad into two triangles along "
-        "the diagonal through the reflex corner (Blender: Face > Triangulate)."
-    ),
-    references=REFERENCES,
-))
-
-register(Rule(
-    code="Q204", name="bowtie-quad",
-    summary="the quad crosses itself", level="error",
-    check=bowtie,
-    what=(
-        "Flags quads whose edges cross (a bow-tie) in their own plane; the value "
-        "reported is the folded fraction of the quad."
-    ),
-    why=(
-        "A self-crossing quad has no consistent orientation; one half renders "
-        "back-facing."
-    ),
-    example="# the unit square with its corners in the order (0,0), (1,1), (1,0), (0,1)\nv 0 0 0\nv 1 1 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 4\n",
-    example_output='example.obj:6:1: Q204 bowtie-quad: the quad crosses itself (0.5)\n',
-    fix=(
-        "Reorder the corners (flip the crossing edge) or delete and refill the "
-        "face (Blender: select the four vertices, F)."
-    ),
-    references=REFERENCES,
-))

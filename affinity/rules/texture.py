@@ -5,62 +5,79 @@ from __future__ import annotations
 import numpy as np
 
 from ..geometry import relative_signed_area
-from .registry import Rule, register
+from .registry import rule
 
 
+@rule(code="Q301", name="uv-degenerate", unit="relative area", default_threshold=1e-9, flags="at-or-below",
+      worst="lowest", attribute="texcoords")
 def uv_degenerate(quads) -> tuple:
-    """Q301: the quad's uv area relative to its uv size."""
+    """Zero area in texture space.
+
+    What it does:
+        Flags quads whose texture-space area is at or below the threshold relative
+        to their UV size.
+
+    Why it matters:
+        The whole quad samples a line or a point of the texture: it smears.
+
+    Example:
+        # a square whose four corners share one line of uv
+        v 0 0 0
+        v 1 0 0
+        v 1 1 0
+        v 0 1 0
+        vt 0 0
+        vt 1 0
+        f 1/1 2/2 3/2 4/1
+
+    Prints:
+        example.obj:8:1: Q301 uv-degenerate: zero area in texture space (0 vs 1e-09 relative area)
+
+    References:
+        Bloomenthal 2022, §2 (the barycentric test divides by the uv triangles' areas).
+
+    How to fix:
+        Unwrap the face again so it gets its own area in UV space.
+    """
     return quads.uv[0], np.abs(relative_signed_area(quads.uv_planar))
 
 
+@rule(code="Q302", name="uv-flipped", worst="lowest", attribute="texcoords")
 def uv_flipped(quads) -> tuple:
-    """Q302: the negative relative uv area of the quads whose uv winds against the face.
+    """Texture orientation reversed against the surface.
 
-    Quads whose |area| is within Q301's threshold (as configured) are Q301's: degenerate, not flipped.
+    What it does:
+        Flags quads whose UV winding is clockwise while the face winding is
+        counter-clockwise (a mirrored UV island); the value reported is the negative
+        relative UV area. Quads whose UV area is within Q301's threshold (as
+        configured) are Q301's: degenerate, not flipped.
+
+    Why it matters:
+        Mirrored UVs flip the tangent frame: normal maps light the wrong way.
+
+    Example:
+        # a UV island mirrored to save texture space
+        v 0 0 0
+        v 1 0 0
+        v 1 1 0
+        v 0 1 0
+        vt 1 0
+        vt 0 0
+        vt 0 1
+        vt 1 1
+        f 1/1 2/2 3/3 4/4
+
+    Prints:
+        example.obj:10:1: Q302 uv-flipped: texture orientation reversed against the surface (-1)
+
+    References:
+        Mikkelsen 2008, Simulation of wrinkled surfaces revisited (tangent frames at mirrored UVs).
+
+    How to fix:
+        Flip the island in the UV editor (Blender: UV > Mirror), or split tangents at
+        the mirror seam.
     """
     rows = np.arange(len(quads))[quads.uv[0]]
     area = relative_signed_area(quads.uv_planar)
     flipped = area < -quads.settings.threshold("Q301")
     return rows[flipped], area[flipped]
-
-
-register(Rule(
-    code="Q301", name="uv-degenerate",
-    summary="zero area in texture space",
-    unit="relative area", default_threshold=1e-9, flags="at-or-below", worst="lowest", attribute="texcoords",
-    check=uv_degenerate,
-    what=(
-        "Flags quads whose texture-space area is at or below the threshold "
-        "relative to their UV size."
-    ),
-    why="The whole quad samples a line or a point of the texture: it smears.",
-    example=(
-        "# a square whose four corners share one line of uv\n"
-        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nf 1/1 2/2 3/2 4/1\n"
-    ),
-    example_output='example.obj:8:1: Q301 uv-degenerate: zero area in texture space (0 vs 1e-09 relative area)\n',
-    fix="Unwrap the face again so it gets its own area in UV space.",
-    references="Bloomenthal 2022, §2 (the barycentric test divides by the uv triangles' areas).",
-))
-
-register(Rule(
-    code="Q302", name="uv-flipped",
-    summary="texture orientation reversed against the surface", worst="lowest", attribute="texcoords",
-    check=uv_flipped,
-    what=(
-        "Flags quads whose UV winding is clockwise while the face winding is "
-        "counter-clockwise (a mirrored UV island); the value reported is the "
-        "negative relative UV area."
-    ),
-    why="Mirrored UVs flip the tangent frame: normal maps light the wrong way.",
-    example=(
-        "# a UV island mirrored to save texture space\n"
-        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 1 0\nvt 0 0\nvt 0 1\nvt 1 1\nf 1/1 2/2 3/3 4/4\n"
-    ),
-    example_output='example.obj:10:1: Q302 uv-flipped: texture orientation reversed against the surface (-1)\n',
-    fix=(
-        "Flip the island in the UV editor (Blender: UV > Mirror), or split "
-        "tangents at the mirror seam."
-    ),
-    references="Mikkelsen 2008, Simulation of wrinkled surfaces revisited (tangent frames at mirrored UVs).",
-))
