@@ -6,8 +6,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from affinity.loaders import load
 from affinity.errors import MeshError, SkippedFile
+from affinity.loaders import load
 
 SQUARE = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"  # lines 1-4
 

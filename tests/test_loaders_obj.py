@@ -256,3 +256,12 @@ def test_latin1_names(tmp_path):
     assert mesh.group_names == ["caf\xe9", "\xe9t\xe9"]
     assert mesh.material_names == ["m\xe4t"]
     assert mesh.face_group.tolist() == [0, 1]
+
+
+def test_nan_colour_is_a_note_not_an_error(tmp_path):
+    body = "v 0 0 0 1 0 0\nv 1 0 0 nan 0 0\nv 1 1 0 0 1 nan\nv 0 1 0 0 0 1\nf 1 2 3 4\n"
+    mesh = load(write(tmp_path, body))
+    assert mesh.colors is None and mesh.notes == ["2 vertex colours NaN (first at line 2): colours not checked"]
+    np.testing.assert_array_equal(mesh.positions, [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]])
+    with pytest.raises(MeshError, match="finite"):
+        load(write(tmp_path, "v 0 0 0 1 0 0\nv nan 0 0 1 0 0\nv 1 1 0 0 1 0\nf 1 2 3\n"))

@@ -35,7 +35,7 @@ import numpy as np
 
 from ..errors import MeshError
 from ..mesh import Mesh
-from .faces import check_indices, ragged_positions
+from .faces import check_indices, color_note, ragged_positions
 from .mtl import read_material_textures
 from .numbers import PAD, parse_floats, parse_ints
 from .text import Tokens, floats_or_raise, read_chunks, tokenize
@@ -76,6 +76,7 @@ class _Part:
     bytes: int  # bytes of the chunk's lines
     events: list = field(default_factory=list)  # (face in chunk, keyword, name)
     mtllibs: list = field(default_factory=list)
+    nan_colors: list = field(default_factory=list)  # (vertices, first line) with a NaN colour
 
 
 #: Chunks parsed in parallel (NumPy releases the GIL inside its loops).
@@ -105,7 +106,8 @@ def _parse_chunk(chunk, path) -> _Part:
     counts = tokens.counts
     kind = _line_kinds(tokens, counts)
     element_lines = {k: np.flatnonzero(kind == k) for k in _WIDTHS}
-    elements = {k: _elements(tokens, path, lines, k) for k, lines in element_lines.items()}
+    nan_colors = []
+    elements = {k: _elements(tokens, path, lines, k, nan_colors) for k, lines in element_lines.items()}
     _check_colors(tokens, path, element_lines[_V], elements[_V])
     face_lines = np.flatnonzero(kind == _F)
     sizes, corners, relative, bounds, face_slashes = _faces(tokens, path, kind, face_lines)
@@ -123,6 +125,7 @@ def _parse_chunk(chunk, path) -> _Part:
         bounds=bounds,
         lines=len(tokens.end) + len(chunk.joined),
         bytes=len(chunk.buf) - 2 * PAD,
+        nan_colors=nan_colors,
     )
     statements = np.flatnonzero((counts > 0) & (kind == 0))
     if len(statements):
@@ -177,8 +180,12 @@ def _token_block(tokens: Tokens, lines, width: int, previous: bool = False):
     return block + (tokens.ends[index - 1],) if previous else block
 
 
-def _elements(tokens: Tokens, path, lines, which) -> np.ndarray:
-    """(n, width) float64 numbers of the ``which`` lines, NaN where a line has fewer."""
+def _elements(tokens: Tokens, path, lines, which, nan_colors: list) -> np.ndarray:
+    """(n, width) float64 numbers of the ``which`` lines, NaN where a line has fewer.
+
+    NaN colours (``v x y z r g b`` lines) are kept and counted in ``nan_colors``
+    (see :func:`_nan_colors_or_raise`); every other number must be finite.
+    """
     if len(lines) == 0:
         return np.zeros((0, _WIDTHS[which][0]))
     counts = tokens.counts[lines]
@@ -186,15 +193,21 @@ def _elements(tokens: Tokens, path, lines, which) -> np.ndarray:
         width = int(counts[0]) - 1  # one width: a (lines, numbers) block
         starts, ends = _token_block(tokens, lines, width)
         rows, bad = parse_floats(tokens.buf, starts, ends, finite=True)
-        if len(bad):  # let the token-by-token path say what is wrong with it
-            floats_or_raise(tokens, path, tokens.first[lines[bad[:1] // width]] + 1 + bad[:1] % width, finite=True)
+        if len(bad):
+            line, column = bad // width, bad % width
+            token = tokens.first[lines[line]] + 1 + column
+            _nan_colors_or_raise(tokens, path, which, token, column, width, nan_colors)
     else:
         width, numbers = _line_tokens(tokens, lines)
         wrong = ~_ALLOWED[which][np.minimum(width, _MAX_WIDTH)]
         if wrong.any():
             line = lines[np.argmax(wrong)]
             raise MeshError(path, tokens.number[line], f"{tokens.text(tokens.first[line])} line with {width[wrong][0]} numbers")
-        values = floats_or_raise(tokens, path, numbers, finite=True)
+        values, bad = parse_floats(tokens.buf, tokens.starts[numbers], tokens.ends[numbers], finite=True)
+        if len(bad):
+            line = np.repeat(np.arange(len(width)), width)[bad]
+            column = ragged_positions(np.zeros(len(width), np.int64), width)[bad]
+            _nan_colors_or_raise(tokens, path, which, numbers[bad], column, width[line], nan_colors)
         # As wide as the widest line: 'v x y z' among 'v x y z w' lines has no colour.
         rows = np.full((len(width), max(int(width.max()), _WIDTHS[which][0])), np.nan)
         rows[np.repeat(np.arange(len(width)), width), ragged_positions(np.zeros(len(width), np.int64), width)] = values
@@ -205,6 +218,19 @@ def _elements(tokens: Tokens, path, lines, which) -> np.ndarray:
     if rows.shape[1] == 7:
         rows[np.isnan(rows[:, 4]), 3] = np.nan  # 'v x y z w' among colour lines
     return rows[:, :6]  # the alpha of 'v x y z r g b a' is not kept
+
+
+def _nan_colors_or_raise(tokens: Tokens, path, which, token, column, width, nan_colors: list) -> None:
+    """Of the tokens ``token`` (n,) that are not finite numbers (``column`` (n,) within
+    lines of ``width`` numbers), accept the NaN colours (appending their lines to
+    ``nan_colors`` as (vertices, first line in the chunk)); MeshError at the first other one."""
+    values, not_numbers = parse_floats(tokens.buf, tokens.starts[token], tokens.ends[token])
+    colour = np.isnan(values) & (column >= 3) & (np.asarray(width) >= 6) & (which == _V)
+    colour[not_numbers] = False
+    if not colour.all():
+        floats_or_raise(tokens, path, token[~colour][:1], finite=True)
+    lines = np.searchsorted(tokens.first, token, side="right") - 1
+    nan_colors.append((len(np.unique(lines)), int(tokens.number[lines[0]])))
 
 
 def _reject_slashes(tokens: Tokens, path, lines) -> None:
@@ -546,6 +572,7 @@ class _Assembly:
         self.bounds = [(0, -1)] * 3
         self.events = []
         self.mtllibs = []
+        self.nan_colors = []  # (vertices, line) with a NaN colour, in file order
 
     def _growing(self, dtype, width=None) -> _Growing:
         return _Growing(dtype, self.progress, width)
@@ -558,6 +585,7 @@ class _Assembly:
         except MeshError as error:
             raise MeshError(error.path, error.line + self.n_lines * (error.line > 0), error.reason) from None
         part.face_line += self.n_lines
+        part.nan_colors = [(count, line + self.n_lines) for count, line in part.nan_colors]
         return part
 
     def add(self, part: _Part) -> None:
@@ -567,6 +595,7 @@ class _Assembly:
         before = {k: len(self.elements[k]) for k in _WIDTHS}
         for k in _WIDTHS:
             self.elements[k].append(part.elements[k])
+        self.nan_colors += part.nan_colors
         n_faces = len(part.face_line)
         if n_faces == 0:
             self.mtllibs += part.mtllibs
@@ -651,6 +680,9 @@ class _Assembly:
         for library in self.mtllibs:
             for material, texture in read_material_textures(os.path.join(folder, library)).items():
                 textures.setdefault(material, texture)
+        notes = []
+        if self.nan_colors:
+            notes.append(color_note(sum(count for count, _ in self.nan_colors), 0, self.nan_colors[0][1]))
         return Mesh(
             path=os.fspath(path),
             positions=vertices if vertices.shape[1] == 3 else np.ascontiguousarray(vertices[:, :3]),
@@ -661,12 +693,13 @@ class _Assembly:
             corner_texcoord=corners[1] if len(texcoords) else None,
             normals=normals if len(normals) else None,
             corner_normal=corners[2] if len(normals) else None,
-            colors=np.nan_to_num(vertices[:, 3:6], nan=1.0) if vertices.shape[1] >= 6 else None,
+            colors=np.nan_to_num(vertices[:, 3:6], nan=1.0) if vertices.shape[1] >= 6 and not notes else None,
             group_names=group_names,
             face_group=face_group,
             material_names=material_names,
             face_material=face_material,
             material_textures=textures,
+            notes=notes,
         )
 
 
