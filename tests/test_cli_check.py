@@ -86,7 +86,7 @@ def test_barycentric_measure_uses_paper_tolerance(tmp_path):
 def test_statistics_counts_per_rule(tmp_path):
     path = str(write(tmp_path, "trapezoid.obj", TRAPEZOID))
     result = run("check", "--statistics", path)
-    assert re.search(r"^\s+1\s+Q101\s+uv-disaffine$", result.stdout, re.MULTILINE), result.stdout
+    assert re.search(r"^\s+1\s+Q101\s+uv-disaffine$", result.stdout, re.M), result.stdout
 
 
 def test_text_output_is_capped_per_rule(tmp_path):

@@ -10,8 +10,8 @@ from affinity.geometry import (
     interior_angles,
     is_bowtie,
     nonplanarity,
-    planar_quads,
     plane_coordinates,
+    planar_quads,
     quad_normals,
     relative_signed_area,
 )

@@ -11,12 +11,7 @@ import pytest
 from test_cli_check import run
 from test_formats import SQUARE, UNIT_UV, quad_obj, trapezoid
 
-from affinity.pipeline.check import (
-    BYTES_PER_WORKER,
-    auto_jobs,
-    available_cpus,
-    check_files,
-)
+from affinity.pipeline.check import BYTES_PER_WORKER, auto_jobs, available_cpus, check_files
 from affinity.settings import Settings
 
 HEAVY = ("render", "PIL", "matplotlib", "jinja2", "trimesh", "igl", "pyvista", "tqdm")

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 import affinity.lint
-from affinity.lint import lint_mesh, quad_uv_misplacement
 from affinity.loaders.imagesize import image_size
+from affinity.lint import lint_mesh, quad_uv_misplacement
 from affinity.mesh import Mesh
 from affinity.settings import Settings
 

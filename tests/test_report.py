@@ -15,8 +15,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from affinity.loaders.objwriter import write_obj
 from affinity.mesh import mesh_from_polygons
+from affinity.loaders.objwriter import write_obj
 from affinity.scenes import color_squares
 
 TRAPEZOID = "v -1 0 0\nv 1 0 0\nv 0.5 1 0\nv -0.5 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n"
@@ -226,7 +226,8 @@ def test_output_into_an_unwritable_place_is_an_error_and_writes_nothing(tmp_path
 
 
 def test_scores_are_the_lint_rule_values_for_every_quad():
-    from affinity.lint import lint_mesh, quad_scores
+    from affinity.lint import lint_mesh
+    from affinity.lint import quad_scores
     from affinity.scenes import demo_sphere
     from affinity.settings import Settings
 

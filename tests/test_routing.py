@@ -2,12 +2,7 @@
 
 import numpy as np
 
-from affinity.draw.routing import (
-    attribute_area,
-    route_by_view,
-    screen_area,
-    split_error_pixels,
-)
+from affinity.draw.routing import attribute_area, route_by_view, screen_area, split_error_pixels
 
 UNIT_UV = np.array([[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]])
 

@@ -54,7 +54,7 @@ def test_readme_rule_table_is_the_generated_one():
     if not README.exists():
         pytest.skip("README.md not written yet")
     text = README.read_text()
-    match = re.search(r"<!-- rules:start -->\n(.*?)<!-- rules:end -->", text, re.DOTALL)
+    match = re.search(r"<!-- rules:start -->\n(.*?)<!-- rules:end -->", text, re.S)
     assert match, "README.md lacks the <!-- rules:start --> / <!-- rules:end --> markers"
     assert match[1] == rules_table(), "regenerate the table with `affinity rules --markdown`"
     assert run("rules", "--markdown").stdout == rules_table()

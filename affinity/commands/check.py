@@ -159,10 +159,10 @@ def _write_baseline(reports, path: str, quiet: bool) -> None:
 
 
 def run(args) -> int:
+    from ..pipeline.check import check_files
     from ..config import Resolver
     from ..loaders.usd import UsdOptions
     from ..output import CheckRun
-    from ..pipeline.check import check_files
 
     if args.baseline and args.write_baseline:
         raise UsageError("--baseline and --write-baseline exclude each other")

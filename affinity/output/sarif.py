@@ -33,15 +33,7 @@ from urllib.parse import quote
 from .. import __version__
 from ..findings import FileReport
 from ..rules import RULES, UNREADABLE, rule_page
-from . import (
-    CheckRun,
-    Finding,
-    face_label,
-    file_findings,
-    located,
-    value_token,
-    working_relative,
-)
+from . import CheckRun, Finding, face_label, file_findings, located, value_token, working_relative
 
 SARIF_VERSION = "2.1.0"
 SARIF_SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"

@@ -25,13 +25,16 @@ def write_findings(run: CheckRun, out: TextIO, verbose: bool = False) -> None:
     """Every finding of every checked file, capped per file and rule unless verbose."""
     for report in run.reports:
         findings, omitted = file_findings(report, None if verbose else TEXT_LIMIT)
-        out.writelines(text_line(f) + "\n" for f in findings)
-        out.writelines(f"{report.path}: ... and {n} more {code} (use --verbose or --format json for all)\n" for code, n in omitted.items())
+        for f in findings:
+            out.write(text_line(f) + "\n")
+        for code, n in omitted.items():
+            out.write(f"{report.path}: ... and {n} more {code} (use --verbose or --format json for all)\n")
 
 
 def write_statistics(run: CheckRun, out: TextIO) -> None:
     """One line per rule with findings: count, code, name (like ``ruff --statistics``)."""
-    out.writelines(f"{n:>8}  {code}  {RULES[code].name}\n" for code, n in rule_counts(run.reports).items())
+    for code, n in rule_counts(run.reports).items():
+        out.write(f"{n:>8}  {code}  {RULES[code].name}\n")
 
 
 def write_summary(run: CheckRun, out: TextIO) -> None:

@@ -19,8 +19,8 @@ import numpy as np
 from ..findings import FileReport
 from ..lint import QuadScores, quad_scores, scored_codes
 from ..mesh import Mesh
-from ..scenes import View
 from ..settings import Settings
+from ..scenes import View
 from .demo import MeshInput
 
 RENDER_SIZE = (480, 360)
@@ -138,8 +138,8 @@ def _overview(result: MeshResult, step: Callable[[str], None]) -> None:
 
 def collect_mesh(item: MeshInput, settings: Settings, step: Callable[[str], None] = lambda name: None) -> MeshResult:
     """Lint, score, render and picture one mesh; an unreadable file gives a result with ``file.error``."""
-    from ..draw.texture import checker
     from ..pipeline.check import load_and_check
+    from ..draw.texture import checker
 
     start = time.perf_counter()
     step("lint")
