@@ -97,10 +97,9 @@ def generate_obj(rng: random.Random) -> str:
                 slots = form.split("/")
                 corners.append("/".join(index({"v": "v", "vt": "vt", "vn": "vn"}[s]) if s else "" for s in slots))
             gaps = [_separator(rng, wide) for _ in corners]
-            words = "f" + "".join(gap + corner for gap, corner in zip(gaps, corners))
             if rng.random() < 0.05:  # continue the statement on the next line
-                cut = words.index(" ", 2)
-                words = words[:cut] + " \\\n" + words[cut + 1 :]
+                gaps[1] = " \\\n"
+            words = "f" + "".join(gap + corner for gap, corner in zip(gaps, corners))
             emit(words)
     return "\n".join(lines) + rng.choice(["\n", ""])
 

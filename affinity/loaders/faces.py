@@ -80,7 +80,8 @@ def polygon_mesh(path, positions, sizes, corners, face_line, texcoords=None, cor
     if small.any():
         raise MeshError(path, int(face_line[np.argmax(small)]), f"face with {sizes[small][0]} corners (at least 3 needed)")
     face_start = np.concatenate(([0], np.cumsum(sizes)))
-    corner_vertex = np.where(corners == np.round(corners), corners, -1).astype(np.int64)
+    whole = (corners == np.round(corners)) & (np.abs(corners) < 2**62)  # NaN, inf and 1e30 are no index
+    corner_vertex = np.where(whole, corners, -1).astype(np.int64)
     check_indices(path, corner_vertex, len(positions), face_start, face_line, "vertex")
     if texcoords is not None and corner_texcoord is None:
         corner_texcoord = corner_vertex
