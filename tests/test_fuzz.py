@@ -10,6 +10,7 @@ OFF counts). For each file:
 - ``load`` returns a mesh that passes :meth:`Mesh.validate` or raises the
   loader's own error (MeshError, SkippedFile), within a time limit;
 - ``lint_mesh`` runs on every mesh that loads, without an exception;
+- an OBJ read in 4 kB chunks gives the same mesh as read whole (or fails too);
 - ``affinity check --format json`` over batches of files (one process per
   batch) exits 0, 1 or 2 with valid JSON, no traceback and no "internal error",
   and agrees with the in-process outcome: batches of clean files exit 0, of
@@ -31,11 +32,13 @@ import sys
 from collections import Counter
 from pathlib import Path
 
-from test_loaders_chunks import generate_obj
+import numpy as np
+from test_loaders_chunks import FIELDS, generate_obj
 
 from affinity.errors import MeshError, SkippedFile
 from affinity.lint import lint_mesh
 from affinity.loaders import load
+from affinity.loaders.obj import load_obj
 from affinity.settings import Settings
 
 FUZZ_FILES = int(os.environ.get("AFFINITY_FUZZ_FILES", "600"))
@@ -46,6 +49,8 @@ DATA = Path(__file__).parent / "data" / "loaders"
 LARGEST_SEED = 300_000
 #: Files per ``affinity check`` process.
 BATCH = 150
+#: Chunk size of the second reading of every OBJ (the mesh must not depend on it).
+SMALL_CHUNK = 4096
 #: Seconds one load may take before it counts as a hang.
 LOAD_SECONDS = 20
 
@@ -196,12 +201,17 @@ def load_outcome(path: Path) -> tuple[str, str | None]:
     previous = signal.signal(signal.SIGALRM, _alarm)
     signal.alarm(LOAD_SECONDS)
     try:
-        mesh = load(path)
+        try:
+            mesh = load(path)
+        except MeshError as error:
+            return "unreadable", (f"error names {error.path}" if error.path != str(path) else
+                                  None if path.suffix != ".obj" else chunked_difference(path, None))
         mesh.validate()
         hits = lint_mesh(mesh, Settings())
-    except (MeshError, SkippedFile) as error:
-        outcome = "skipped" if isinstance(error, SkippedFile) else "unreadable"
-        return outcome, None if error.path == str(path) else f"error names {error.path}"
+        if path.suffix == ".obj" and (difference := chunked_difference(path, mesh)):
+            return "crash", difference
+    except SkippedFile:
+        return "skipped", None
     except Hang:
         return "hang", f"load or lint took more than {LOAD_SECONDS} s"
     except Exception as error:  # noqa: BLE001  the defect this harness looks for
@@ -210,6 +220,25 @@ def load_outcome(path: Path) -> tuple[str, str | None]:
         signal.alarm(0)
         signal.signal(signal.SIGALRM, previous)
     return ("findings" if any(len(h) for h in hits) else "clean"), None
+
+
+def chunked_difference(path: Path, whole) -> str | None:
+    """How the OBJ at ``path`` read in chunks of :data:`SMALL_CHUNK` bytes differs from
+    ``whole``, the mesh read in one chunk (None: it was unreadable); None when it does not.
+
+    Both must fail, or give the same mesh (which error comes first may differ: a
+    chunk checks its vertices before its faces)."""
+    try:
+        pieces = load_obj(path, chunk_bytes=SMALL_CHUNK)
+    except MeshError as error:
+        return None if whole is None else f"in {SMALL_CHUNK}-byte chunks: {error.reason} (line {error.line})"
+    if whole is None:
+        return f"readable in {SMALL_CHUNK}-byte chunks, unreadable whole"
+    for name in FIELDS:
+        a, b = getattr(whole, name), getattr(pieces, name)
+        if (a is None) != (b is None) or (a is not None and not np.array_equal(a, b, equal_nan=True)):
+            return f"{name} differs when read in {SMALL_CHUNK}-byte chunks"
+    return None
 
 
 def check_batch(paths: list[Path], expected: str) -> list[str]:
