@@ -4,7 +4,7 @@ Generated valid OBJ files mix face sizes and corner forms (attributes on some
 faces only, empty trailing slots), groups, materials, comments, colours,
 negative indices and '\\' continuations, in runs, so that chunk boundaries fall
 between runs of one face size and runs of several. Each file is parsed whole,
-at chunk sizes down to one byte, and by the plain line-by-line reader below,
+at chunk sizes down to three bytes, and by the plain line-by-line reader below,
 which shares no code with the loader.
 """
 
@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 
 from affinity.loaders.obj import load_obj
 
-CHUNK_SIZES = (4096, 333, 64, 23, 7, 1)
+CHUNK_SIZES = (4096, 257, 61, 13, 3)
 
 
 def _number(rng: random.Random, value: float) -> str:
@@ -190,7 +190,7 @@ def assert_same_mesh(mesh, expected: dict, where: str) -> None:
     mesh.validate()
 
 
-@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(seed=st.integers(0, 2**32 - 1))
 def test_chunk_size_never_changes_the_mesh(tmp_path, seed):
     text = generate_obj(random.Random(seed))
