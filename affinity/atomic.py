@@ -44,14 +44,15 @@ def atomic_write(path: str | os.PathLike, binary: bool = False):
     is not writable, or ``path`` is a directory, so callers can turn it into
     one clear line.
     """
-    target = Path(os.path.realpath(path))
-    mode = _existing_mode(target)
+    mode = _existing_mode(Path(path))
     if mode is not None and stat.S_ISDIR(mode):
         raise IsADirectoryError(errno.EISDIR, "is a directory, not a file", os.fspath(path))
     if mode is not None and not stat.S_ISREG(mode):
-        with _write_once(target, binary) as out:
+        # through the path as given: /dev/stdout on a pipe resolves to no file name
+        with _write_once(Path(path), binary) as out:
             yield out
         return
+    target = Path(os.path.realpath(path))
     fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
     try:
         os.fchmod(fd, stat.S_IMODE(mode) if mode is not None else 0o666 & ~_umask())

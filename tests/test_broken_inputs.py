@@ -12,6 +12,8 @@ import json
 import os
 import stat
 import struct
+import subprocess
+import sys
 
 import pytest
 from test_atomic import make_null_device, read_fifo_in_background
@@ -227,3 +229,14 @@ def test_baseline_onto_a_directory_is_refused(tmp_path):
     folder.mkdir()
     result = run("check", "--write-baseline", str(folder), str(write(tmp_path, "trap.obj", TRAPEZOID)))
     assert result.returncode == 2 and "directory" in result.stderr and os.listdir(folder) == []
+
+
+def test_render_to_standard_output_through_a_link(tmp_path):
+    """A link to the process's own stdout (as /dev/stdout is) on a pipe: the PNG goes down the pipe."""
+    link = tmp_path / "stdout.png"
+    link.symlink_to("/proc/self/fd/1")
+    result = subprocess.run([sys.executable, "-m", "affinity.cli", *RENDER, "-o", str(link)],
+                            capture_output=True, timeout=300, check=False)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.startswith(b"\x89PNG\r\n\x1a\n")
+    assert link.is_symlink() and os.listdir(tmp_path) == ["stdout.png"]
