@@ -99,6 +99,8 @@ def test_fail_on_skip(tmp_path):
     result = run("check", "--fail-on-skip", str(tmp_path))
     assert result.returncode == 2 and "big.obj: skipped (lfs-pointer)" in result.stderr
     assert "No findings" in result.stdout
+    quiet = run("check", "--fail-on-skip", "-q", str(tmp_path))  # the line that explains the exit stays
+    assert quiet.returncode == 2 and quiet.stderr.splitlines() == [f"{tmp_path / 'big.obj'}: skipped (lfs-pointer)"]
 
 
 def test_options_are_never_abbreviated(tmp_path):
