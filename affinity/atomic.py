@@ -1,9 +1,22 @@
-"""Write output files whole or not at all: a temporary file beside the target, renamed when complete."""
+"""Write output files whole or not at all, and never destroy what the path names.
+
+- A regular file (or a new path) gets a temporary file beside it, renamed over
+  it when complete; an existing file keeps its permission bits.
+- A symbolic link is followed: its target is replaced that way, and the link
+  stays a link.
+- A character device, FIFO or socket (``-o /dev/stdout``, ``-o /dev/null``, a
+  named pipe) cannot be replaced: the whole output is built in memory and
+  written to it once, so a failure while producing it writes nothing.
+- A directory is refused (``IsADirectoryError``) before anything is produced.
+"""
 
 from __future__ import annotations
 
 import contextlib
+import errno
+import io
 import os
+import stat
 import tempfile
 from pathlib import Path
 
@@ -14,21 +27,52 @@ def _umask() -> int:
     return mask
 
 
+def _existing_mode(path: Path) -> int | None:
+    """``st_mode`` of what ``path`` names (links followed), None when nothing is there."""
+    try:
+        return os.stat(path).st_mode
+    except FileNotFoundError:
+        return None
+
+
 @contextlib.contextmanager
 def atomic_write(path: str | os.PathLike, binary: bool = False):
-    """Yield a file object; on success it replaces ``path``, on any error it is removed.
+    """Yield a file object (text: UTF-8, '\\n' line ends); on success the output is at ``path``.
 
-    Raises ``OSError`` (before anything is written) when the folder does not
-    exist or is not writable, so callers can turn it into one clear line.
+    See the module docstring for what each kind of ``path`` gets. Raises
+    ``OSError`` before anything is written when the folder does not exist or
+    is not writable, or ``path`` is a directory, so callers can turn it into
+    one clear line.
     """
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(dir=path.parent if str(path.parent) else ".", prefix=f".{path.name}.", suffix=".tmp")
+    mode = _existing_mode(Path(path))
+    if mode is not None and stat.S_ISDIR(mode):
+        raise IsADirectoryError(errno.EISDIR, "is a directory, not a file", os.fspath(path))
+    if mode is not None and not stat.S_ISREG(mode):
+        # through the path as given: /dev/stdout on a pipe resolves to no file name
+        with _write_once(Path(path), binary) as out:
+            yield out
+        return
+    target = Path(os.path.realpath(path))
+    fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
     try:
-        os.fchmod(fd, 0o666 & ~_umask())
+        os.fchmod(fd, stat.S_IMODE(mode) if mode is not None else 0o666 & ~_umask())
         with os.fdopen(fd, "wb" if binary else "w", **({} if binary else {"encoding": "utf-8", "newline": "\n"})) as f:
             yield f
-        os.replace(tmp, path)
+        os.replace(tmp, target)
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
         raise
+
+
+@contextlib.contextmanager
+def _write_once(target: Path, binary: bool):
+    """Collect the output in memory, then write it to the device or pipe ``target`` in one go."""
+    buffer = io.BytesIO() if binary else io.StringIO(newline="\n")
+    yield buffer
+    data = buffer.getvalue()
+    data = data if binary else data.encode("utf-8")
+    with open(target, "wb", buffering=0) as out:
+        view = memoryview(data)
+        while view:  # a pipe may take less than everything at once
+            view = view[out.write(view):]

@@ -7,6 +7,7 @@ unreadable input (2 wins over 1). Findings go to stdout, errors to stderr.
 from __future__ import annotations
 
 import argparse
+import functools
 import sys
 
 from .errors import UsageError
@@ -26,12 +27,16 @@ SUBCOMMANDS = [check_command, render_command, rules_command, report_command, vie
 def build_parser() -> argparse.ArgumentParser:
     from . import __version__
 
+    # No prefix matching anywhere: '--stat' is not '--statistics', and '--fail-on error' never
+    # parses as '--fail-on-skip' plus a path named 'error'.
     parser = argparse.ArgumentParser(
         prog="affinity",
         description="Lint quad meshes for texture/colour affinity and render them with a hybrid rasterizer.",
+        allow_abbrev=False,
     )
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
-    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND",
+                                parser_class=functools.partial(argparse.ArgumentParser, allow_abbrev=False))
     for command in SUBCOMMANDS:
         command.add_parser(sub)
     return parser

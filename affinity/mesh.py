@@ -14,7 +14,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-
 #: How each per-corner attribute is named on the command line and in pictures (``--show uv``).
 ATTRIBUTE_NAMES = {"texcoords": "uv", "colors": "color", "normals": "normal"}
 
@@ -156,6 +155,71 @@ class Mesh:
             if name in self.material_textures:
                 return self.material_textures[name]
         return next(iter(self.material_textures.values()), None)
+
+    def validate(self) -> None:
+        """Raise ValueError naming every invariant of the model this mesh breaks.
+
+        What every loader guarantees and every measure relies on: array shapes
+        and integer types, ``face_start`` rising from 0 by at least 3 corners a
+        face to the number of corners, every index inside what it indexes (-1
+        for an absent texcoord or normal), finite positions, texture
+        coordinates and normals, colours in [0, 1] (NaN: none), and the
+        group, material and prim tables covering every face.
+        """
+        problems = []
+
+        def require(condition, what: str) -> None:
+            if not condition:
+                problems.append(what)
+
+        def shaped(name: str, array, width: int | None, kind: str) -> bool:
+            ok = isinstance(array, np.ndarray) and array.dtype.kind in kind and (
+                array.ndim == 1 if width is None else (array.ndim == 2 and array.shape[1] == width))
+            require(ok, f"{name} is not a {'(n,)' if width is None else f'(n, {width})'} {kind} array")
+            return ok
+
+        def indexes(name: str, index, total: int, low: int) -> None:
+            if shaped(name, index, None, "iu"):
+                require(len(index) == n_corners, f"{name} has {len(index)} entries for {n_corners} corners")
+                require(len(index) == 0 or (index.min() >= low and index.max() < total),
+                        f"{name} has an entry outside [{low}, {total})")
+
+        n_vertices = len(self.positions) if shaped("positions", self.positions, 3, "f") else 0
+        require(np.isfinite(self.positions).all(), "positions are not all finite")
+        n_corners = len(self.corner_vertex) if shaped("corner_vertex", self.corner_vertex, None, "iu") else 0
+        if shaped("face_start", self.face_start, None, "iu"):
+            require(len(self.face_start) >= 1 and self.face_start[0] == 0, "face_start does not start at 0")
+            require((np.diff(self.face_start) >= 3).all(), "a face has fewer than 3 corners")
+            require(self.face_start[-1:].tolist() in ([n_corners], []), "face_start does not end at the corner count")
+        indexes("corner_vertex", self.corner_vertex, n_vertices, 0)
+        n_faces = max(self.n_faces, 0)
+        for name, table in (("face_line", self.face_line), ("face_group", self.face_group),
+                            ("face_material", self.face_material)):
+            if shaped(name, table, None, "iu"):
+                require(len(table) == n_faces, f"{name} has {len(table)} entries for {n_faces} faces")
+        require(len(self.face_line) == 0 or self.face_line.min() >= 0, "face_line has a negative line")
+        require(len(self.face_group) == 0 or (self.face_group.min() >= 0 and self.face_group.max() < len(self.group_names)),
+                "face_group has an entry outside group_names")
+        require(len(self.face_material) == 0 or (self.face_material.min() >= -1
+                                                 and self.face_material.max() < len(self.material_names)),
+                "face_material has an entry outside material_names")
+        for values, index, width in (("texcoords", "corner_texcoord", 2), ("normals", "corner_normal", 3)):
+            array = getattr(self, values)
+            require((array is None) == (getattr(self, index) is None), f"{values} and {index} are not both given")
+            if array is not None and shaped(values, array, width, "f"):
+                require(np.isfinite(array).all(), f"{values} are not all finite")
+                if getattr(self, index) is not None:
+                    indexes(index, getattr(self, index), len(array), -1)
+        if self.colors is not None and shaped("colors", self.colors, 3, "f"):
+            require(len(self.colors) == n_vertices, f"colors has {len(self.colors)} rows for {n_vertices} vertices")
+            inside = (self.colors >= 0) & (self.colors <= 1)
+            require((inside | np.isnan(self.colors)).all(), "a colour is outside [0, 1]")
+        if self.prim_face_start is not None and shaped("prim_face_start", self.prim_face_start, None, "iu"):
+            starts = self.prim_face_start
+            require(len(starts) == len(self.group_names) + 1 and starts[0] == 0 and starts[-1] == n_faces
+                    and (np.diff(starts) >= 0).all(), "prim_face_start does not split the faces into the prims")
+        if problems:
+            raise ValueError(f"{self.path}: inconsistent mesh: " + "; ".join(problems))
 
 
 

@@ -3,7 +3,9 @@
 from pathlib import Path
 
 import numpy as np
+import pytest
 
+from affinity.errors import MeshError
 from affinity.loaders import load
 from affinity.loaders import text as loader_text
 
@@ -227,3 +229,39 @@ def test_number_parsing_matches_python_float(tmp_path):
     body = "".join(f"v {' '.join(row)}\n" for row in rows)
     mesh = load(write(tmp_path, body))
     np.testing.assert_array_equal(mesh.positions, [[float(t) for t in row] for row in rows])
+
+
+def test_empty_trailing_slots(tmp_path):
+    """``v//``, ``v/vt/`` and ``v/`` name no more than the slots they fill (tinyobjloader, Blender read them)."""
+    body = SQUARE + "vt 0 0\nvt 1 1\nvn 0 0 1\nf 1// 2// 3//\nf 1/2/ 2/1/ 3/2/ 4/1/\nf 1/\t2/\t4/\nf 2//1 3//1 4//1\n"
+    mesh = load(write(tmp_path, body))
+    assert mesh.face_start.tolist() == [0, 3, 7, 10, 13]
+    assert mesh.corner_vertex.tolist() == [0, 1, 2, 0, 1, 2, 3, 0, 1, 3, 1, 2, 3]
+    assert mesh.corner_texcoord.tolist() == [-1] * 3 + [1, 0, 1, 0] + [-1] * 6
+    assert mesh.corner_normal.tolist() == [-1] * 10 + [0] * 3
+    mesh.validate()
+
+
+def test_empty_slots_in_uniform_lines_are_read_per_line(tmp_path):
+    """'1/  2' (one empty slot, two spaces) and '1// 2' have gaps of one length: each line is read as written."""
+    body = SQUARE + "vt 0 0\nf 1/1/  2/1/  3/1/\nf 1/1// 2/1// 3/1//\n"
+    error = pytest.raises(MeshError, load, write(tmp_path, body)).value
+    assert error.line == 7 and "malformed" in error.reason
+
+
+def test_latin1_names(tmp_path):
+    """A name in an 8-bit code page is text (Latin-1 when it is not UTF-8); only numbers must parse."""
+    body = SQUARE.encode() + b"g caf\xe9\nusemtl m\xe4t\nf 1 2 3\ng \xc3\xa9t\xc3\xa9\nf 1 3 4\n"
+    mesh = load(write(tmp_path, body, mode="wb"))
+    assert mesh.group_names == ["caf\xe9", "\xe9t\xe9"]
+    assert mesh.material_names == ["m\xe4t"]
+    assert mesh.face_group.tolist() == [0, 1]
+
+
+def test_nan_colour_is_a_note_not_an_error(tmp_path):
+    body = "v 0 0 0 1 0 0\nv 1 0 0 nan 0 0\nv 1 1 0 0 1 nan\nv 0 1 0 0 0 1\nf 1 2 3 4\n"
+    mesh = load(write(tmp_path, body))
+    assert mesh.colors is None and mesh.notes == ["2 vertex colours NaN (first at line 2): colours not checked"]
+    np.testing.assert_array_equal(mesh.positions, [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]])
+    with pytest.raises(MeshError, match="finite"):
+        load(write(tmp_path, "v 0 0 0 1 0 0\nv nan 0 0 1 0 0\nv 1 1 0 0 1 0\nf 1 2 3\n"))

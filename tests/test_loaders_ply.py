@@ -5,6 +5,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from affinity.errors import MeshError
 from affinity.loaders import load
 
 DATA = Path(__file__).parent / "data" / "loaders"
@@ -144,3 +145,60 @@ def test_vertices_without_faces(tmp_path, fmt):
 def test_fixture():
     square = load(DATA / "square.ply")
     assert square.face_sizes.tolist() == [4, 3] and square.face_line.tolist() == [16, 17]
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_tristrips_read_as_triangles(tmp_path, fmt):
+    """Stanford-style ``tristrips`` (igea, elephant): -1 restarts a strip; checked against trimesh's converter."""
+    from trimesh.util import triangle_strips_to_faces
+
+    rng = np.random.default_rng(7)
+    rows = [tuple(rng.uniform(-1, 1, 3).tolist()) for _ in range(12)]
+    items = [0, 1, 2, 3, 4, 5, -1, 6, 7, 8, 8, 9, 10, 11, -1, 2, 3, 6]
+    strips_element = ("tristrips", [("list", "int", "int", "vertex_indices")], [(items,), ([5, 6, 7, 1],)])
+    path = write_ply(tmp_path / "strips.ply", fmt, [("vertex", VERTEX[:3], rows), strips_element])
+    mesh = load(path)
+    mesh.validate()
+    pieces = [[0, 1, 2, 3, 4, 5], [6, 7, 8, 8, 9, 10, 11], [2, 3, 6], [5, 6, 7, 1]]
+    expected = triangle_strips_to_faces([np.array(p) for p in pieces])
+    expected = expected[(expected[:, 0] != expected[:, 1]) & (expected[:, 1] != expected[:, 2]) & (expected[:, 0] != expected[:, 2])]
+    got = mesh.corner_vertex.reshape(-1, 3)
+    assert mesh.counts() == {"faces": len(expected), "quads": 0, "triangles": len(expected), "ngons": 0}
+
+    def oriented(triangles):  # each triangle rotated to start at its smallest corner: winding kept
+        return sorted(tuple(np.roll(t, -int(np.argmin(t))).tolist()) for t in triangles)
+
+    assert oriented(got) == oriented(expected)
+    assert any("triangle strip" in note and "2 degenerate" in note for note in mesh.notes)
+    if fmt == "ascii":
+        assert sorted(set(mesh.face_line.tolist())) == [23, 24]  # 10 header lines, 12 vertices
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_nan_colour_is_a_note_not_an_error(tmp_path, fmt):
+    vertex = [("float", "x"), ("float", "y"), ("float", "z"), ("float", "red"), ("float", "green"), ("float", "blue")]
+    rows = [(0.0, 0.0, 0.0, 1.0, 0.0, 0.0), (1.0, 0.0, 0.0, float("nan"), 0.0, 0.0), (1.0, 1.0, 0.0, 0.0, 1.0, 0.0)]
+    path = write_ply(tmp_path / "nan_colour.ply", fmt, [("vertex", vertex, rows), ("face", FACE[:1], [([0, 1, 2],)])])
+    mesh = load(path)
+    assert mesh.colors is None and len(mesh.notes) == 1 and "NaN" in mesh.notes[0]
+    np.testing.assert_array_equal(mesh.positions, np.array(rows)[:, :3])
+    assert mesh.counts()["triangles"] == 1
+
+
+@pytest.mark.parametrize("count", [300_000_000, 4_000_000_000])
+def test_binary_header_lying_about_its_size_is_refused_before_allocating(tmp_path, count):
+    """A 177-byte file claiming 3e8 vertices (or 4e9) is a clean error, not gigabytes of arrays."""
+    import tracemalloc
+
+    path = write_ply(tmp_path / "liar.ply", "binary_little_endian",
+                     [("vertex", VERTEX[:3], [(0.0, 0.0, 0.0)] * 3), ("face", FACE[:1], [([0, 1, 2],)])])
+    path.write_bytes(path.read_bytes().replace(b"element vertex 3", f"element vertex {count}".encode()))
+    tracemalloc.start()
+    try:
+        with pytest.raises(MeshError) as caught:
+            load(path)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert "truncated" in caught.value.reason and str(count) in caught.value.reason
+    assert peak < 10_000_000

@@ -250,7 +250,6 @@ BAD_STAGES = {
                          "/World/Bad: primvars:st:indices has an entry outside the 1 values"),
     "uv-not-2d": (stage_text(extra='float3[] primvars:st = [(0, 0, 0)] (interpolation = "constant")'),
                   "/World/Bad: primvars:st is float3[], not 2-component values"),
-    "no-meshes": ('#usda 1.0\ndef Xform "World"\n{\n}\n', "no UsdGeom.Mesh prim to check in the stage"),
     "parse-error": ('#usda 1.0\ndef Mesh "M"\n{\n    int[] faceVertexCounts = [4,\n', "cannot open the stage: "),
 }
 

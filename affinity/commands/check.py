@@ -94,6 +94,9 @@ def add_parser(sub) -> None:
     p.add_argument("-j", "--jobs", type=_jobs, metavar="N",
                    help="check files in N processes (default: all CPUs, fewer when the files are small)")
     p.add_argument("--statistics", action="store_true", help="print counts per rule instead of findings")
+    p.add_argument("--fail-on-skip", action="store_true",
+                   help="exit 2 when a file was skipped (a Git LFS pointer, a USD stage with no mesh), so a "
+                        "checkout without 'git lfs pull' cannot pass with nothing checked")
     p.add_argument("--verbose", action="store_true", help="show every finding in text output")
     p.add_argument("-q", "--quiet", action="store_true", help="print findings and nothing else")
     p.set_defaults(run=run)
@@ -116,12 +119,13 @@ def _overrides(args) -> dict:
     return {"thresholds": thresholds, **{k: v for k, v in given.items() if v is not None}}
 
 
-def _report_problems(reports, quiet: bool) -> None:
-    """Unreadable files (always), skipped files and the loader's notes (unless quiet), one line each on stderr."""
+def _report_problems(reports, quiet: bool, skips_fail: bool = False) -> None:
+    """Unreadable files (always), skipped files (unless quiet; always when they fail the run) and the
+    loader's notes (unless quiet), one line each on stderr."""
     for report in reports:
         if report.error is not None:
             sys.stderr.write(f"{report.path}:{report.error_line}: Q901 unreadable: {report.error}\n")
-        elif report.skipped is not None and not quiet:
+        elif report.skipped is not None and (skips_fail or not quiet):
             sys.stderr.write(f"{report.path}: skipped ({report.skipped})\n")
         for note in [] if quiet else report.notes:
             sys.stderr.write(f"{report.path}: note: {note}\n")
@@ -187,8 +191,8 @@ def run(args) -> int:
     tasks = _tasks(resolver, paths)
     progress = _progress_bar() if len(tasks) > 1 and sys.stderr.isatty() else None
     reports = check_files(tasks, args.jobs, progress, usd=UsdOptions(args.time, args.uv_primvar))
-    _report_problems(reports, args.quiet)
-    failed = any(r.error is not None for r in reports)
+    _report_problems(reports, args.quiet, args.fail_on_skip)
+    failed = any(r.error is not None or (args.fail_on_skip and r.skipped is not None) for r in reports)
     if args.write_baseline:
         _write_baseline(reports, args.write_baseline, args.quiet)
         return EXIT_ERROR if failed else EXIT_CLEAN

@@ -43,7 +43,7 @@ def run(args) -> int:
     require(("PIL",), "render")
     from ..draw import RenderOptions, render_mesh
     from ..draw.texture import TextureError
-    from ..errors import MeshError
+    from ..errors import MeshError, SkippedFile
 
     try:
         options = RenderOptions(
@@ -54,6 +54,8 @@ def run(args) -> int:
         result = render_mesh(args.mesh, options, warn=lambda line: sys.stderr.write(f"affinity render: warning: {line}\n"))
     except MeshError as err:
         raise UsageError(f"{err.path}:{err.line}: {err.reason}") from None
+    except SkippedFile as skip:
+        raise UsageError(f"{skip.path}: skipped ({skip.reason}): nothing to render") from None
     except (TextureError, ValueError) as err:
         raise UsageError(str(err)) from None
     try:

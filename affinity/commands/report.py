@@ -2,9 +2,11 @@
 
 Without MESH it reports on the built-in demo scenes. The page is one
 self-contained file (pictures embedded, no network). An unreadable mesh is a
-failed row in the report and a ``Q901`` line on stderr, and the exit code is 2;
-otherwise 0 (findings are the report's content, not a failure). A report that
-cannot be written is an error (exit 2) and leaves no partial file.
+failed row in the report and a ``Q901`` line on stderr, a skipped one (a Git LFS
+pointer, a USD stage without a mesh) a skipped row, and the exit code is 2;
+otherwise 0 (findings are the report's content, not a failure). A single MESH
+that is skipped, or a report that cannot be written, is an error (exit 2) and
+writes nothing.
 """
 
 from __future__ import annotations
@@ -22,7 +24,8 @@ def add_parser(sub) -> None:
         description="Lint, score and render MESH files (directories are searched; default: the built-in demo "
                     "scenes) into one self-contained HTML page.",
         epilog="Exit codes: 0 the report was written; 2 a usage error, an output that cannot be written (nothing "
-               "is written), or an unreadable mesh (the report is still written, with the failed row).",
+               "is written), a single MESH that is skipped (nothing is written), or an unreadable or skipped mesh "
+               "among several (the report is still written, with its row).",
     )
     p.add_argument("meshes", nargs="*", metavar="MESH", help=".obj/.ply/.off files or directories")
     p.add_argument("-o", "--output", default="report.html", metavar="HTML",
@@ -33,9 +36,12 @@ def add_parser(sub) -> None:
 
 def _check_writable(path: str) -> None:
     """Fail before the work, with a clear line, when ``path`` cannot be written."""
-    folder = os.path.dirname(os.path.abspath(path))
-    if os.path.isdir(path):
+    target = os.path.realpath(path)  # a link is written through (affinity.atomic)
+    folder = os.path.dirname(target)
+    if os.path.isdir(target):
         raise UsageError(f"{path}: is a directory (name the HTML file to write)")
+    if os.path.exists(target) and not os.path.isfile(target):
+        return  # a device or pipe, written in place
     if not os.path.isdir(folder):
         raise UsageError(f"{path}: cannot write the report: no such directory {folder}")
     if not os.access(folder, os.W_OK):
@@ -80,6 +86,9 @@ def run(args) -> int:
               disable=args.quiet or not sys.stderr.isatty()) as bar:
         report = collect_run(inputs, lambda path: resolver.resolve(path).settings.for_file(path),
                              resolver.resolve(os.curdir).settings, bar)
+        skipped = [result.file for result in report.meshes if result.file.skipped is not None]
+        if len(inputs) == 1 and skipped:  # a report of nothing: say so, write nothing
+            raise UsageError(f"{skipped[0].path}: skipped ({skipped[0].skipped}): nothing to report")
         bar.set_postfix_str("writing the page")
         html = render_page(report)
     _write(args.output, html)
@@ -87,8 +96,11 @@ def run(args) -> int:
     failed = [result.file for result in report.meshes if result.file.error is not None]
     for file in failed:
         sys.stderr.write(f"{file.path}:{file.error_line}: Q901 unreadable: {file.error}\n")
+    for file in skipped:
+        sys.stderr.write(f"{file.path}: skipped ({file.skipped})\n")
     if not args.quiet:
         unreadable = f", {len(failed)} unreadable" if failed else ""
+        unreadable += f", {len(skipped)} skipped" if skipped else ""
         sys.stderr.write(f"affinity report: wrote {args.output} ({len(inputs)} file{'s' * (len(inputs) != 1)}{unreadable}, "
                          f"{len(html.encode()) / 1e6:.1f} MB, {report.seconds:.1f} s)\n")
-    return EXIT_ERROR if failed else EXIT_CLEAN
+    return EXIT_ERROR if failed or skipped else EXIT_CLEAN

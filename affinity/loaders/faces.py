@@ -39,18 +39,32 @@ def check_indices(path, index: np.ndarray, total: int, face_start, face_line, na
     raise MeshError(path, int(face_line[face]), f"{name} index out of range (the file has {total})")
 
 
-def unit_colors(path, colors: np.ndarray, scale: float, lines) -> np.ndarray:
+def unit_colors(path, colors: np.ndarray, scale: float, lines, notes: list) -> np.ndarray | None:
     """(V, 3) float64 colours divided by ``scale``; MeshError where one leaves [0, 1].
 
     lines : (V,) int64 source line per vertex, or an int for all (0 in binary files).
+    A NaN colour is no colour: the mesh is checked without colours (None), and
+    ``notes`` says so once.
     """
     colors = colors / scale
+    missing = np.isnan(colors).any(axis=1)
+    if missing.any():
+        vertex = int(np.argmax(missing))
+        line = lines if np.isscalar(lines) else int(lines[vertex])
+        notes.append(color_note(int(missing.sum()), vertex, line))
+        return None
     outside = ~((colors >= 0) & (colors <= 1)).all(axis=1)
     if outside.any():
         vertex = int(np.argmax(outside))
         line = lines if np.isscalar(lines) else int(lines[vertex])
         raise MeshError(path, line, f"vertex colour {colors[vertex] * scale} outside the range [0, {scale:g}]")
     return colors
+
+
+def color_note(count: int, vertex: int, line: int) -> str:
+    """The note for a mesh whose vertex colours are dropped because ``count`` of them are NaN."""
+    where = f"line {line}" if line else f"vertex {vertex}"
+    return f"{count} vertex colour{'s' * (count != 1)} NaN (first at {where}): colours not checked"
 
 
 def polygon_mesh(path, positions, sizes, corners, face_line, texcoords=None, corner_texcoord=None, normals=None, colors=None) -> Mesh:
@@ -66,7 +80,8 @@ def polygon_mesh(path, positions, sizes, corners, face_line, texcoords=None, cor
     if small.any():
         raise MeshError(path, int(face_line[np.argmax(small)]), f"face with {sizes[small][0]} corners (at least 3 needed)")
     face_start = np.concatenate(([0], np.cumsum(sizes)))
-    corner_vertex = np.where(corners == np.round(corners), corners, -1).astype(np.int64)
+    whole = (corners == np.round(corners)) & (np.abs(corners) < 2**62)  # NaN, inf and 1e30 are no index
+    corner_vertex = np.where(whole, corners, -1).astype(np.int64)
     check_indices(path, corner_vertex, len(positions), face_start, face_line, "vertex")
     if texcoords is not None and corner_texcoord is None:
         corner_texcoord = corner_vertex

@@ -35,7 +35,7 @@ import numpy as np
 
 from ..errors import MeshError
 from ..mesh import Mesh
-from .faces import check_indices, ragged_positions
+from .faces import check_indices, color_note, ragged_positions
 from .mtl import read_material_textures
 from .numbers import PAD, parse_floats, parse_ints
 from .text import Tokens, floats_or_raise, read_chunks, tokenize
@@ -76,18 +76,23 @@ class _Part:
     bytes: int  # bytes of the chunk's lines
     events: list = field(default_factory=list)  # (face in chunk, keyword, name)
     mtllibs: list = field(default_factory=list)
+    nan_colors: list = field(default_factory=list)  # (vertices, first line) with a NaN colour
 
 
 #: Chunks parsed in parallel (NumPy releases the GIL inside its loops).
 _WORKERS = 2
 
 
-def load_obj(path) -> Mesh:
-    """Read a Wavefront OBJ file (and the ``map_Kd`` entries of its ``mtllib`` files)."""
+def load_obj(path, chunk_bytes: int | None = None) -> Mesh:
+    """Read a Wavefront OBJ file (and the ``map_Kd`` entries of its ``mtllib`` files).
+
+    ``chunk_bytes`` (default :data:`~affinity.loaders.text.CHUNK_BYTES`) is how
+    much is read at a time; the mesh does not depend on it.
+    """
     pending = []
     with open(path, "rb") as fh, ThreadPoolExecutor(_WORKERS) as pool:
         assembly = _Assembly(os.fstat(fh.fileno()).st_size)
-        for chunk in read_chunks(fh, continuations=True, count_lines=False):
+        for chunk in read_chunks(fh, continuations=True, size=chunk_bytes, count_lines=False):
             pending.append(pool.submit(_parse_chunk, chunk, path))
             if len(pending) > 2 * _WORKERS:  # bound the chunks held in memory
                 assembly.add(assembly.result(pending.pop(0)))
@@ -101,7 +106,8 @@ def _parse_chunk(chunk, path) -> _Part:
     counts = tokens.counts
     kind = _line_kinds(tokens, counts)
     element_lines = {k: np.flatnonzero(kind == k) for k in _WIDTHS}
-    elements = {k: _elements(tokens, path, lines, k) for k, lines in element_lines.items()}
+    nan_colors = []
+    elements = {k: _elements(tokens, path, lines, k, nan_colors) for k, lines in element_lines.items()}
     _check_colors(tokens, path, element_lines[_V], elements[_V])
     face_lines = np.flatnonzero(kind == _F)
     sizes, corners, relative, bounds, face_slashes = _faces(tokens, path, kind, face_lines)
@@ -119,6 +125,7 @@ def _parse_chunk(chunk, path) -> _Part:
         bounds=bounds,
         lines=len(tokens.end) + len(chunk.joined),
         bytes=len(chunk.buf) - 2 * PAD,
+        nan_colors=nan_colors,
     )
     statements = np.flatnonzero((counts > 0) & (kind == 0))
     if len(statements):
@@ -173,8 +180,12 @@ def _token_block(tokens: Tokens, lines, width: int, previous: bool = False):
     return block + (tokens.ends[index - 1],) if previous else block
 
 
-def _elements(tokens: Tokens, path, lines, which) -> np.ndarray:
-    """(n, width) float64 numbers of the ``which`` lines, NaN where a line has fewer."""
+def _elements(tokens: Tokens, path, lines, which, nan_colors: list) -> np.ndarray:
+    """(n, width) float64 numbers of the ``which`` lines, NaN where a line has fewer.
+
+    NaN colours (``v x y z r g b`` lines) are kept and counted in ``nan_colors``
+    (see :func:`_nan_colors_or_raise`); every other number must be finite.
+    """
     if len(lines) == 0:
         return np.zeros((0, _WIDTHS[which][0]))
     counts = tokens.counts[lines]
@@ -182,19 +193,24 @@ def _elements(tokens: Tokens, path, lines, which) -> np.ndarray:
         width = int(counts[0]) - 1  # one width: a (lines, numbers) block
         starts, ends = _token_block(tokens, lines, width)
         rows, bad = parse_floats(tokens.buf, starts, ends, finite=True)
-        if len(bad):  # let the token-by-token path say what is wrong with it
-            floats_or_raise(tokens, path, tokens.first[lines[bad[:1] // width]] + 1 + bad[:1] % width, finite=True)
+        if len(bad):
+            line, column = bad // width, bad % width
+            token = tokens.first[lines[line]] + 1 + column
+            _nan_colors_or_raise(tokens, path, which, token, column, width, nan_colors)
     else:
         width, numbers = _line_tokens(tokens, lines)
         wrong = ~_ALLOWED[which][np.minimum(width, _MAX_WIDTH)]
         if wrong.any():
             line = lines[np.argmax(wrong)]
             raise MeshError(path, tokens.number[line], f"{tokens.text(tokens.first[line])} line with {width[wrong][0]} numbers")
-        values = floats_or_raise(tokens, path, numbers, finite=True)
-        rows = np.full((len(width), max(_WIDTHS[which])), np.nan)
+        values, bad = parse_floats(tokens.buf, tokens.starts[numbers], tokens.ends[numbers], finite=True)
+        if len(bad):
+            line = np.repeat(np.arange(len(width)), width)[bad]
+            column = ragged_positions(np.zeros(len(width), np.int64), width)[bad]
+            _nan_colors_or_raise(tokens, path, which, numbers[bad], column, width[line], nan_colors)
+        # As wide as the widest line: 'v x y z' among 'v x y z w' lines has no colour.
+        rows = np.full((len(width), max(int(width.max()), _WIDTHS[which][0])), np.nan)
         rows[np.repeat(np.arange(len(width)), width), ragged_positions(np.zeros(len(width), np.int64), width)] = values
-        if len(width) == 0:
-            rows = rows[:, : _WIDTHS[which][0]]
     if which != _V or rows.shape[1] == 3:
         return rows
     if rows.shape[1] == 4:  # 'v x y z w': w is not a colour
@@ -202,6 +218,19 @@ def _elements(tokens: Tokens, path, lines, which) -> np.ndarray:
     if rows.shape[1] == 7:
         rows[np.isnan(rows[:, 4]), 3] = np.nan  # 'v x y z w' among colour lines
     return rows[:, :6]  # the alpha of 'v x y z r g b a' is not kept
+
+
+def _nan_colors_or_raise(tokens: Tokens, path, which, token, column, width, nan_colors: list) -> None:
+    """Of the tokens ``token`` (n,) that are not finite numbers (``column`` (n,) within
+    lines of ``width`` numbers), accept the NaN colours (appending their lines to
+    ``nan_colors`` as (vertices, first line in the chunk)); MeshError at the first other one."""
+    values, not_numbers = parse_floats(tokens.buf, tokens.starts[token], tokens.ends[token])
+    colour = np.isnan(values) & (column >= 3) & (np.asarray(width) >= 6) & (which == _V)
+    colour[not_numbers] = False
+    if not colour.all():
+        floats_or_raise(tokens, path, token[~colour][:1], finite=True)
+    lines = np.searchsorted(tokens.first, token, side="right") - 1
+    nan_colors.append((len(np.unique(lines)), int(tokens.number[lines[0]])))
 
 
 def _reject_slashes(tokens: Tokens, path, lines) -> None:
@@ -224,18 +253,25 @@ def _check_colors(tokens: Tokens, path, lines, vertices) -> None:
 
 
 #: Bits of a face token's separator layout (see :func:`_face_layout`).
-_AFTER_SLASH, _AFTER_DOUBLE, _BEFORE_SLASH, _BAD_GAP = 1, 2, 4, 8
+_AFTER_SLASH, _AFTER_DOUBLE, _BEFORE_SLASH, _BAD_GAP, _TRAILING, _TRAILING_DOUBLE = 1, 2, 4, 8, 16, 32
 
 
 def _face_layout(buf, start, end, previous_end) -> np.ndarray:
     """(K,) uint8 per face token (bytes ``start:end``, previous token ending at
-    ``previous_end``): which of '/', '//' precede it, whether '/' follows, and
-    whether the separator before it is anything but whitespace, '/' or '//'."""
+    ``previous_end``): which of '/', '//' precede it, whether '/' follows,
+    whether the separator before it is anything but whitespace, '/' or '//',
+    and whether the corner ends in empty slots: '/' or '//' then whitespace
+    (``v/``, ``v//``, ``v/vt/``)."""
     after = buf[start - 1] == _SLASH
     double = after & (buf[start - 2] == _SLASH)
     bad_gap = after & (start - previous_end != 1 + double)
     layout = after.view(np.uint8) | (double.view(np.uint8) << 1) | (bad_gap.view(np.uint8) << 3)
-    layout |= (buf[end] == _SLASH).view(np.uint8) << 2
+    before = buf[end] == _SLASH
+    layout |= before.view(np.uint8) << 2
+    if before.any():
+        second = buf[end + 1]
+        layout |= (before & (second <= 32)).view(np.uint8) << 4
+        layout |= (before & (second == _SLASH) & (buf[end + 2] <= 32)).view(np.uint8) << 5
     return layout
 
 
@@ -252,14 +288,16 @@ def _corner_slots(layout, line_start):
     for _ in range(2):  # 'a/b/c': c follows b; two passes expose a fourth slot
         slot[1:] = np.where(single[1:], slot[:-1] + 1, slot[1:])
     joined_next = np.append(after[1:] & ~line_start[1:], False)
-    malformed = ((layout & _BAD_GAP) > 0) | (after & line_start) | (slot > 2)
-    malformed |= ((layout & _BEFORE_SLASH) > 0) & ~joined_next
+    empty_slots = ((layout & _TRAILING) > 0) + 2 * ((layout & _TRAILING_DOUBLE) > 0)
+    malformed = ((layout & _BAD_GAP) > 0) | (after & line_start) | (slot + empty_slots > 2)
+    malformed |= ((layout & _BEFORE_SLASH) > 0) & ~joined_next & (empty_slots == 0)
     return slot, malformed
 
 
 def _slash_count(layout) -> int:
-    """Number of '/' bytes the separators of these face tokens hold."""
-    return int(np.count_nonzero(layout & _AFTER_SLASH) + np.count_nonzero(layout & _AFTER_DOUBLE))
+    """Number of '/' bytes the separators of these face tokens hold, empty trailing slots included."""
+    counted = (_AFTER_SLASH, _AFTER_DOUBLE, _TRAILING, _TRAILING_DOUBLE, _TRAILING_DOUBLE)
+    return sum(int(np.count_nonzero(layout & bit)) for bit in counted)
 
 
 def _faces(tokens: Tokens, path, kind, face_lines):
@@ -277,7 +315,11 @@ def _faces(tokens: Tokens, path, kind, face_lines):
         start, end, previous_end = _token_block(tokens, face_lines, width, previous=True)
         if _laid_out_alike(tokens.buf, start, end, previous_end):
             layout = _face_layout(tokens.buf, start[0], end[0], previous_end[0])
-            return _uniform_faces(tokens, path, kind, face_lines, start, end, layout)
+            # Empty trailing slots depend on bytes the cheap comparison does not
+            # look at ('/  ' and '// ' gaps look alike to it): compare every line.
+            if not (layout & (_TRAILING | _TRAILING_DOUBLE)).any() or \
+                    (_face_layout(tokens.buf, start, end, previous_end) == layout).all():
+                return _uniform_faces(tokens, path, kind, face_lines, start, end, layout)
     return _mixed_faces(tokens, path, kind, face_lines)
 
 
@@ -419,17 +461,23 @@ def _statement(tokens: Tokens, path, line, faces_before, part: _Part) -> None:
     number = int(tokens.number[line])
     raw = bytes(tokens.buf[tokens.begin[line] : tokens.end[line]]).split()
     comment = next((k for k, word in enumerate(raw) if word.startswith(b"#")), len(raw))
-    try:
-        words = [word.decode("utf-8") for word in raw[:comment]]
-    except UnicodeDecodeError:
-        raise MeshError(path, number, "text is not UTF-8") from None
+    words = [_name_text(word) for word in raw[:comment]]
     if not words or not _KEYWORD.fullmatch(words[0]):
         raise MeshError(path, number, f"not an OBJ statement: {' '.join(words)!r}")
     name = " ".join(words[1:])
     if words[0] in ("g", "o", "usemtl"):
         part.events.append((faces_before, words[0], name))
-    elif words[0] == "mtllib":
-        part.mtllibs.append(name)
+    elif words[0] == "mtllib":  # a file name: the bytes as the file system spells them
+        part.mtllibs.append(os.fsdecode(b" ".join(raw[1:comment])))
+
+
+def _name_text(word: bytes) -> str:
+    """A name as text: UTF-8 when it is, else Latin-1 (exporters write names in
+    the system's 8-bit code page; a name never makes a file unreadable)."""
+    try:
+        return word.decode("utf-8")
+    except UnicodeDecodeError:
+        return word.decode("latin-1")
 
 
 class _Progress:
@@ -515,7 +563,8 @@ class _Assembly:
         self.elements = {k: self._growing(np.float64, width=0) for k in _WIDTHS}
         self.face_line = self._growing(np.int64)
         self.sizes = self._growing(np.int64)  # filled only once faces of differing sizes appear
-        self.uniform_size = None  # the one face size while there is only one
+        self.uniform_size = None  # the one face size while every face so far has it
+        self.spelled_out = False  # faces of differing sizes appeared: ``sizes`` holds every face's
         self.n_faces = 0
         self.n_corners = 0
         self.n_lines = 0  # lines of the chunks added so far
@@ -523,6 +572,7 @@ class _Assembly:
         self.bounds = [(0, -1)] * 3
         self.events = []
         self.mtllibs = []
+        self.nan_colors = []  # (vertices, line) with a NaN colour, in file order
 
     def _growing(self, dtype, width=None) -> _Growing:
         return _Growing(dtype, self.progress, width)
@@ -535,6 +585,7 @@ class _Assembly:
         except MeshError as error:
             raise MeshError(error.path, error.line + self.n_lines * (error.line > 0), error.reason) from None
         part.face_line += self.n_lines
+        part.nan_colors = [(count, line + self.n_lines) for count, line in part.nan_colors]
         return part
 
     def add(self, part: _Part) -> None:
@@ -544,6 +595,7 @@ class _Assembly:
         before = {k: len(self.elements[k]) for k in _WIDTHS}
         for k in _WIDTHS:
             self.elements[k].append(part.elements[k])
+        self.nan_colors += part.nan_colors
         n_faces = len(part.face_line)
         if n_faces == 0:
             self.mtllibs += part.mtllibs
@@ -578,12 +630,13 @@ class _Assembly:
 
     def _add_sizes(self, sizes, n_faces: int) -> int:
         """Record the chunk's face sizes; return its number of corners."""
-        if isinstance(sizes, int) and self.uniform_size in (None, sizes):
+        if isinstance(sizes, int) and not self.spelled_out and self.uniform_size in (None, sizes):
             self.uniform_size = sizes
             return sizes * n_faces
-        if self.uniform_size is not None:  # the first face of another size: spell the sizes out
-            self.sizes.fill(self.n_faces, self.uniform_size)
+        if not self.spelled_out:  # the first face of another size: spell the sizes out
+            self.sizes.fill(self.n_faces, self.uniform_size or 0)
             self.uniform_size = None
+            self.spelled_out = True
         if isinstance(sizes, int):
             self.sizes.fill(n_faces, sizes)
             return sizes * n_faces
@@ -591,7 +644,7 @@ class _Assembly:
         return int(sizes.sum())
 
     def face_start(self) -> np.ndarray:
-        if self.uniform_size is not None or self.n_faces == 0:
+        if not self.spelled_out:
             size = self.uniform_size or 0
             return np.arange(0, size * self.n_faces + 1, max(size, 1))[: self.n_faces + 1]
         face_start = np.empty(self.n_faces + 1, dtype=np.int64)
@@ -627,6 +680,9 @@ class _Assembly:
         for library in self.mtllibs:
             for material, texture in read_material_textures(os.path.join(folder, library)).items():
                 textures.setdefault(material, texture)
+        notes = []
+        if self.nan_colors:
+            notes.append(color_note(sum(count for count, _ in self.nan_colors), 0, self.nan_colors[0][1]))
         return Mesh(
             path=os.fspath(path),
             positions=vertices if vertices.shape[1] == 3 else np.ascontiguousarray(vertices[:, :3]),
@@ -637,18 +693,20 @@ class _Assembly:
             corner_texcoord=corners[1] if len(texcoords) else None,
             normals=normals if len(normals) else None,
             corner_normal=corners[2] if len(normals) else None,
-            colors=np.nan_to_num(vertices[:, 3:6], nan=1.0) if vertices.shape[1] >= 6 else None,
+            colors=np.nan_to_num(vertices[:, 3:6], nan=1.0) if vertices.shape[1] >= 6 and not notes else None,
             group_names=group_names,
             face_group=face_group,
             material_names=material_names,
             face_material=face_material,
             material_textures=textures,
+            notes=notes,
         )
 
 
 def _texcoords(vt: np.ndarray) -> np.ndarray:
-    """(T, 2) float64 (u, v) from ``vt u [v [w]]`` rows; a missing v is 0."""
-    if vt.shape[1] == 2:
+    """(T, 2) float64 (u, v) from ``vt u [v [w]]`` rows (NaN-padded where a
+    line has fewer numbers than the widest); a missing v is 0."""
+    if vt.shape[1] == 2 and not np.isnan(vt[:, 1]).any():
         return vt
     uv = np.zeros((len(vt), 2))
     uv[:, : min(2, vt.shape[1])] = vt[:, :2]

@@ -30,8 +30,6 @@ def load_off(path) -> Mesh:
     if len(rows.number) < n_vertices + n_faces:
         last = int(rows.number[-1]) if len(rows.number) else line
         raise MeshError(path, last, f"truncated: {len(rows.number)} data lines for {n_vertices} vertices and {n_faces} faces")
-    if len(rows.number) > n_vertices + n_faces:
-        raise MeshError(path, int(rows.number[n_vertices + n_faces]), "more data lines than the header declares")
 
     width = rows.counts[:n_vertices]
     fixed = 3 + 3 * has_normal + 2 * has_st
@@ -43,18 +41,23 @@ def load_off(path) -> Mesh:
     vertex_values = rows.values[: rows.first[n_vertices]]
     infinite = ~np.isfinite(vertex_values)
     if infinite.any():
-        row = np.searchsorted(rows.first, np.argmax(infinite), side="right") - 1
-        raise MeshError(path, int(rows.number[row]), "coordinate is not finite")
+        row = np.searchsorted(rows.first, np.flatnonzero(infinite), side="right") - 1
+        column = np.flatnonzero(infinite) - first[row]
+        colour = 3 + 3 * has_normal
+        # a NaN colour drops the colours (unit_colors says so); anything else must be finite
+        allowed = has_color & (column >= colour) & (column < width[row] - 2 * has_st) & np.isnan(vertex_values[infinite])
+        if not allowed.all():
+            raise MeshError(path, int(rows.number[row[np.argmax(~allowed)]]), "coordinate is not finite")
 
     def columns(offset, count):
         return rows.values[first[:, None] + offset + np.arange(count)]
 
     positions = columns(0, 3)
     normals = columns(3, 3) if has_normal else None
-    colors = None
+    colors, notes = None, []
     if has_color:
         colors = columns(3 + 3 * has_normal, 3)
-        colors = unit_colors(path, colors, 255.0 if (colors > 1).any() else 1.0, rows.number[:n_vertices])
+        colors = unit_colors(path, colors, 255.0 if (colors > 1).any() else 1.0, rows.number[:n_vertices], notes)
     texcoords = rows.values[(first + width - 2)[:, None] + np.arange(2)] if has_st else None
 
     face_rows = np.arange(n_vertices, n_vertices + n_faces)
@@ -62,12 +65,48 @@ def load_off(path) -> Mesh:
     sizes = rows.values[rows.first[face_rows]]
     extra = rows.counts[face_rows] - 1 - sizes
     bad = (sizes < 3) | (sizes != np.round(sizes)) | (extra < 0) | (extra > 4)
-    if bad.any():
-        row = int(np.argmax(bad))
-        raise MeshError(path, int(face_line[row]), f"face line: {rows.counts[face_rows][row]} numbers for a face of {sizes[row]:g} corners")
-    sizes = sizes.astype(np.int64)
-    corners = rows.values[ragged_positions(rows.first[face_rows] + 1, sizes)]
-    return polygon_mesh(path, positions, sizes, corners, face_line, texcoords, None, normals, colors)
+    if len(rows.number) > n_vertices + n_faces or bad.any():
+        sizes, starts, face_line = _free_format_faces(path, rows, n_vertices, n_faces)
+    else:
+        sizes, starts = sizes.astype(np.int64), rows.first[face_rows] + 1
+    corners = rows.values[ragged_positions(starts, sizes)]
+    mesh = polygon_mesh(path, positions, sizes, corners, face_line, texcoords, None, normals, colors)
+    mesh.notes += notes
+    return mesh
+
+
+def _free_format_faces(path, rows, n_vertices: int, n_faces: int):
+    """Faces read as a stream of numbers: ``n i0 ... i(n-1)`` may wrap over lines, and
+    what follows the last index on its line (0 to 4 numbers) is the face's colour.
+
+    Returns ``sizes (F,) int64``, ``starts (F,) int64`` (offset of each face's first
+    index in ``rows.values``) and ``face_line (F,) int64`` (the line of its count).
+    Each face's place depends on the sizes before it, so this walks the faces
+    one by one; files with one face a line take the vectorized path instead.
+    """
+    first = int(rows.first[n_vertices])
+    values = rows.values
+    token_line = np.repeat(rows.number, rows.counts)
+    sizes, starts, face_line = (np.empty(n_faces, dtype=np.int64) for _ in range(3))
+    at = first
+    for face in range(n_faces):
+        if at >= len(values):
+            raise MeshError(path, int(token_line[-1]), f"truncated: {face} of {n_faces} faces")
+        size = values[at]
+        if not (3 <= size < 2**31 and size == round(size)):
+            raise MeshError(path, int(token_line[at]), f"face {face}: {size:g} is not a number of corners (at least 3)")
+        end = at + 1 + int(size)
+        if end > len(values):
+            raise MeshError(path, int(token_line[-1]), f"truncated: face {face} needs {int(size)} indices")
+        sizes[face], starts[face], face_line[face] = size, at + 1, token_line[at]
+        at = end
+        colour = np.searchsorted(token_line, token_line[end - 1], side="right")  # the rest of that line
+        if colour - at > 4:
+            raise MeshError(path, int(token_line[end - 1]), f"face {face}: {colour - at} numbers after its indices")
+        at = colour
+    if at < len(values):
+        raise MeshError(path, int(token_line[at]), "more data than the header declares")
+    return sizes, starts, face_line
 
 
 def _header(fh, path):

@@ -182,6 +182,7 @@ def _read_binary(path, data: bytes, elements, order):
     def width(dtype):
         return dtype.itemsize
 
+    _check_declared_sizes(path, elements, len(data))
     columns, offset = {}, 0
     for element in elements:
         starts = _row_starts(path, element, offset, read, data, order)
@@ -193,6 +194,20 @@ def _read_binary(path, data: bytes, elements, order):
     if data[offset:].strip():
         raise MeshError(path, 0, f"{len(data) - offset} bytes after the last element")
     return columns
+
+
+def _check_declared_sizes(path, elements, size: int) -> None:
+    """MeshError (line 0, binary data) for the first element whose rows cannot fit in the
+    ``size`` bytes after the header, before anything is allocated for them: every row
+    takes at least its scalars and its list counts (an element without properties
+    counts one byte a row, so that a header cannot ask for billions of empty rows)."""
+    needed = 0
+    for element in elements:
+        row = sum((p.dtype if p.count_dtype is None else p.count_dtype).itemsize for p in element.properties)
+        needed += element.count * max(row, 1)
+        if needed > size:
+            raise MeshError(path, 0, f"truncated: the header declares {element.count} {element.name} rows (line "
+                                     f"{element.line}), at least {needed} bytes, but {size} bytes of data follow it")
 
 
 def _row_starts(path, element: _Element, offset: int, read, data: bytes, order: str) -> np.ndarray:
@@ -278,6 +293,14 @@ def _mesh(path, elements, columns) -> Mesh:
         raise MeshError(path, elements[names.index("face")].line, "face element has no vertex_indices list")
     sizes, corner_vertex = indices if indices is not None else (np.zeros(0, np.int64), np.zeros(0))
     face_line = columns.get("face:lines", np.zeros(len(sizes), np.int64))
+    notes = []
+    strips = columns.get("tristrips", {})
+    strips = strips.get("vertex_indices", strips.get("vertex_index"))
+    if strips is not None and len(sizes) == 0:
+        strip_lines = columns.get("tristrips:lines", np.zeros(len(strips[0]), np.int64))
+        sizes, corner_vertex, face_line, dropped = strip_triangles(*strips, strip_lines)
+        notes.append(f"{len(sizes)} triangles read from {len(strips[0])} triangle strip list"
+                     f"{'s' * (len(strips[0]) != 1)}" + (f" ({dropped} degenerate joining triangles left out)" if dropped else ""))
     texcoords = corner_texcoord = normals = colors = None
     if all(k in vertex for k in ("nx", "ny", "nz")):
         normals = np.stack([vertex[k] for k in ("nx", "ny", "nz")], axis=1).astype(np.float64)
@@ -286,7 +309,7 @@ def _mesh(path, elements, columns) -> Mesh:
         rgb = [vertex[k] for k in ("red", "green", "blue")]
         prop = next(p for p in elements[names.index("vertex")].properties if p.name == "red")
         scale = float(np.iinfo(prop.dtype).max) if prop.dtype.kind in "iu" else 1.0
-        colors = unit_colors(path, np.stack(rgb, axis=1).astype(np.float64), scale, lines)
+        colors = unit_colors(path, np.stack(rgb, axis=1).astype(np.float64), scale, lines, notes)
     if "texcoord" in face:
         counts, uv = face["texcoord"]
         if (counts != 2 * sizes).any():
@@ -298,7 +321,43 @@ def _mesh(path, elements, columns) -> Mesh:
         if uv_names:
             texcoords = np.stack([vertex[k] for k in uv_names], axis=1).astype(np.float64)
             _require_finite(path, texcoords, lines)
-    return polygon_mesh(path, positions, sizes, corner_vertex, face_line, texcoords, corner_texcoord, normals, colors)
+    mesh = polygon_mesh(path, positions, sizes, corner_vertex, face_line, texcoords, corner_texcoord, normals, colors)
+    mesh.notes += notes
+    return mesh
+
+
+def strip_triangles(counts, items, row_lines):
+    """Triangles of PLY ``tristrips`` lists, in OpenGL strip order.
+
+    counts : (R,) int64 items per list; items : (sum counts,) vertex indices,
+    -1 ending one strip and starting the next (a list's end does too);
+    row_lines : (R,) int64 source line of every list. Triangle ``k`` of a strip
+    is ``(v[k], v[k+1], v[k+2])``, odd ``k`` swapping the first two so every
+    triangle keeps the strip's orientation. Triangles with a repeated vertex
+    (the zero-area joins strippers insert) are left out.
+
+    Returns ``sizes (T,) int64`` (all 3), ``corners (3T,) int64``, ``face_line
+    (T,) int64`` and the number of triangles left out.
+
+    >>> sizes, corners, lines, dropped = strip_triangles(np.array([6]), np.array([0, 1, 2, 3, -1, 4]), np.array([9]))
+    >>> corners.reshape(-1, 3).tolist(), dropped
+    ([[0, 1, 2], [2, 1, 3]], 0)
+    """
+    blob = np.asarray(items).astype(np.int64)
+    row = np.repeat(np.arange(len(counts)), counts)
+    new_strip = np.ones(len(blob), dtype=bool)
+    new_strip[1:] = (blob[1:] == -1) | (row[1:] != row[:-1])
+    strip = np.cumsum(new_strip) - 1
+    begin = np.flatnonzero(new_strip)
+    offset = np.arange(len(blob)) - begin[strip] - (blob[begin] == -1)[strip]
+    a, b, c = blob[:-2], blob[1:-1], blob[2:]
+    whole = (strip[:-2] == strip[2:]) & (a != -1) & (b != -1) & (c != -1)
+    odd = (offset[:-2] % 2 == 1)
+    triangles = np.stack([np.where(odd, b, a), np.where(odd, a, b), c], axis=1)
+    degenerate = (a == b) | (b == c) | (a == c)
+    keep = whole & ~degenerate
+    return (np.full(int(keep.sum()), 3, dtype=np.int64), triangles[keep].reshape(-1),
+            np.asarray(row_lines, dtype=np.int64)[row[:-2][keep]], int((whole & degenerate).sum()))
 
 def _require_finite(path, values, lines) -> None:
     """MeshError at the line of the first row of ``values`` (n, k) with a NaN or inf."""

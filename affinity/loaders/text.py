@@ -48,7 +48,7 @@ class Chunk:
         return int(hits[0]) if len(hits) else -1
 
 
-def read_chunks(fh, first_line: int = 1, continuations: bool = False, size: int = CHUNK_BYTES, count_lines: bool = True):
+def read_chunks(fh, first_line: int = 1, continuations: bool = False, size: int | None = None, count_lines: bool = True):
     """Yield :class:`Chunk` s of whole lines from the binary file object ``fh``.
 
     With ``continuations`` a '\\' right before a line break joins the two lines
@@ -56,8 +56,10 @@ def read_chunks(fh, first_line: int = 1, continuations: bool = False, size: int 
     numbers still point into the file). The last line gets a '\\n' if it lacks one.
     Without ``count_lines`` every chunk's lines count from ``first_line`` (the
     caller adds the lines of the chunks before; counting them here would cost
-    a pass over every chunk on the reading thread).
+    a pass over every chunk on the reading thread). ``size`` defaults to
+    :data:`CHUNK_BYTES`, read at call time (tests shrink it).
     """
+    size = CHUNK_BYTES if size is None else size
     carry = b""
     line = first_line
     while True:

@@ -45,7 +45,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import MeshError
+from ..errors import MeshError, SkippedFile
 from ..mesh import Mesh
 
 USD_SUFFIXES = (".usd", ".usda", ".usdc", ".usdz")
@@ -84,8 +84,8 @@ def load_usd(path, options: UsdOptions | None = None) -> Mesh:
     """Read every drawn mesh prim of the USD stage at ``path`` as one mesh (see the module docstring).
 
     Raises MeshError (line 0, the prim path in the reason) when usd-core is
-    missing, the stage cannot be opened, it has no mesh to check, or a prim's
-    topology or values are invalid.
+    missing, the stage cannot be opened or traversed, or a prim's topology or
+    values are invalid; SkippedFile (``no-mesh``) when it has no mesh to check.
     """
     try:
         from pxr import Tf, Usd, UsdGeom
@@ -99,10 +99,13 @@ def load_usd(path, options: UsdOptions | None = None) -> Mesh:
         line = _TEXT_LINE.search(reason)  # .usda parse errors say where: "file.usda:7:9: ..."
         raise MeshError(path, int(line.group(1)) if line else 0, f"cannot open the stage: {reason}") from None
     time = Usd.TimeCode.EarliestTime() if options.time is None else Usd.TimeCode(options.time)
-    xforms = UsdGeom.XformCache(time)
-    prims, notes = _mesh_prims(stage, time)
-    if not prims:
-        raise MeshError(path, 0, "no UsdGeom.Mesh prim to check in the stage" + "".join(f" ({n})" for n in notes))
+    try:
+        xforms = UsdGeom.XformCache(time)
+        prims, notes = _mesh_prims(stage, time)
+    except Tf.ErrorException as error:
+        raise MeshError(path, 0, f"cannot read the stage: {_pxr_reason(error)}") from None
+    if not prims:  # a material, light or layout layer: nothing of ours to check
+        raise SkippedFile(path, "no-mesh")
     parts = []
     for prim in prims:
         try:
@@ -113,10 +116,23 @@ def load_usd(path, options: UsdOptions | None = None) -> Mesh:
     if options.uv_primvar and all(part.texcoords is None for part in parts):
         notes.append(f"no mesh has the primvar {options.uv_primvar!r}: texture coordinates not checked")
     mesh = _concatenate(os.fspath(path), parts, [str(prim.GetPath()) for prim in prims])
-    mesh.up_axis = str(UsdGeom.GetStageUpAxis(stage))
-    mesh.meters_per_unit = float(UsdGeom.GetStageMetersPerUnit(stage))
+    mesh.up_axis = _stage_metadata(stage, "upAxis", lambda: str(UsdGeom.GetStageUpAxis(stage)), notes)
+    mesh.meters_per_unit = _stage_metadata(stage, "metersPerUnit", lambda: float(UsdGeom.GetStageMetersPerUnit(stage)), notes)
     mesh.notes = notes
     return mesh
+
+
+def _stage_metadata(stage, name: str, read, notes: list[str]):
+    """``read()``, the stage's ``name`` metadata; None and a note when it cannot be read
+    (e.g. a value of the wrong type): the meshes are checked all the same."""
+    from pxr import Tf
+
+    try:
+        return read()
+    except (Tf.ErrorException, TypeError, ValueError) as error:
+        reason = _pxr_reason(error) if isinstance(error, Tf.ErrorException) else str(error)
+        notes.append(f"the stage's {name} cannot be read ({reason}): not recorded")
+        return None
 
 
 def _pxr_reason(error) -> str:

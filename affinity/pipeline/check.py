@@ -33,20 +33,23 @@ def load_and_check(path: str, settings: Settings, usd=None) -> tuple[FileReport,
 
     try:
         mesh = load(path, usd)
+        report = FileReport(
+            path,
+            counts=mesh.counts(),
+            hits=lint_mesh(mesh, settings),
+            group_names=list(mesh.group_names),
+            prim_face_start=mesh.prim_face_start,
+            up_axis=mesh.up_axis,
+            meters_per_unit=mesh.meters_per_unit,
+            notes=list(mesh.notes),
+        )
     except SkippedFile as skip:
         return FileReport(path, skipped=skip.reason), None
     except MeshError as err:
         return FileReport(path, error=err.reason, error_line=err.line), None
-    report = FileReport(
-        path,
-        counts=mesh.counts(),
-        hits=lint_mesh(mesh, settings),
-        group_names=list(mesh.group_names),
-        prim_face_start=mesh.prim_face_start,
-        up_axis=mesh.up_axis,
-        meters_per_unit=mesh.meters_per_unit,
-        notes=list(mesh.notes),
-    )
+    except Exception as err:  # noqa: BLE001  a defect or MemoryError: this file's Q901, not the run's end
+        reason = " ".join(f"internal error: {type(err).__name__}: {err}".split())
+        return FileReport(path, error=reason[:300], error_line=0), None
     return report, mesh
 
 
