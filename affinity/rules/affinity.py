@@ -81,7 +81,7 @@ register(Rule(
     ),
     example_output=(
         'example.obj:10:1: Q101 uv-disaffine: texture coordinates are not an affine image of the positions'
-        ' (256 vs 0.5 texels)\n'
+        ' (256 vs 0.5 texels) [face 0]\n'
     ),
     fix=(
         "Re-UV the quad as a parallelogram matching its shape (Blender: UV > "
@@ -109,7 +109,7 @@ register(Rule(
     ),
     example_output=(
         'example.obj:6:1: Q102 color-disaffine: vertex colours are not an affine image of the positions'
-        ' (110.4 vs 2/255)\n'
+        ' (110.4 vs 2/255) [face 0]\n'
     ),
     fix=(
         "Repaint the corner colours so opposite corners average to the same "
@@ -137,7 +137,7 @@ register(Rule(
     ),
     example_output=(
         'example.obj:10:1: Q103 normal-disaffine: normals are not an affine image of the positions'
-        ' (9.847 vs 2 degrees)\n'
+        ' (9.847 vs 2 degrees) [face 0]\n'
     ),
     fix=(
         "Subdivide the quad or even out its corners (Blender: Mesh > Clean Up, or "

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..geometry import degeneracy, folded_fraction, interior_angles, is_bowtie
+from ..geometry import degeneracy, folded_fraction, interior_angles, is_bowtie, squared_lengths
 from .registry import Rule, register
 
 REFERENCES = "Bloomenthal 2022, §3.4 (nonplanar and degenerate quads); Hormann & Tarini 2004, §4 (concave and self-crossing quads)."
@@ -15,9 +15,49 @@ def degenerate(quads) -> tuple:
     return slice(None), degeneracy(quads.planar)
 
 
+def _fold(p: np.ndarray, normal: np.ndarray, a: int, b: int, c: int, d: int) -> np.ndarray:
+    """(Q,) float64 degrees between the normals of triangles (a, b, c) and (a, c, d):
+    the fold along the diagonal a-c of corners ``p`` (3, 4, Q).
+
+    Each triangle's normal is taken on the side of the quad's ``normal`` (3, Q)
+    (d02 x d13), so a flat concave or self-crossing quad, whose wrong split
+    overlaps itself, folds nothing (that is Q203's and Q204's). A triangle without
+    area has no normal and folds nothing either: that quad is Q201's.
+    """
+    e1, e2, e3 = p[:, b] - p[:, a], p[:, c] - p[:, a], p[:, d] - p[:, a]
+    n1, n2 = np.cross(e1, e2, axis=0), np.cross(e2, e3, axis=0)
+    n1 *= np.sign((n1 * normal).sum(axis=0))
+    n2 *= np.sign((n2 * normal).sum(axis=0))
+    sine = np.sqrt(squared_lengths(np.cross(n1, n2, axis=0)))
+    cosine = (n1 * n2).sum(axis=0)
+    return np.degrees(np.arctan2(sine, cosine))
+
+
+def fold_degrees(p: np.ndarray, diagonal: str, diagonals: np.ndarray | None = None) -> np.ndarray:
+    """(Q,) float64 fold angle in degrees of quads with corners ``p`` (3, 4, Q) float64.
+
+    The angle between the normals of the two triangles of the split along 0-2
+    (triangles 012 and 023) or 1-3 (123 and 130), as the dihedral angle of the
+    split surface: 0 for a planar quad (see :func:`_fold`), atan2(|n1 x n2|, n1 . n2).
+    ``diagonal`` is the setting: ``"02"``, ``"13"``, ``"both"`` (the worse of the
+    two) or ``"shortest"`` (the diagonal shorter in 3-D; ``diagonals`` (Q, 2)
+    holds the lengths of 0-2 and 1-3).
+    """
+    normal = np.cross(p[:, 2] - p[:, 0], p[:, 3] - p[:, 1], axis=0)
+    if diagonal == "02":
+        return _fold(p, normal, 0, 1, 2, 3)
+    if diagonal == "13":
+        return _fold(p, normal, 1, 2, 3, 0)
+    fold02, fold13 = _fold(p, normal, 0, 1, 2, 3), _fold(p, normal, 1, 2, 3, 0)
+    if diagonal == "shortest":
+        return np.where(diagonals[:, 0] <= diagonals[:, 1], fold02, fold13)
+    return np.maximum(fold02, fold13)
+
+
 def nonplanar(quads) -> tuple:
-    """Q202: the distance between the diagonals relative to their mean length."""
-    return slice(None), quads.planar.warp
+    """Q202: the fold angle along the split diagonal (the ``diagonal`` setting), in degrees."""
+    planar = quads.planar
+    return slice(None), fold_degrees(planar.components, quads.settings.diagonal, planar.diagonals)
 
 
 def concave(quads) -> tuple:
@@ -57,7 +97,7 @@ register(Rule(
     example="# a quad with a repeated corner\nv 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3 3\n",
     example_output=(
         'example.obj:5:1: Q201 degenerate-quad: zero area, collapsed edge or repeated corner'
-        ' (0 vs 1e-09 relative area)\n'
+        ' (0 vs 1e-09 relative area) [face 0]\n'
     ),
     fix=(
         "Merge the collapsed corners (Blender: Mesh > Clean Up > Merge by "
@@ -68,33 +108,38 @@ register(Rule(
 
 register(Rule(
     code="Q202", name="nonplanar-quad",
-    summary="corners do not lie in one plane (warp above tolerance)",
-    unit="relative warp", default_threshold=0.01,
+    summary="the split folds: the two triangles meet at an angle along the diagonal",
+    unit="degrees", default_threshold=45.0,
     check=nonplanar,
     what=(
-        "Measures the distance between the two diagonals relative to their mean "
-        "length and flags quads above the threshold; the affinity test runs on the "
+        "Measures the fold angle between the two triangles of the split along the "
+        "diagonal (the diagonal setting; with diagonal = both, the worse of the two "
+        "splits), in degrees, and flags quads above the threshold. 45 degrees is "
+        "where Blender's 3D-Print Toolbox calls a face distorted. A triangle without "
+        "area folds nothing here: that quad is Q201's. The affinity test runs on the "
         "projection onto the quad's plane."
     ),
     why=(
-        "A warped quad has no single flat shape: each diagonal split gives a "
-        "different surface and lighting, and no interpolation is exact."
+        "A folded quad has no single flat shape: each diagonal split gives a "
+        "different surface and lighting, and no interpolation is exact. Slight folds "
+        "are the nature of base meshes built for subdivision; a sharp one shows as "
+        "a crease wherever the engine picks the other diagonal."
     ),
-    example="# the unit square with one corner lifted by 0.2\nv 0 0 0\nv 1 0 0\nv 1 1 0.2\nv 0 1 0\nf 1 2 3 4\n",
+    example="# the unit square with one corner lifted by 1\nv 0 0 0\nv 1 0 0\nv 1 1 1\nv 0 1 0\nf 1 2 3 4\n",
     example_output=(
-        'example.obj:6:1: Q202 nonplanar-quad: corners do not lie in one plane'
-        ' (warp above tolerance) (0.06967 vs 0.01 relative warp)\n'
+        'example.obj:6:1: Q202 nonplanar-quad: the split folds: the two triangles meet at an angle along'
+        ' the diagonal (60 vs 45 degrees) [face 0]\n'
     ),
     fix=(
-        "Flatten the quad (Blender: Mesh > Clean Up > Make Planar Faces) or "
-        "triangulate it along the intended diagonal."
+        "Flatten the quad (Blender: Mesh > Clean Up > Make Planar Faces), "
+        "subdivide it, or triangulate it along the intended diagonal."
     ),
     references=REFERENCES,
 ))
 
 register(Rule(
     code="Q203", name="concave-quad",
-    summary="one corner is reflex",
+    summary="one corner is reflex", level="info",
     unit="degrees", default_threshold=180.0,
     check=concave,
     what=(
@@ -106,7 +151,7 @@ register(Rule(
         "bilinear inversion is ambiguous."
     ),
     example="# a dart: the corner at (0.5, 0.5) points inward\nv 0 0 0\nv 2 0 0\nv 0.5 0.5 0\nv 0 2 0\nf 1 2 3 4\n",
-    example_output='example.obj:6:1: Q203 concave-quad: one corner is reflex (233.1 vs 180 degrees)\n',
+    example_output='example.obj:6:1: Q203 concave-quad: one corner is reflex (233.1 vs 180 degrees) [face 0]\n',
     fix=(
         "Move the reflex corner outward, or split the quad into two triangles along "
         "the diagonal through the reflex corner (Blender: Face > Triangulate)."
@@ -116,7 +161,7 @@ register(Rule(
 
 register(Rule(
     code="Q204", name="bowtie-quad",
-    summary="the quad crosses itself", level="error",
+    summary="the quad crosses itself", level="error", unit="folded fraction",
     check=bowtie,
     what=(
         "Flags quads whose edges cross (a bow-tie) in their own plane; the value "
@@ -127,7 +172,7 @@ register(Rule(
         "back-facing."
     ),
     example="# the unit square with its corners in the order (0,0), (1,1), (1,0), (0,1)\nv 0 0 0\nv 1 1 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 4\n",
-    example_output='example.obj:6:1: Q204 bowtie-quad: the quad crosses itself (0.5)\n',
+    example_output='example.obj:6:1: Q204 bowtie-quad: the quad crosses itself (0.5 folded fraction) [face 0]\n',
     fix=(
         "Reorder the corners (flip the crossing edge) or delete and refill the "
         "face (Blender: select the four vertices, F)."

@@ -35,14 +35,15 @@ register(Rule(
         "# a square whose four corners share one line of uv\n"
         "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nf 1/1 2/2 3/2 4/1\n"
     ),
-    example_output='example.obj:8:1: Q301 uv-degenerate: zero area in texture space (0 vs 1e-09 relative area)\n',
+    example_output='example.obj:8:1: Q301 uv-degenerate: zero area in texture space (0 vs 1e-09 relative area) [face 0]\n',
     fix="Unwrap the face again so it gets its own area in UV space.",
     references="Bloomenthal 2022, §2 (the barycentric test divides by the uv triangles' areas).",
 ))
 
 register(Rule(
     code="Q302", name="uv-flipped",
-    summary="texture orientation reversed against the surface", worst="lowest", attribute="texcoords",
+    summary="texture orientation reversed against the surface", level="info",
+    unit="relative area", worst="lowest", attribute="texcoords",
     check=uv_flipped,
     what=(
         "Flags quads whose UV winding is clockwise while the face winding is "
@@ -54,7 +55,7 @@ register(Rule(
         "# a UV island mirrored to save texture space\n"
         "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 1 0\nvt 0 0\nvt 0 1\nvt 1 1\nf 1/1 2/2 3/3 4/4\n"
     ),
-    example_output='example.obj:10:1: Q302 uv-flipped: texture orientation reversed against the surface (-1)\n',
+    example_output='example.obj:10:1: Q302 uv-flipped: texture orientation reversed against the surface (-1 relative area) [face 0]\n',
     fix=(
         "Flip the island in the UV editor (Blender: UV > Mirror), or split "
         "tangents at the mirror seam."
