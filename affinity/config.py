@@ -106,8 +106,10 @@ def _codes(value, where: str) -> list[str]:
 
 
 def _number(value, where: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise ConfigError(f"{where}: expected a finite number (use ignore to switch a rule off)")
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ConfigError(f"{where}: expected a number")
+    if not math.isfinite(value):
+        raise ConfigError(f"{where}: expected a finite number, not {value} (use ignore to switch a rule off)")
     return float(value)
 
 

@@ -60,10 +60,12 @@ def _rule_annotation(report, hits, path: str) -> str:
     worst = worst_findings(report, hits, 1)[0]
     first = first_findings(report, hits, FIRST_FACES)
     where = lambda f: face_label(f) + (f" (line {f.line})" if f.line > 0 else "")  # noqa: E731
-    count = f"{len(hits)} finding{'s' * (len(hits) != 1)}"
-    message = f"{count}; worst: {describe(worst)}" + (f" at {where(worst)}" if face_label(worst) else "")
-    listed = [where(f) for f in first if face_label(f)]
-    if len(hits) > 1 and listed:
-        message += "; first: " + ", ".join(listed) + (", ..." if len(hits) > len(first) else "")
+    located = describe(worst) + (f", {where(worst)}" if face_label(worst) else "")
+    if len(hits) == 1:
+        message = located
+    else:
+        listed = ", ".join(where(f) for f in first if face_label(f))
+        more = ", ..." if len(hits) > len(first) else ""
+        message = f"{len(hits)} findings, the worst: {located}" + (f"; first: {listed}{more}" if listed else "")
     return annotation(_COMMANDS[worst.level], message, path, worst.line, worst.column,
                       title=f"{worst.code} {worst.name}")

@@ -94,14 +94,14 @@ def walk(top: str, settings_of: Callable[[str], Settings]) -> list[str]:
         settings = settings_of(folder)
         kept = []
         for name in sorted(dirs):
-            sub = os.path.join(folder, name)
+            sub = str(Path(folder, name))
             if _excluded(settings, sub, top) or is_environment(sub) or rules.ignores(sub, True):
                 continue
             kept.append(name)
             ignores[os.path.abspath(sub)] = rules.entering(sub)
         dirs[:] = kept
         for name in sorted(files):
-            path = os.path.join(folder, name)
+            path = str(Path(folder, name))
             if (os.path.splitext(name)[1].lower() in MESH_SUFFIXES and os.path.isfile(path)
                     and not _excluded(settings, path, top) and not rules.ignores(path, False)):
                 found.append(path)
