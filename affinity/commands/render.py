@@ -7,6 +7,7 @@ the equator so that the trapezoids near the pole show the split's crease.
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 
 from ..errors import UsageError
@@ -32,9 +33,22 @@ def _camera(text: str) -> tuple[tuple[float, ...], tuple[float, ...], float]:
         values = [float(v) for v in text.split(",")]
     except ValueError:
         values = []
-    if len(values) != 7:
+    if len(values) != 7 or not all(math.isfinite(v) for v in values):
         raise argparse.ArgumentTypeError("use --camera EX,EY,EZ,TX,TY,TZ,FOV (eye, target, vertical fov in degrees)")
+    if not 0 < values[6] < 180:
+        raise argparse.ArgumentTypeError(f"the field of view must lie between 0 and 180 degrees, got {values[6]:g}")
     return tuple(values[:3]), tuple(values[3:6]), values[6]
+
+
+def _tolerance(text: str) -> float:
+    """``--pixel-tolerance``: a number of pixels, zero or more (NaN would route nothing)."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not value >= 0:
+        raise argparse.ArgumentTypeError(f"not a pixel tolerance: {text!r} (a number of pixels, 0 or more)")
+    return value
 
 
 def add_parser(sub) -> None:
@@ -47,7 +61,7 @@ def add_parser(sub) -> None:
     p.add_argument("--method", choices=METHODS, default="hybrid")
     p.add_argument("--route", choices=["view", "lint"], default="view",
                    help="hybrid routing: visible split error in this view (default) or the lint flags")
-    p.add_argument("--pixel-tolerance", type=float, default=0.5, metavar="PX",
+    p.add_argument("--pixel-tolerance", type=_tolerance, default=0.5, metavar="PX",
                    help="route a quad to mvc when the split moves its texture by more than PX pixels")
     p.add_argument("--size", type=_size, default=(800, 600), metavar="WxH")
     p.add_argument("--camera", type=_camera, metavar="EX,EY,EZ,TX,TY,TZ,FOV")
