@@ -59,7 +59,10 @@ def _rule_annotation(report, hits, path: str) -> str:
     """The one annotation of a rule in a file."""
     worst = worst_findings(report, hits, 1)[0]
     first = first_findings(report, hits, FIRST_FACES)
-    where = lambda f: face_label(f) + (f" (line {f.line})" if f.line > 0 else "")  # noqa: E731
+
+    def where(f) -> str:
+        return face_label(f) + (f" (line {f.line})" if f.line > 0 else "")
+
     located = describe(worst) + (f", {where(worst)}" if face_label(worst) else "")
     if len(hits) == 1:
         message = located

@@ -38,11 +38,11 @@ register(Rule(
 ))
 
 _MTLLIB = re.compile(rb"^[ \t]*mtllib[ \t]+([^\r\n#]*)", re.MULTILINE)
-_LFS_POINTER = b"version https://git-lfs.github.com/spec/"
 
 
 def _unusable(path: str, image: bool) -> str | None:
     """Why the resource at ``path`` cannot be used (``"not found"``, ...), or None when it can."""
+    from ..loaders import _LFS_POINTER
     from ..loaders.imagesize import image_size
 
     try:
@@ -76,6 +76,8 @@ def missing_resources(mesh, settings) -> tuple | None:
         with open(mesh.path, "rb") as fh:
             data = fh.read()
     except OSError:
+        return None
+    if data.find(b"mtllib") < 0:
         return None
     folder = os.path.dirname(mesh.path)
     texels = mesh.texcoords is not None and "Q101" in RULES

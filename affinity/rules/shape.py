@@ -148,7 +148,9 @@ register(Rule(
     ),
     why=(
         "Splitting along the wrong diagonal folds a triangle outside the quad; "
-        "bilinear inversion is ambiguous."
+        "bilinear inversion is ambiguous. Concave quads are often modelled on "
+        "purpose (darts along a silhouette) and every engine splits them through "
+        "the reflex corner, so the rule is info by default."
     ),
     example="# a dart: the corner at (0.5, 0.5) points inward\nv 0 0 0\nv 2 0 0\nv 0.5 0.5 0\nv 0 2 0\nf 1 2 3 4\n",
     example_output='example.obj:6:1: Q203 concave-quad: one corner is reflex (233.1 vs 180 degrees) [face 0]\n',

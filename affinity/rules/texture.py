@@ -50,7 +50,12 @@ register(Rule(
         "counter-clockwise (a mirrored UV island); the value reported is the "
         "negative relative UV area."
     ),
-    why="Mirrored UVs flip the tangent frame: normal maps light the wrong way.",
+    why=(
+        "Mirrored UVs flip the tangent frame: normal maps light the wrong way. "
+        "Mirroring is also a common way to save texture space and is invisible "
+        "without a normal map, so the rule is info by default (set its level to "
+        "warning in [levels] when the asset bakes normal maps)."
+    ),
     example=(
         "# a UV island mirrored to save texture space\n"
         "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 1 0\nvt 0 0\nvt 0 1\nvt 1 1\nf 1/1 2/2 3/3 4/4\n"
