@@ -273,6 +273,17 @@ def test_per_file_ignores_name_groups(tmp_path):
     assert {f["group"] for f in doc["findings"]} == {"body", "helper-tongue", "helper-eyes"}
 
 
+def test_per_file_ignores_name_usd_prims(tmp_path):
+    pytest.importorskip("pxr")
+    scene = Path(__file__).parent / "data" / "usd" / "scene.usda"
+    (tmp_path / "scene.usda").write_bytes(scene.read_bytes())
+    before = findings(run("check", "--format", "json", "scene.usda", cwd=tmp_path))
+    assert {f["prim"] for f in before} == {"/World/Panel"}
+    write(tmp_path, "affinity.toml", '[per-file-ignores]\n"*.usda::/World/Pan*" = ["Q101", "Q102"]\n')
+    after = findings(run("check", "--format", "json", "scene.usda", cwd=tmp_path))
+    assert [f["code"] for f in after] == ["Q103"] and len(before) == 3
+
+
 def test_inline_ignore_comments(tmp_path):
     text = GROUPED.replace("g body\nf 1 2 3 4\n", "g body\nf 1 2 3 4  # affinity: ignore[Q202]\n")
     text = text.replace("g helper-tongue\n", "g helper-tongue # affinity: ignore[Q1, Q20]\n")
