@@ -16,7 +16,15 @@ from __future__ import annotations
 from typing import TextIO
 
 from ..rules import UNREADABLE
-from . import CheckRun, describe, face_label, first_findings, statistics, worst_findings, working_relative
+from . import (
+    CheckRun,
+    describe,
+    face_label,
+    first_findings,
+    statistics,
+    working_relative,
+    worst_findings,
+)
 
 #: Faces listed in a rule's annotation.
 FIRST_FACES = 5

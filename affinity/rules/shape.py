@@ -4,7 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..geometry import degeneracy, folded_fraction, interior_angles, is_bowtie, squared_lengths
+from ..geometry import (
+    degeneracy,
+    folded_fraction,
+    interior_angles,
+    is_bowtie,
+    squared_lengths,
+)
 from .registry import Rule, register
 
 REFERENCES = "Bloomenthal 2022, §3.4 (nonplanar and degenerate quads); Hormann & Tarini 2004, §4 (concave and self-crossing quads)."
