@@ -14,11 +14,18 @@ Keys (kebab-case, as in ruff)::
     measure = "misplacement"         # or "barycentric"
     diagonal = "both"                # "02", "13", "shortest"
     texture-size = 2048
-    exclude = ["legacy", "wip/*.ply"]
+    exclude = ["legacy", "wip/*.ply"]  # replaces the default skips (.git, node_modules, ...)
+    extend-exclude = ["scratch"]     # adds to them
     [thresholds]                     # [tool.affinity.thresholds] in pyproject.toml
     Q102 = 3
+    [levels]                         # [tool.affinity.levels]: error, warning or info
+    Q203 = "warning"
     [per-file-ignores]
     "scans/*" = ["Q202", "Q203"]
+    "characters/*.obj::helper-*" = ["ALL"]   # path::group (OBJ g/o name, USD prim path)
+
+Thresholds must be finite numbers and ``select`` must name at least one rule
+(``ignore`` switches rules off): nothing here switches a check off silently.
 
 Globs are relative to the configuration file's folder (see
 :func:`affinity.settings.glob_matches`).
@@ -26,12 +33,13 @@ Globs are relative to the configuration file's folder (see
 
 from __future__ import annotations
 
+import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
 
 from .errors import UsageError
-from .settings import DIAGONALS, MEASURES, Settings, unknown_codes, unthresholded_codes
+from .settings import DIAGONALS, MEASURES, Settings, unknown_codes, unknown_levels, unthresholded_codes
 
 CONFIG_NAMES = ("affinity.toml", "pyproject.toml")
 
@@ -100,7 +108,26 @@ def _codes(value, where: str) -> list[str]:
 def _number(value, where: str) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ConfigError(f"{where}: expected a number")
+    if not math.isfinite(value):
+        raise ConfigError(f"{where}: expected a finite number, not {value} (use ignore to switch a rule off)")
     return float(value)
+
+
+def _selection(value, where: str) -> list[str]:
+    codes = _codes(value, where)
+    if not codes:
+        raise ConfigError(f"{where}: selects no rule (use ignore to switch rules off)")
+    return codes
+
+
+def _levels(value, where: str) -> dict[str, str]:
+    if not isinstance(value, dict):
+        raise ConfigError(f"{where}: expected a table of rule code = \"error\" | \"warning\" | \"info\"")
+    levels = {str(code).upper(): level for code, level in value.items()}
+    bad = unknown_levels(levels)
+    if bad:
+        raise ConfigError(f"{where}: {', '.join(bad)} (expected a rule code = \"error\", \"warning\" or \"info\")")
+    return levels
 
 
 def _choice(value, choices: tuple[str, ...], where: str) -> str:
@@ -139,13 +166,15 @@ def _per_file_ignores(value, where: str) -> dict[str, list[str]]:
 
 #: TOML key -> (Settings field, validator(value, where)).
 _KEYS = {
-    "select": ("select", _codes),
+    "select": ("select", _selection),
     "ignore": ("ignore", _codes),
     "thresholds": ("thresholds", _thresholds),
     "measure": ("measure", lambda v, where: _choice(v, MEASURES, where)),
     "diagonal": ("diagonal", lambda v, where: _choice(v, DIAGONALS, where)),
     "texture-size": ("texture_size", _texture_size),
     "exclude": ("exclude", _globs),
+    "extend-exclude": ("extend_exclude", _globs),
+    "levels": ("levels", _levels),
     "per-file-ignores": ("per_file_ignores", _per_file_ignores),
 }
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from fnmatch import fnmatchcase
 
 import numpy as np
 
@@ -25,6 +26,13 @@ class RuleHits:
         The threshold the values exceeded.
     groups : (n,) int32
         Index into the file's ``group_names`` for each face.
+    level : str or None
+        ``"error"``, ``"warning"`` or ``"info"`` as the file's settings set it
+        (:func:`settle`); None: the rule's default.
+    unit : str or None
+        The unit of ``values`` under the file's reading; None: the rule's unit.
+    details : list of str or None
+        One remark per finding, said after the rule's summary (Q902 names the resource).
     """
 
     code: str
@@ -33,9 +41,18 @@ class RuleHits:
     values: np.ndarray
     threshold: float
     groups: np.ndarray
+    level: str | None = None
+    unit: str | None = None
+    details: list[str] | None = None
 
     def __len__(self) -> int:
         return len(self.faces)
+
+    def subset(self, rows: np.ndarray) -> RuleHits:
+        """The findings at ``rows`` (an index array or a boolean mask), level and unit kept."""
+        details = None if self.details is None else np.asarray(self.details, dtype=object)[rows].tolist()
+        return RuleHits(self.code, self.faces[rows], self.lines[rows], self.values[rows], self.threshold,
+                        self.groups[rows], self.level, self.unit, details)
 
 
 @dataclass(eq=False)
@@ -68,3 +85,36 @@ class FileReport:
     @property
     def n_findings(self) -> int:
         return sum(len(h) for h in self.hits)
+
+
+def _matches(code: str, prefixes: list[str]) -> bool:
+    return any(p == "ALL" or code.startswith(p) for p in prefixes)
+
+
+def settle(hits: list[RuleHits], settings, group_names: list[str], inline=()) -> list[RuleHits]:
+    """Give lint's ``hits`` their level and unit from ``settings`` and drop the suppressed ones.
+
+    Suppressed are the findings in a group that a ``path::group`` per-file
+    ignore names (``settings.group_ignores``: glob over ``group_names``) and the
+    faces ``inline`` silences: ``(codes, faces (k,) int64)`` pairs from
+    ``# affinity: ignore[CODE]`` comments (:mod:`affinity.loaders.suppress`).
+    """
+    from .rules import RULES
+
+    settled = []
+    for h in hits:
+        rule = RULES[h.code]
+        h.level, h.unit = settings.level(h.code), h.unit or rule.unit_for(settings.measure)
+        silenced = np.zeros(len(h), dtype=bool)
+        groups = [i for i, name in enumerate(group_names)
+                  if any(fnmatchcase(name, glob) and _matches(h.code, codes) for glob, codes in settings.group_ignores)]
+        if groups:
+            silenced |= np.isin(h.groups, groups)
+        for codes, faces in inline:
+            if _matches(h.code, codes):
+                silenced |= np.isin(h.faces, faces)
+        if silenced.any():
+            h = h.subset(~silenced)
+        if len(h):
+            settled.append(h)
+    return settled

@@ -175,8 +175,9 @@ def lint_mesh(mesh: Mesh, settings: Settings) -> list[RuleHits]:
     for rule in enabled:
         found = rule.check(mesh, settings) if rule.scope == "mesh" else None
         if found is not None:
-            faces, lines, values = found
-            hits.append(RuleHits(rule.code, faces, lines, values, 0.0, np.zeros(len(faces), dtype=np.int32)))
+            faces, lines, values, *details = found  # a mesh rule may add one detail per finding
+            hits.append(RuleHits(rule.code, faces, lines, values, 0.0, np.zeros(len(faces), dtype=np.int32),
+                                 details=details[0] if details else None))
     quad_rules = [rule for rule in enabled if rule.scope == "quad"]
     thresholds = {rule.code: settings.threshold(rule.code) if rule.has_threshold else None for rule in quad_rules}
 

@@ -17,9 +17,11 @@ import os
 from dataclasses import dataclass, field, replace
 from fnmatch import fnmatchcase
 
-from .rules import RULES
+from .rules import LEVELS, RULES
 
 MEASURES = ("misplacement", "barycentric")
+#: Folders a directory walk never enters unless ``exclude`` is set (``extend-exclude`` adds to them).
+DEFAULT_EXCLUDE = (".git", "node_modules", "__pycache__")
 DIAGONALS = ("both", "02", "13", "shortest")
 
 
@@ -34,7 +36,12 @@ class Settings:
     ``diagonal`` picks which split the affinity test measures: ``"both"``,
     ``"02"``, ``"13"`` or ``"shortest"``. ``exclude`` lists globs of files not
     to check; ``per_file_ignores`` maps a glob to rule codes (or prefixes)
-    ignored in the files it matches; both are relative to ``root``.
+    ignored in the files it matches; both are relative to ``root``. A key
+    ``"path::group"`` ignores the codes only in the groups (OBJ ``g``/``o``
+    names, USD prim paths) its second glob matches; :meth:`for_file` turns those
+    into ``group_ignores``, (group glob, codes) pairs. ``levels`` maps rule codes
+    to the level their findings get (``error``, ``warning``, ``info``), over the
+    rule's default.
     """
 
     select: list[str] | None = None
@@ -43,9 +50,12 @@ class Settings:
     measure: str = "misplacement"
     diagonal: str = "both"
     texture_size: int = 1024
-    exclude: list[str] = field(default_factory=list)
+    exclude: list[str] = field(default_factory=lambda: list(DEFAULT_EXCLUDE))
     per_file_ignores: dict[str, list[str]] = field(default_factory=dict)
+    levels: dict[str, str] = field(default_factory=dict)
+    extend_exclude: list[str] = field(default_factory=list)
     root: str | None = None
+    group_ignores: list[tuple[str, list[str]]] = field(default_factory=list)
 
     def threshold(self, code: str) -> float | None:
         """The threshold of rule ``code``: the configured one, else the rule's default for the reading."""
@@ -53,10 +63,15 @@ class Settings:
             return self.thresholds[code]
         return RULES[code].default_for(self.measure)
 
+    def level(self, code: str) -> str:
+        """The level of rule ``code``'s findings: the configured one, else the rule's."""
+        return self.levels.get(code, RULES[code].level)
+
     def updated(self, options: dict) -> Settings:
-        """A copy with ``options`` (field name -> value) applied on top; thresholds merge per rule."""
+        """A copy with ``options`` (field name -> value) applied on top; thresholds and levels merge per rule."""
         thresholds = {**self.thresholds, **options.get("thresholds", {})}
-        return replace(self, **{**options, "thresholds": thresholds})
+        levels = {**self.levels, **options.get("levels", {})}
+        return replace(self, **{**options, "thresholds": thresholds, "levels": levels})
 
     def relative(self, path: str) -> str | None:
         """``path`` relative to ``root`` with ``/`` separators, or None when it lies outside."""
@@ -66,20 +81,26 @@ class Settings:
         return None if rel.startswith("..") else rel.replace(os.sep, "/")
 
     def is_excluded(self, path: str) -> bool:
-        """Whether an ``exclude`` glob matches ``path``."""
+        """Whether an ``exclude`` or ``extend-exclude`` glob matches ``path``."""
         rel = self.relative(path)
-        return rel is not None and any(glob_matches(pattern, rel) for pattern in self.exclude)
+        return rel is not None and any(glob_matches(pattern, rel) for pattern in (*self.exclude, *self.extend_exclude))
 
     def for_file(self, path: str) -> Settings:
-        """The settings to lint ``path`` with: ``ignore`` extended by the matching per-file ignores."""
+        """The settings to lint ``path`` with: ``ignore`` extended by the matching per-file
+        ignores, ``group_ignores`` set from the matching ``path::group`` keys."""
         rel = self.relative(path)
-        extra = [
-            code
-            for pattern, codes in self.per_file_ignores.items()
-            if rel is not None and glob_matches(pattern, rel)
-            for code in codes
-        ]
-        return replace(self, ignore=[*(self.ignore or []), *extra]) if extra else self
+        extra, groups = [], []
+        for key, codes in self.per_file_ignores.items():
+            pattern, _, group = key.partition("::")
+            if rel is None or not glob_matches(pattern, rel):
+                continue
+            if group:
+                groups.append((group, list(codes)))
+            else:
+                extra += codes
+        if not extra and not groups:
+            return self
+        return replace(self, ignore=[*(self.ignore or []), *extra], group_ignores=groups)
 
 
 def glob_matches(pattern: str, rel: str) -> bool:
@@ -110,6 +131,11 @@ def glob_matches(pattern: str, rel: str) -> bool:
 def unknown_codes(prefixes: list[str]) -> list[str]:
     """The entries of ``prefixes`` that select no rule (``"ALL"`` and any prefix of a code are fine)."""
     return [p for p in prefixes if p != "ALL" and not any(code.startswith(p) for code in RULES)]
+
+
+def unknown_levels(levels: dict) -> list[str]:
+    """``"CODE = level"`` entries of ``levels`` that name no lint rule or no level."""
+    return [f"{code} = {level!r}" for code, level in levels.items() if code not in RULES or level not in LEVELS]
 
 
 def unthresholded_codes(codes: list[str]) -> list[str]:

@@ -13,7 +13,10 @@ import pytest
 
 SQUARE = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n"
 TRAPEZOID = "v -1 0 0\nv 1 0 0\nv 0.5 1 0\nv -0.5 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n"
-TEXT_LINE = re.compile(r"^(?P<path>.+):(?P<line>\d+):(?P<col>\d+): (?P<code>Q\d{3}) (?P<name>[a-z-]+): .+ \(.+ vs .+\)$")
+TEXT_LINE = re.compile(
+    r"^(?P<path>.+):(?P<line>\d+):(?P<col>\d+): (?P<code>Q\d{3}) (?P<name>[a-z-]+): .+ "
+    r"\((?P<value>\S+) vs (?P<threshold>\S+) (?P<unit>[a-z ]+)\) \[face (?P<face>\d+)\]$"
+)
 
 
 def run(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
@@ -47,6 +50,7 @@ def test_trapezoid_is_flagged_with_ruff_style_line(tmp_path):
     match = TEXT_LINE.match(lines[0])
     assert match, lines[0]
     assert (match["line"], match["col"], match["code"], match["name"]) == ("10", "1", "Q101", "uv-disaffine")
+    assert (match["value"], match["threshold"], match["unit"], match["face"]) == ("256", "0.5", "texels", "0")
 
 
 def test_json_document_carries_every_field(tmp_path):
@@ -85,7 +89,7 @@ def test_barycentric_measure_uses_paper_tolerance(tmp_path):
 def test_statistics_counts_per_rule(tmp_path):
     path = str(write(tmp_path, "trapezoid.obj", TRAPEZOID))
     result = run("check", "--statistics", path)
-    assert re.search(r"^\s+1\s+Q101\s+uv-disaffine$", result.stdout, re.M), result.stdout
+    assert re.search(r"^\s+1\s+Q101\s+uv-disaffine\s+\[warning\]$", result.stdout, re.M), result.stdout
 
 
 def test_text_output_is_capped_per_rule(tmp_path):
@@ -141,7 +145,7 @@ def test_missing_path_and_empty_directory_are_usage_errors(tmp_path):
         result = run("check", str(target))
         assert result.returncode == 2 and "Traceback" not in result.stderr
         assert str(target) in result.stderr
-    assert run("check").returncode == 2
+    assert run("check", cwd=tmp_path).returncode == 2, "no PATH checks ., and . has no meshes"
 
 
 def test_one_bad_file_does_not_stop_a_directory_run(tmp_path):

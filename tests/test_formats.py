@@ -74,11 +74,11 @@ def test_text_lines_and_summary():
     text.write(sample_run(), out)
     assert out.getvalue().splitlines() == [
         "a, b:c.obj:10:1: Q101 uv-disaffine: texture coordinates are not an affine image of the positions "
-        "(3.5 vs 0.5 texels)",
-        "a, b:c.obj:11:1: Q204 bowtie-quad: the quad crosses itself (0.3)",
+        "(3.5 vs 0.5 texels) [face 0]",
+        "a, b:c.obj:11:1: Q204 bowtie-quad: the quad crosses itself (0.3 folded fraction) [face 1]",
         "a, b:c.obj:12:1: Q101 uv-disaffine: texture coordinates are not an affine image of the positions "
-        "(256 vs 0.5 texels)",
-        "Found 3 findings (2 files checked, 1 unreadable, 1 skipped).",
+        "(256 vs 0.5 texels) [face 2]",
+        "Found 3 findings: 1 error, 2 warning (2 files checked, 1 unreadable, 1 skipped).",
     ]
 
 
@@ -86,21 +86,29 @@ def test_text_summary_counts_baselined_findings():
     run_ = sample_run()
     run_.baselined = {"a, b:c.obj": 4}
     assert render(text, run_).splitlines()[-1] == (
-        "Found 3 new findings (2 files checked, 1 unreadable, 1 skipped, 4 baselined)."
+        "Found 3 new findings: 1 error, 2 warning (2 files checked, 1 unreadable, 1 skipped, 4 baselined)."
     )
 
 
 def test_github_annotations_escape_and_levels():
+    """One annotation per file and rule, on the worst finding's line, with the count and the first faces."""
     lines = render(github, sample_run()).splitlines()
     assert lines == [
-        "::warning file=a%2C b%3Ac.obj,line=10,col=1,title=Q101 uv-disaffine::texture coordinates are not "
-        "an affine image of the positions (3.5 vs 0.5 texels), face 0",
-        "::error file=a%2C b%3Ac.obj,line=11,col=1,title=Q204 bowtie-quad::the quad crosses itself (0.3), face 1",
-        "::warning file=a%2C b%3Ac.obj,line=12,col=1,title=Q101 uv-disaffine::texture coordinates are not "
-        "an affine image of the positions (256 vs 0.5 texels), face 2",
+        "::warning file=a%2C b%3Ac.obj,line=12,col=1,title=Q101 uv-disaffine::2 findings, the worst: texture "
+        "coordinates are not an affine image of the positions (256 vs 0.5 texels), face 2 (line 12); "
+        "first: face 0 (line 10), face 2 (line 12)",
+        "::error file=a%2C b%3Ac.obj,line=11,col=1,title=Q204 bowtie-quad::the quad crosses itself "
+        "(0.3 folded fraction), face 1 (line 11)",
         "::error file=broken.obj,line=4,title=Q901 unreadable::face index 9 out of range%0D%0A(1 based)",
         "::notice file=big.obj,title=skipped::skipped (lfs-pointer)",
     ]
+
+
+def test_github_annotation_level_is_the_findings_level():
+    info = hits("Q101", [0], [10], [3.5])
+    info.level = "info"
+    (line,) = render(github, CheckRun([FileReport("a.obj", hits=[info])], Settings())).splitlines()
+    assert line.startswith("::notice file=a.obj,line=10,col=1,title=Q101 uv-disaffine::")
 
 
 def test_github_leaves_out_line_zero_and_escapes_percent():
@@ -112,7 +120,7 @@ def test_github_leaves_out_line_zero_and_escapes_percent():
 def test_file_level_finding_names_no_face():
     run_ = CheckRun([FileReport("points.obj", hits=[hits("Q205", [-1], [1], [2.0], 0.0)])], Settings())
     assert render(github, run_).splitlines() == [
-        "::warning file=points.obj,line=1,col=1,title=Q205 no-faces::the mesh has vertices but no faces (2)"]
+        "::warning file=points.obj,line=1,col=1,title=Q205 no-faces::the mesh has vertices but no faces (2 vertices)"]
     assert ET.fromstring(render(junit, run_)).find("testsuite/testcase").get("name") == "Q205 no-faces"
 
 
@@ -143,7 +151,8 @@ def test_junit_survives_characters_xml_cannot_carry():
 def test_json_summary_and_thresholdless_rules():
     doc = json.loads(render(json_output, sample_run()))
     assert doc["summary"] == {"files": 4, "checked": 2, "unreadable": 1, "skipped": 1, "findings": 3,
-                              "baselined": 0, "by_rule": {"Q101": 2, "Q204": 1}}
+                              "baselined": 0, "by_rule": {"Q101": 2, "Q204": 1},
+                              "by_level": {"error": 1, "warning": 2}}
     bowtie = next(f for f in doc["findings"] if f["code"] == "Q204")
     assert bowtie["threshold"] is None and bowtie["group"] == "body"
 
@@ -162,7 +171,7 @@ def test_github_format_end_to_end(meshes):
     assert result.returncode == 1, result.stderr
     assert result.stdout.splitlines() == [
         "::warning file=bad.obj,line=10,col=1,title=Q101 uv-disaffine::texture coordinates are not an affine "
-        "image of the positions (256 vs 0.5 texels), face 0",
+        "image of the positions (256 vs 0.5 texels), face 0 (line 10)",
     ]
 
 

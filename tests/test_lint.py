@@ -124,17 +124,19 @@ def test_colours_and_normals():
 def test_shape_rules():
     square = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
     pole = [[0, 0, 0], [1, 0, 0], [0.5, 1, 0], [0.5, 1, 0]]
-    warped = [[0, 0, 0], [1, 0, 0], [1, 1, 0.2], [0, 1, 0]]
+    warped = [[0, 0, 0], [1, 0, 0], [1, 1, 1], [0, 1, 0]]  # folds 60 degrees along 0-2, 54.7 along 1-3
     dart = [[0, 0, 0], [2, 1, 0], [4, 0, 0], [2, 3, 0]]
     bowtie = [[0, 0, 0], [1, 1, 0], [1, 0, 0], [0, 1, 0]]
     mesh = quads_mesh(square, pole, warped, dart, bowtie)
     hits = found(mesh)
     assert set(hits) == {"Q201", "Q202", "Q203", "Q204"}
     assert hits["Q201"][0] == [1] and hits["Q201"][1][0] == 0
-    assert hits["Q202"][0] == [2] and hits["Q202"][1][0] > 0.01
+    assert hits["Q202"][0] == [2]
+    np.testing.assert_allclose(hits["Q202"][1], [60.0])
     assert hits["Q203"][0] == [3] and hits["Q203"][1][0] > 180
     assert hits["Q204"][0] == [4] and hits["Q204"][1][0] == 0.5
-    assert "Q202" not in found(mesh, thresholds={"Q202": 0.5})
+    assert "Q202" not in found(mesh, thresholds={"Q202": 61})
+    np.testing.assert_allclose(found(mesh, diagonal="13")["Q202"][1], [np.degrees(np.arccos(1 / np.sqrt(3)))])
 
 
 def test_uv_rules():

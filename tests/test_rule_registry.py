@@ -27,9 +27,11 @@ def test_each_rules_example_triggers_that_rule_and_only_it(code, tmp_path, monke
     assert 4 <= len(rule.example.splitlines()) <= 10, "the example is a tiny OBJ"
     (tmp_path / "example.obj").write_text(rule.example)
     monkeypatch.chdir(tmp_path)
-    status, out, err = check(["check", "--select", "ALL", "--format", "json", "example.obj"], capsys)
+    status, out, err = check(["check", "--select", "ALL", "--fail-on", "info", "--format", "json", "example.obj"], capsys)
     assert status == 1, err
-    assert {f["code"] for f in json.loads(out)["findings"]} == {code}
+    findings = json.loads(out)["findings"]
+    assert {f["code"] for f in findings} == {code}
+    assert {f["level"] for f in findings} == {rule.level} and {f["unit"] for f in findings} == {rule.unit}
     status, out, _ = check(["check", "--select", "ALL", "example.obj"], capsys)
     lines = [line for line in out.splitlines() if not line.startswith("Found ")]
     assert rule.example_output, f"{code}: the page shows what affinity check prints for its example"

@@ -58,7 +58,7 @@ def test_sample_log_validates_with_rules_results_and_notifications(tmp_path, mon
     assert location == {"artifactLocation": {"uri": "a%2C%20b%3Ac.obj", "uriBaseId": "%SRCROOT%"},
                         "region": {"startLine": 12, "startColumn": 1}}
     assert results[2]["properties"] == {"name": "uv-disaffine", "face": 2, "value": 256.0, "threshold": 0.5,
-                                        "group": "body"}
+                                        "unit": "texels", "level": "warning", "group": "body"}
     assert sarif_run["originalUriBaseIds"]["%SRCROOT%"]["uri"] == tmp_path.as_uri() + "/"
 
     (invocation,) = sarif_run["invocations"]
@@ -85,7 +85,7 @@ def test_file_level_finding_has_no_logical_location(tmp_path, monkeypatch):
     assert_valid(log)
     (result,) = log["runs"][0]["results"]
     assert "logicalLocations" not in result["locations"][0]
-    assert result["message"]["text"] == "the mesh has vertices but no faces (2)"
+    assert result["message"]["text"] == "the mesh has vertices but no faces (2 vertices)"
 
 
 def test_file_outside_the_working_directory_gets_an_absolute_uri(tmp_path, monkeypatch):

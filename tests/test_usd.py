@@ -354,8 +354,9 @@ def test_sarif_locates_by_prim_without_a_region():
 @requires_usd
 def test_github_and_junit_name_the_prim():
     github = check("--format", "github", str(SCENE)).stdout.splitlines()
-    assert github[0].startswith(f"::warning file={SCENE.relative_to(ROOT)},title=Q102 color-disaffine::")
-    assert github[0].endswith(", /World/Panel face 0")
+    (colour,) = [line for line in github if "title=Q102" in line]
+    assert colour.startswith(f"::warning file={SCENE.relative_to(ROOT)},title=Q102 color-disaffine::")
+    assert colour.endswith(", /World/Panel face 0")
     junit = check("--format", "junit", str(SCENE)).stdout
     assert 'name="Q102 color-disaffine /World/Panel face 0"' in junit
     assert '<property name="prim" value="/World/Panel" />' in junit

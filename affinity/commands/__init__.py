@@ -5,6 +5,7 @@ for NumPy and nothing heavier.
 """
 
 import argparse
+import math
 
 EXIT_CLEAN, EXIT_FINDINGS, EXIT_ERROR = 0, 1, 2
 
@@ -46,6 +47,19 @@ def camera(text: str) -> tuple[tuple[float, ...], tuple[float, ...], float]:
         values = [float(v) for v in text.split(",")]
     except ValueError:
         values = []
-    if len(values) != 7:
+    if len(values) != 7 or not all(math.isfinite(v) for v in values):
         raise argparse.ArgumentTypeError("use --camera EX,EY,EZ,TX,TY,TZ,FOV (eye, target, vertical fov in degrees)")
+    if not 0 < values[6] < 180:
+        raise argparse.ArgumentTypeError(f"the field of view must lie between 0 and 180 degrees, got {values[6]:g}")
     return tuple(values[:3]), tuple(values[3:6]), values[6]
+
+
+def pixel_tolerance(text: str) -> float:
+    """An argparse ``type`` for ``--pixel-tolerance``: a number of pixels, zero or more (NaN would route nothing)."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not value >= 0:
+        raise argparse.ArgumentTypeError(f"not a pixel tolerance: {text!r} (a number of pixels, 0 or more)")
+    return value

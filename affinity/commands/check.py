@@ -27,13 +27,30 @@ def _codes(text: str) -> list[str]:
     return codes
 
 
+def _selection(text: str) -> list[str]:
+    """``--select``: at least one rule; ``--ignore`` is how a rule is switched off."""
+    codes = _codes(text)
+    if not codes:
+        raise argparse.ArgumentTypeError("selects no rule (use --ignore to switch rules off)")
+    return codes
+
+
 def _threshold(text: str) -> tuple[str, float]:
-    """``0.8`` (the uv rule Q101) or ``CODE=VALUE``."""
+    """``0.8`` (the uv rule Q101) or ``CODE=VALUE``; VALUE a finite number."""
     code, _, value = text.rpartition("=")
     try:
-        return (code.strip().upper() or "Q101"), float(value)
+        number = float(value)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"not a threshold: {text!r} (use 0.8 or Q102=3)") from None
+        number = math.nan
+    if not math.isfinite(number):
+        raise argparse.ArgumentTypeError(f"not a finite threshold: {text!r} (use 0.8 or Q102=3; --ignore switches a rule off)")
+    return (code.strip().upper() or "Q101"), number
+
+
+def _count(text: str) -> int:
+    if not text.isdigit() or int(text) < 1:
+        raise argparse.ArgumentTypeError(f"not a positive number: {text!r}")
+    return int(text)
 
 
 def _jobs(text: str) -> int:
@@ -54,6 +71,7 @@ def _time(text: str) -> float:
 
 def add_parser(sub) -> None:
     from ..output import FORMATS
+    from ..rules import LEVELS
     from ..settings import DIAGONALS, MEASURES
 
     p = sub.add_parser(
@@ -63,11 +81,11 @@ def add_parser(sub) -> None:
                     "Settings come from affinity.toml or [tool.affinity] in pyproject.toml, found by "
                     "walking up from each file; flags given here win.",
     )
-    p.add_argument("paths", nargs="*", metavar="PATH")
+    p.add_argument("paths", nargs="*", metavar="PATH", help="files or directories (default: .)")
     p.add_argument("--demo", action="store_true", help="also check the bundled demo meshes")
     p.add_argument("--format", choices=FORMATS, default="text",
                    help="text (default), json, sarif (code scanning), github (workflow annotations), junit")
-    p.add_argument("--select", type=_codes, help="rule codes or prefixes to enable, e.g. Q1,Q201")
+    p.add_argument("--select", type=_selection, help="rule codes or prefixes to enable, e.g. Q1,Q201")
     p.add_argument("--ignore", type=_codes, help="rule codes or prefixes to disable")
     p.add_argument(
         "--threshold", type=_threshold, action="append", default=[], metavar="[CODE=]VALUE",
@@ -93,10 +111,19 @@ def add_parser(sub) -> None:
                    help="record every current finding in FILE (counts per file, group and rule) and exit")
     p.add_argument("-j", "--jobs", type=_jobs, metavar="N",
                    help="check files in N processes (default: all CPUs, fewer when the files are small)")
-    p.add_argument("--statistics", action="store_true", help="print counts per rule instead of findings")
+    p.add_argument("--fail-on", choices=LEVELS, default="warning",
+                   help="the lowest level whose findings make exit 1 (default: warning)")
+    p.add_argument("--exit-zero", action="store_true",
+                   help="exit 0 even with findings (unreadable input and --fail-on-skip still exit 2)")
     p.add_argument("--fail-on-skip", action="store_true",
                    help="exit 2 when a file was skipped (a Git LFS pointer, a USD stage with no mesh), so a "
                         "checkout without 'git lfs pull' cannot pass with nothing checked")
+    p.add_argument("--max-findings", type=_count, metavar="N",
+                   help="json/sarif: keep the worst N findings per file and rule, and say what was truncated")
+    p.add_argument("--show-files", action="store_true", help="list the files that would be checked and exit")
+    p.add_argument("-o", "--output-file", metavar="PATH", help="write the output to PATH (whole or not at all)")
+    p.add_argument("--statistics", action="store_true",
+                   help="text: counts per rule instead of findings; json/sarif/github/junit: counts added")
     p.add_argument("--verbose", action="store_true", help="show every finding in text output")
     p.add_argument("-q", "--quiet", action="store_true", help="print findings and nothing else")
     p.set_defaults(run=run)
@@ -145,9 +172,12 @@ def _tasks(resolver, paths: list[str]) -> list:
     """``(file, settings)`` for every mesh file to check: excluded files dropped, per-file ignores applied."""
     from ..pipeline.files import collect_paths
 
+    def warn(message: str) -> None:
+        sys.stderr.write(message + "\n")
+
     return [
         (path, settings.for_file(path))
-        for path in collect_paths(paths)
+        for path in collect_paths(paths, lambda folder: resolver.resolve(folder).settings, warn)
         if not (settings := resolver.resolve(path).settings).is_excluded(path)
     ]
 
@@ -163,8 +193,8 @@ def _write_baseline(reports, path: str, quiet: bool) -> None:
 
 
 def run(args) -> int:
-    from ..pipeline.check import check_files
     from ..config import Resolver
+    from ..pipeline.check import check_files
     from ..loaders.usd import UsdOptions
     from ..output import CheckRun
 
@@ -181,14 +211,15 @@ def run(args) -> int:
 
         write_settings(resolver, paths or [os.curdir], sys.stdout)
         return EXIT_CLEAN
-    if not paths:
-        raise UsageError("no PATH given (name files or directories, or use --demo)")
     if args.baseline:
         from ..pipeline import baseline
 
         known = baseline.read(args.baseline)  # before the check: a bad baseline fails fast
 
     tasks = _tasks(resolver, paths)
+    if args.show_files:
+        _write_output_file(args.output_file, lambda out: out.writelines(path + "\n" for path, _ in tasks))
+        return EXIT_CLEAN
     progress = _progress_bar() if len(tasks) > 1 and sys.stderr.isatty() else None
     reports = check_files(tasks, args.jobs, progress, usd=UsdOptions(args.time, args.uv_primvar))
     _report_problems(reports, args.quiet, args.fail_on_skip)
@@ -197,19 +228,42 @@ def run(args) -> int:
         _write_baseline(reports, args.write_baseline, args.quiet)
         return EXIT_ERROR if failed else EXIT_CLEAN
 
-    check_run = CheckRun(reports, resolver.resolve(os.curdir).settings)
+    check_run = CheckRun(reports, resolver.resolve(os.curdir).settings,
+                         max_findings=args.max_findings, statistics=args.statistics)
     if args.baseline:
         check_run.reports, check_run.baselined = baseline.apply(reports, known)
-    _write_output(check_run, args)
+    _write_output_file(args.output_file, lambda out: _write_output(check_run, args, out))
     if failed:
         return EXIT_ERROR
-    return EXIT_FINDINGS if any(r.n_findings for r in check_run.reports) else EXIT_CLEAN
+    return EXIT_CLEAN if args.exit_zero or not _fails(check_run.reports, args.fail_on) else EXIT_FINDINGS
 
 
-def _write_output(check_run, args) -> None:
+def _fails(reports, fail_on: str) -> bool:
+    """Whether any finding is at level ``fail_on`` or above (error > warning > info)."""
+    from ..rules import LEVELS, RULES
+
+    worse = LEVELS[: LEVELS.index(fail_on) + 1]
+    return any((h.level or RULES[h.code].level) in worse for r in reports for h in r.hits)
+
+
+def _write_output_file(path: str | None, write) -> None:
+    """``write(out)`` to stdout, or to ``path`` atomically (a failed run leaves no partial file)."""
+    if path is None:
+        write(sys.stdout)
+        return
+    from ..atomic import atomic_write
+
+    try:
+        with atomic_write(path) as out:
+            write(out)
+    except OSError as err:
+        raise UsageError(f"{path}: cannot write the output: {err.strerror or err}") from None
+
+
+def _write_output(check_run, args, out) -> None:
     from ..output import text, writer
 
     if args.format == "text":
-        text.write(check_run, sys.stdout, verbose=args.verbose, statistics=args.statistics, summary=not args.quiet)
+        text.write(check_run, out, verbose=args.verbose, statistics=args.statistics, summary=not args.quiet)
     else:
-        writer(args.format)(check_run, sys.stdout)
+        writer(args.format)(check_run, out)

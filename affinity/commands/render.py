@@ -9,7 +9,7 @@ from __future__ import annotations
 import sys
 
 from ..errors import UsageError
-from . import EXIT_CLEAN, camera, image_size, require, spelling
+from . import EXIT_CLEAN, camera, image_size, pixel_tolerance, require, spelling
 
 METHODS = ("hybrid", "split", "mvc", "bilinear", "projective", "exact")
 SHOW_MODES = ("uv", "color", "normal", "shaded")  # what affinity.draw.shading.shade draws
@@ -25,7 +25,7 @@ def add_parser(sub) -> None:
     p.add_argument("--method", choices=METHODS, default="hybrid")
     p.add_argument("--route", choices=["view", "lint"], default="view",
                    help="hybrid routing: visible split error in this view (default) or the lint flags")
-    p.add_argument("--pixel-tolerance", type=float, default=0.5, metavar="PX",
+    p.add_argument("--pixel-tolerance", type=pixel_tolerance, default=0.5, metavar="PX",
                    help="route a quad to mvc when the split moves its texture by more than PX pixels")
     p.add_argument("--size", type=image_size, default=(800, 600), metavar="WxH")
     p.add_argument("--camera", type=camera, metavar="EX,EY,EZ,TX,TY,TZ,FOV")

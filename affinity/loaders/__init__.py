@@ -21,7 +21,7 @@ from .usd import USD_SUFFIXES, UsdOptions, load_usd
 
 LOADERS = {".obj": load_obj, ".ply": load_ply, ".off": load_off, **dict.fromkeys(USD_SUFFIXES, load_usd)}
 
-_LFS_POINTER = b"version https://git-lfs.github.com/spec/"
+LFS_POINTER = b"version https://git-lfs.github.com/spec/"
 
 
 def load(path, usd: UsdOptions | None = None) -> Mesh:
@@ -43,14 +43,14 @@ def load(path, usd: UsdOptions | None = None) -> Mesh:
         raise MeshError(path, 0, f"unknown mesh format {extension or '(no extension)'!r}; expected one of {known}")
     try:
         with open(path, "rb") as fh:
-            head = fh.read(len(_LFS_POINTER))
+            head = fh.read(len(LFS_POINTER))
     except IsADirectoryError:
         raise MeshError(path, 0, "is a directory, not a mesh file") from None
     except OSError as error:
         raise MeshError(path, 0, f"cannot read: {error.strerror or error}") from None
     if not head:
         raise MeshError(path, 0, "empty file")
-    if head == _LFS_POINTER:
+    if head == LFS_POINTER:
         raise SkippedFile(path, "lfs-pointer")
     try:
         if extension in USD_SUFFIXES:

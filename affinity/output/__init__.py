@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..findings import FileReport, RuleHits
-from ..rules import RULES, with_unit
+from ..rules import LEVELS, RULES, with_unit
 from ..settings import Settings
 
 FORMATS = ("text", "json", "sarif", "github", "junit")
@@ -28,11 +28,15 @@ class CheckRun:
     ``settings`` are the resolved settings for the working directory (files
     governed by another configuration file have their own); ``baselined`` maps a
     path to the number of its findings a baseline hid (None: no baseline was used).
+    ``max_findings`` caps the findings the structured formats keep per file and
+    rule (the worst; ``--max-findings``); ``statistics`` asks for per-rule counts.
     """
 
     reports: list[FileReport]
     settings: Settings
     baselined: dict[str, int] | None = None
+    max_findings: int | None = None
+    statistics: bool = False
 
     def tally(self) -> dict[str, int]:
         """Counts for a summary: ``files``, ``checked``, ``unreadable``, ``skipped``, ``findings``, ``baselined``."""
@@ -46,6 +50,10 @@ class CheckRun:
             "findings": sum(r.n_findings for r in self.reports),
             "baselined": sum((self.baselined or {}).values()),
         }
+
+    def kept(self, report: FileReport) -> list[Finding]:
+        """The findings of ``report`` a structured format writes: all, or the worst ``max_findings`` per rule."""
+        return file_findings(report, self.max_findings, worst=True)[0]
 
 
 @dataclass(frozen=True)
@@ -65,6 +73,8 @@ class Finding:
     face: int
     value: float
     threshold: float | None
+    unit: str
+    level: str
     group: str
     message: str
     prim: str | None = None
@@ -86,6 +96,8 @@ def _rows(report: FileReport, hits: RuleHits, take: np.ndarray) -> list[tuple[in
     # Rules without a threshold (Q204, Q205, Q302) measure something else; no limit to report.
     threshold = None if rule.default_threshold is None else hits.threshold
     faces, groups, lines = hits.faces[take], hits.groups[take], hits.lines[take]
+    unit, level = hits.unit if hits.unit is not None else rule.unit, hits.level or rule.level
+    details = [None] * len(faces) if hits.details is None else [hits.details[k] for k in np.arange(len(hits))[take]]
     usd = report.prim_face_start is not None
     if usd:  # no lines; faces count within their prim (the file-level face -1 stays -1)
         faces, lines = faces - report.prim_face_start[groups], np.zeros_like(lines)
@@ -99,25 +111,35 @@ def _rows(report: FileReport, hits: RuleHits, take: np.ndarray) -> list[tuple[in
             face=int(face),
             value=float(value),
             threshold=threshold,
+            unit=unit,
+            level=level,
             group=group_name(report, g),
-            message=rule.summary,
+            message=rule.summary if detail is None else f"{rule.summary}: {detail}",
             prim=group_name(report, g) if usd and order >= 0 else None,
         ))
-        for order, face, line, value, g in zip(
+        for order, face, line, value, g, detail in zip(
             hits.faces[take].tolist(), faces.tolist(), lines.tolist(),
-            hits.values[take].tolist(), groups.tolist(),
+            hits.values[take].tolist(), groups.tolist(), details,
         )
     ]
 
 
-def file_findings(report: FileReport, limit: int | None = None) -> tuple[list[Finding], dict[str, int]]:
+def _worst_first(hits: RuleHits) -> np.ndarray:
+    """(n,) int64 order of ``hits`` from the worst value (the rule's ``worst`` end) to the mildest, ties in file order."""
+    key = hits.values if RULES[hits.code].worst == "lowest" else -hits.values
+    return np.lexsort((hits.faces, key))
+
+
+def file_findings(report: FileReport, limit: int | None = None, worst: bool = False) -> tuple[list[Finding], dict[str, int]]:
     """The findings of one file in source order, and how many each rule left out.
 
     Parameters
     ----------
     limit : int or None
-        Keep at most this many findings per rule (the first in file order);
-        None keeps all.
+        Keep at most this many findings per rule; None keeps all.
+    worst : bool
+        Which ones ``limit`` keeps: the first in file order (text output), or
+        the worst values (``--max-findings``).
 
     Returns
     -------
@@ -127,13 +149,51 @@ def file_findings(report: FileReport, limit: int | None = None) -> tuple[list[Fi
     rows: list[tuple[int, Finding]] = []
     omitted: dict[str, int] = {}
     for hits in report.hits:
-        order = np.argsort(hits.faces, kind="stable")
-        if limit is not None and len(order) > limit:
-            omitted[hits.code] = len(order) - limit
-            order = order[:limit]
+        if limit is not None and len(hits) > limit:
+            omitted[hits.code] = len(hits) - limit
+            order = np.sort(_worst_first(hits)[:limit]) if worst else np.argsort(hits.faces, kind="stable")[:limit]
+        else:
+            order = np.argsort(hits.faces, kind="stable")
         rows.extend(_rows(report, hits, order))
     rows.sort(key=lambda row: (row[1].line, row[0], row[1].code))
     return [f for _, f in rows], omitted
+
+
+def worst_findings(report: FileReport, hits: RuleHits, n: int) -> list[Finding]:
+    """The ``n`` worst findings of one rule in one file, worst first."""
+    return [f for _, f in _rows(report, hits, _worst_first(hits)[:n])]
+
+
+def first_findings(report: FileReport, hits: RuleHits, n: int) -> list[Finding]:
+    """The first ``n`` findings of one rule in one file, in file order."""
+    return [f for _, f in _rows(report, hits, np.argsort(hits.faces, kind="stable")[:n])]
+
+
+def truncation(run: CheckRun, max_findings: int | None) -> list[dict]:
+    """What ``--max-findings`` left out: ``{"path", "code", "kept", "total"}`` per file and rule cut."""
+    if max_findings is None:
+        return []
+    return [{"path": r.path, "code": h.code, "kept": max_findings, "total": len(h)}
+            for r in run.reports for h in r.hits if len(h) > max_findings]
+
+
+def level_counts(reports: list[FileReport]) -> dict[str, int]:
+    """Findings per level (``error``, ``warning``, ``info``) over all reports, levels without findings left out."""
+    counts = dict.fromkeys(LEVELS, 0)
+    for report in reports:
+        for hits in report.hits:
+            counts[hits.level or RULES[hits.code].level] += len(hits)
+    return {level: n for level, n in counts.items() if n}
+
+
+def statistics(reports: list[FileReport]) -> list[dict]:
+    """Per rule with findings: ``{"code", "name", "level", "count"}`` (the level of its first file's findings)."""
+    levels: dict[str, str] = {}
+    for report in reports:
+        for hits in report.hits:
+            levels.setdefault(hits.code, hits.level or RULES[hits.code].level)
+    return [{"code": code, "name": RULES[code].name, "level": levels[code], "count": n}
+            for code, n in rule_counts(reports).items()]
 
 
 def rule_counts(reports: list[FileReport]) -> dict[str, int]:
@@ -151,11 +211,14 @@ def format_value(value: float) -> str:
 
 
 def describe(f: Finding) -> str:
-    """The message with the measurement: ``... (3.2 vs 0.5 texels)``."""
-    measured = format_value(f.value)
-    if f.threshold is not None:
-        measured += " vs " + with_unit(format_value(f.threshold), RULES[f.code].unit)
-    return f"{f.message} ({measured})"
+    """The message with the measurement and its unit: ``... (3.2 vs 0.5 texels)``, ``... (0.5 folded fraction)``.
+
+    A finding without a unit (Q902: a missing file measures nothing) is its message alone.
+    """
+    if not f.unit:
+        return f.message
+    measured = format_value(f.value) if f.threshold is None else f"{format_value(f.value)} vs {format_value(f.threshold)}"
+    return f"{f.message} ({with_unit(measured, f.unit)})"
 
 
 def face_label(f: Finding) -> str:
@@ -171,10 +234,12 @@ def located(f: Finding) -> str:
 
 
 def text_line(f: Finding) -> str:
-    """The ruff-style line ``path:line:col: CODE name: message (value vs threshold)``;
-    ``path:prim:face N: ...`` in USD."""
-    where = f"{f.line}:{f.column}" if f.prim is None else f"{f.prim}:face {f.face}"
-    return f"{f.path}:{where}: {f.code} {f.name}: {describe(f)}"
+    """The ruff-style line ``path:line:col: CODE name: message (value vs threshold unit) [face F]``
+    (design.md); ``path:prim:face N: ...`` in USD, no ``[face]`` for file-level findings."""
+    if f.prim is not None:
+        return f"{f.path}:{f.prim}:face {f.face}: {f.code} {f.name}: {describe(f)}"
+    face = f" [face {f.face}]" if f.face >= 0 else ""
+    return f"{f.path}:{f.line}:{f.column}: {f.code} {f.name}: {describe(f)}{face}"
 
 
 def working_relative(path: str) -> str | None:

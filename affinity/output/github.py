@@ -1,7 +1,11 @@
 """GitHub Actions workflow annotations: ``::warning file=…,line=…,col=…,title=Q101 uv-disaffine::message``.
 
-Findings of rules at level ``error`` (Q204) become ``::error``, unreadable files
-``::error`` with title ``Q901 unreadable``, skipped files ``::notice``. Paths are
+At most one annotation per file and rule (GitHub shows only a handful per step
+anyway): it stands on the worst finding's line and gives the count, the worst
+value and the first few faces with their lines. Its level is the findings'
+(``error`` -> ``::error``, ``warning`` -> ``::warning``, ``info`` -> ``::notice``);
+unreadable files are ``::error`` with title ``Q901 unreadable``, skipped files
+``::notice``. ``--statistics`` adds one ``::notice`` per rule with its count. Paths are
 relative to the working directory (the checkout in a workflow step). Escaping
 follows the Actions runner: in the message ``%``, ``\\r`` and ``\\n``; in property
 values also ``:`` and ``,``.
@@ -11,8 +15,20 @@ from __future__ import annotations
 
 from typing import TextIO
 
-from ..rules import RULES, UNREADABLE
-from . import CheckRun, file_findings, located, working_relative
+from ..rules import UNREADABLE
+from . import (
+    CheckRun,
+    describe,
+    face_label,
+    first_findings,
+    statistics,
+    working_relative,
+    worst_findings,
+)
+
+#: Faces listed in a rule's annotation.
+FIRST_FACES = 5
+_COMMANDS = {"error": "error", "warning": "warning", "info": "notice"}
 
 _DATA_ESCAPES = (("%", "%25"), ("\r", "%0D"), ("\n", "%0A"))
 _PROPERTY_ESCAPES = _DATA_ESCAPES + ((":", "%3A"), (",", "%2C"))
@@ -39,7 +55,28 @@ def write(run: CheckRun, out: TextIO) -> None:
             out.write(annotation("error", report.error, path, report.error_line, title=title) + "\n")
         elif report.skipped is not None:
             out.write(annotation("notice", f"skipped ({report.skipped})", path, title="skipped") + "\n")
-        for f in file_findings(report)[0]:
-            line = annotation(RULES[f.code].level, located(f), path, f.line, f.column,
-                              title=f"{f.code} {f.name}")
-            out.write(line + "\n")
+        for hits in report.hits:
+            out.write(_rule_annotation(report, hits, path) + "\n")
+    if run.statistics:
+        for row in statistics(run.reports):
+            out.write(annotation("notice", f"{row['count']} findings of {row['code']} {row['name']} ({row['level']})",
+                                 ".", title="statistics") + "\n")
+
+
+def _rule_annotation(report, hits, path: str) -> str:
+    """The one annotation of a rule in a file."""
+    worst = worst_findings(report, hits, 1)[0]
+    first = first_findings(report, hits, FIRST_FACES)
+
+    def where(f) -> str:
+        return face_label(f) + (f" (line {f.line})" if f.line > 0 else "")
+
+    located = describe(worst) + (f", {where(worst)}" if face_label(worst) else "")
+    if len(hits) == 1:
+        message = located
+    else:
+        listed = ", ".join(where(f) for f in first if face_label(f))
+        more = ", ..." if len(hits) > len(first) else ""
+        message = f"{len(hits)} findings, the worst: {located}" + (f"; first: {listed}{more}" if listed else "")
+    return annotation(_COMMANDS[worst.level], message, path, worst.line, worst.column,
+                      title=f"{worst.code} {worst.name}")

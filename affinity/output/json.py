@@ -9,10 +9,19 @@ Document layout::
                  USD only: "up_axis", "meters_per_unit", "notes"}
                 | {"path", "error", "line"} | {"path", "skipped"}],
       "findings": [{"path", "line", "column", "code", "name", "face", "value",
-                    "threshold", "group", "message", USD only: "prim"}],
+                    "threshold", "unit", "level", "group", "message", USD only: "prim"}],
       "summary": {"files", "checked", "unreadable", "skipped", "findings",
-                  "baselined", "by_rule": {"Q101": n, ...}}
+                  "baselined", "by_rule": {"Q101": n, ...}, "by_level": {"warning": n, ...}},
+      with --max-findings N: "truncated": [{"path", "code", "kept", "total"}],
+      with --statistics: "statistics": [{"code", "name", "level", "count"}]
     }
+
+Written compact (no indentation): machine formats are read by machines.
+``level`` is the finding's level (``[levels]`` in the configuration
+overrides the rule's); ``unit`` the unit of ``value`` and ``threshold``.
+With ``--max-findings N`` each file keeps the worst N findings per rule and
+``truncated`` lists, per file and rule cut, how many were kept of the total;
+``summary`` still counts every finding.
 
 ``face`` is the 0-based index of the face in file order counting every face;
 ``line`` its 1-based source line (0 in binary PLY); ``value`` the measured score
@@ -31,7 +40,7 @@ import json
 from typing import TextIO
 
 from ..findings import FileReport
-from . import CheckRun, Finding, file_findings, rule_counts
+from . import CheckRun, Finding, level_counts, rule_counts, statistics, truncation
 
 SCHEMA = "quad-affinity-check"
 VERSION = 1
@@ -57,17 +66,22 @@ def _finding_entry(f: Finding) -> dict:
 
 def document(run: CheckRun) -> dict:
     """The whole JSON document as Python objects."""
-    findings = [_finding_entry(f) for r in run.reports for f in file_findings(r)[0]]
-    return {
+    findings = [_finding_entry(f) for r in run.reports for f in run.kept(r)]
+    doc = {
         "schema": SCHEMA,
         "version": VERSION,
         "settings": dataclasses.asdict(run.settings),
         "files": [_file_entry(r) for r in run.reports],
         "findings": findings,
-        "summary": {**run.tally(), "by_rule": rule_counts(run.reports)},
+        "summary": {**run.tally(), "by_rule": rule_counts(run.reports), "by_level": level_counts(run.reports)},
     }
+    if run.max_findings is not None:
+        doc["truncated"] = truncation(run, run.max_findings)
+    if run.statistics:
+        doc["statistics"] = statistics(run.reports)
+    return doc
 
 
 def write(run: CheckRun, out: TextIO) -> None:
-    json.dump(document(run), out, indent=1)
+    json.dump(document(run), out, separators=(",", ":"))
     out.write("\n")

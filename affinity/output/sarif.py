@@ -17,6 +17,12 @@ reordered or other parts of the file are edited), plus the ordinal among
 findings that share all four, in file order. It changes when the quad itself
 changes, which makes it a new finding.
 
+Each result's ``level`` is the finding's (SARIF's ``note`` for ``info``).
+With ``--max-findings N`` each file keeps the worst N results per rule, and
+the run's ``properties.truncated`` lists, per file and rule cut, how many were
+kept of the total; ``--statistics`` adds ``properties.statistics`` (per-rule
+counts). The log is written compact.
+
 Unreadable (Q901) and skipped files are not results: they are tool execution
 notifications of the run's invocation, and an unreadable file makes
 ``executionSuccessful`` false.
@@ -33,7 +39,7 @@ from urllib.parse import quote
 from .. import __version__
 from ..findings import FileReport
 from ..rules import RULES, UNREADABLE, rule_page
-from . import CheckRun, Finding, face_label, file_findings, located, value_token, working_relative
+from . import CheckRun, Finding, face_label, located, statistics, truncation, value_token, working_relative
 
 SARIF_VERSION = "2.1.0"
 SARIF_SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
@@ -48,9 +54,14 @@ def _descriptor(rule) -> dict:
         "shortDescription": {"text": rule.summary},
         "fullDescription": {"text": rule.what},
         "help": {"text": rule_page(rule), "markdown": rule_page(rule, markdown=True)},
-        "defaultConfiguration": {"level": rule.level},
+        "defaultConfiguration": {"level": sarif_level(rule.level)},
         "properties": {"unit": rule.unit, "defaultThreshold": rule.default_threshold},
     }
+
+
+def sarif_level(level: str) -> str:
+    """SARIF's word for a level: ``error``, ``warning``, ``note`` (our ``info``)."""
+    return "note" if level == "info" else level
 
 
 def artifact_location(path: str) -> dict:
@@ -74,12 +85,12 @@ def fingerprint(code: str, uri: str, group: str, value: float, ordinal: int) -> 
     return hashlib.sha256(text.encode("utf-8")).hexdigest()[:32]
 
 
-def _results(report: FileReport) -> list[dict]:
+def _results(run: CheckRun, report: FileReport) -> list[dict]:
     location = artifact_location(report.path)
     seen: dict[tuple, int] = {}
     rule_index = {code: i for i, code in enumerate(RULES)}  # registered rules, as the driver lists them
     results = []
-    for f in file_findings(report)[0]:
+    for f in run.kept(report):
         identity = (f.code, f.group, value_token(f.value))
         seen[identity] = ordinal = seen.get(identity, -1) + 1
         result_location: dict = {"physicalLocation": _physical(location, f.line, f.column)}
@@ -89,12 +100,12 @@ def _results(report: FileReport) -> list[dict]:
         results.append({
             "ruleId": f.code,
             "ruleIndex": rule_index[f.code],
-            "level": RULES[f.code].level,
+            "level": sarif_level(f.level),
             "message": {"text": located(f)},
             "locations": [result_location],
             "partialFingerprints": {FINGERPRINT: fingerprint(f.code, location["uri"], f.group, f.value, ordinal)},
             "properties": {"name": f.name, "face": f.face, "value": f.value,
-                           "threshold": f.threshold, "group": f.group,
+                           "threshold": f.threshold, "unit": f.unit, "level": f.level, "group": f.group,
                            **({} if f.prim is None else {"prim": f.prim})},
         })
     return results
@@ -136,6 +147,11 @@ def _folder_uri(folder: Path) -> str:
 
 def document(run: CheckRun) -> dict:
     """The SARIF log as Python objects."""
+    properties: dict = {}
+    if run.max_findings is not None:
+        properties["truncated"] = truncation(run, run.max_findings)
+    if run.statistics:
+        properties["statistics"] = statistics(run.reports)
     return {
         "$schema": SARIF_SCHEMA,
         "version": SARIF_VERSION,
@@ -155,11 +171,12 @@ def document(run: CheckRun) -> dict:
             }],
             "originalUriBaseIds": {SRCROOT: {"uri": _folder_uri(Path.cwd())}},
             "columnKind": "unicodeCodePoints",
-            "results": [result for report in run.reports for result in _results(report)],
+            "results": [result for report in run.reports for result in _results(run, report)],
+            **({"properties": properties} if properties else {}),
         }],
     }
 
 
 def write(run: CheckRun, out: TextIO) -> None:
-    json.dump(document(run), out, indent=1)
+    json.dump(document(run), out, separators=(",", ":"))
     out.write("\n")

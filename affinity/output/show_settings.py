@@ -8,6 +8,7 @@ reads, so a block can be saved as an ``affinity.toml`` as it is.
 from __future__ import annotations
 
 import json
+import math
 from typing import TextIO
 
 from ..config import Resolver
@@ -16,7 +17,22 @@ from ..settings import Settings
 
 
 def _toml(value) -> str:
-    return json.dumps(value)  # JSON strings, numbers and lists of them are TOML too
+    """A TOML value: a basic string (control characters escaped, astral characters as
+    they are: JSON's surrogate pairs are not TOML), a number, or a list of them."""
+    if isinstance(value, str):
+        return json.dumps(value, ensure_ascii=False).replace("\x7f", "\\u007f")
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return repr(value) if math.isfinite(value) else ("inf" if value > 0 else "-inf" if value < 0 else "nan")
+    if isinstance(value, int):
+        return str(value)
+    return "[" + ", ".join(map(_toml, value)) + "]"
+
+
+def _comment(text: str) -> str:
+    """``text`` on one comment line (a path may hold a newline)."""
+    return "# " + text.replace("\r", " ").replace("\n", " ")
 
 
 def settings_toml(settings: Settings) -> list[str]:
@@ -28,11 +44,14 @@ def settings_toml(settings: Settings) -> list[str]:
         f"diagonal = {_toml(settings.diagonal)}",
         f"texture-size = {settings.texture_size}",
         f"exclude = {_toml(settings.exclude)}",
+        f"extend-exclude = {_toml(settings.extend_exclude)}",
         "",
         "[thresholds]",
     ]
-    lines += [f"{code} = {_toml(settings.threshold(code))}"
+    lines += [f"{code} = {_toml(float(settings.threshold(code)))}"
               for code, rule in RULES.items() if rule.default_threshold is not None]
+    lines += ["", "[levels]"]
+    lines += [f"{code} = {_toml(settings.level(code))}" for code in RULES]
     lines += ["", "[per-file-ignores]"]
     lines += [f"{_toml(glob)} = {_toml(codes)}" for glob, codes in settings.per_file_ignores.items()]
     return lines
@@ -48,9 +67,9 @@ def write_settings(resolver: Resolver, paths: list[str], out: TextIO) -> None:
         settings = resolved.settings
         source = resolved.source or "no configuration file (defaults and command-line flags)"
         head = [
-            f"# settings for {', '.join(names)}",
-            f"# from {source}",
-            f"# globs relative to {settings.root or '(none)'}",
-            f"# rules enabled: {', '.join(resolve_codes(settings.select, settings.ignore))}",
+            _comment(f"settings for {', '.join(names)}"),
+            _comment(f"from {source}"),
+            _comment(f"globs relative to {settings.root or '(none)'}"),
+            _comment(f"rules enabled: {', '.join(resolve_codes(settings.select, settings.ignore))}"),
         ]
         out.write(("\n" if i else "") + "\n".join(head + settings_toml(settings)) + "\n")

@@ -1,11 +1,14 @@
-"""Text output: ``path:line:col: CODE name: message (value vs threshold)``, one finding a line."""
+"""Text output: ``path:line:col: CODE name: message (value vs threshold unit) [face F]``, one finding a line.
+
+The closing summary counts the findings per level; ``--statistics`` prints
+count, code, name and level per rule instead of the findings.
+"""
 
 from __future__ import annotations
 
 from typing import TextIO
 
-from ..rules import RULES
-from . import CheckRun, file_findings, rule_counts, text_line
+from . import CheckRun, file_findings, level_counts, statistics, text_line
 
 #: Findings shown per file and rule before "... and N more" (design.md, Clarifications).
 TEXT_LIMIT = 20
@@ -32,9 +35,9 @@ def write_findings(run: CheckRun, out: TextIO, verbose: bool = False) -> None:
 
 
 def write_statistics(run: CheckRun, out: TextIO) -> None:
-    """One line per rule with findings: count, code, name (like ``ruff --statistics``)."""
-    for code, n in rule_counts(run.reports).items():
-        out.write(f"{n:>8}  {code}  {RULES[code].name}\n")
+    """One line per rule with findings: count, code, name, level (like ``ruff --statistics``)."""
+    for row in statistics(run.reports):
+        out.write(f"{row['count']:>8}  {row['code']}  {row['name']}  [{row['level']}]\n")
 
 
 def write_summary(run: CheckRun, out: TextIO) -> None:
@@ -44,4 +47,6 @@ def write_summary(run: CheckRun, out: TextIO) -> None:
     parts += [f"{n[key]} {key}" for key in ("unreadable", "skipped", "baselined") if n[key]]
     new = "" if run.baselined is None else "new "
     head = f"Found {n['findings']} {new}finding{'s' * (n['findings'] != 1)}" if n["findings"] else f"No {new}findings"
+    levels = ", ".join(f"{k} {level}" for level, k in level_counts(run.reports).items())
+    head += f": {levels}" if levels else ""
     out.write(f"{head} ({', '.join(parts)}).\n")

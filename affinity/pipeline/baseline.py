@@ -139,7 +139,7 @@ def apply(reports: list[FileReport], baseline: Baseline) -> tuple[list[FileRepor
             keep[id(hits)][new] = True
             hidden += len(rows) - len(new)
         hits = [
-            RuleHits(h.code, h.faces[m], h.lines[m], h.values[m], h.threshold, h.groups[m])
+            h.subset(m)
             for h in report.hits
             if (m := keep[id(h)]).any()
         ]

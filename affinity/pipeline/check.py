@@ -13,7 +13,7 @@ from collections.abc import Callable, Iterable, Iterator
 from functools import partial
 
 from ..errors import MeshError, SkippedFile
-from ..findings import FileReport
+from ..findings import FileReport, settle
 from ..mesh import Mesh
 from ..settings import Settings
 
@@ -36,7 +36,7 @@ def load_and_check(path: str, settings: Settings, usd=None) -> tuple[FileReport,
         report = FileReport(
             path,
             counts=mesh.counts(),
-            hits=lint_mesh(mesh, settings),
+            hits=settle(lint_mesh(mesh, settings), settings, list(mesh.group_names), _inline_ignores(path, mesh)),
             group_names=list(mesh.group_names),
             prim_face_start=mesh.prim_face_start,
             up_axis=mesh.up_axis,
@@ -51,6 +51,15 @@ def load_and_check(path: str, settings: Settings, usd=None) -> tuple[FileReport,
         reason = " ".join(f"internal error: {type(err).__name__}: {err}".split())
         return FileReport(path, error=reason[:300], error_line=0), None
     return report, mesh
+
+
+def _inline_ignores(path: str, mesh: Mesh) -> list:
+    """The ``# affinity: ignore[...]`` comments of an OBJ file (see :mod:`affinity.loaders.suppress`)."""
+    if not str(path).lower().endswith(".obj"):
+        return []
+    from ..loaders.suppress import inline_ignores
+
+    return inline_ignores(path, mesh.face_line)
 
 
 #: Mesh bytes that pay for one more worker process: starting one costs about as

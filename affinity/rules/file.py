@@ -1,10 +1,13 @@
-"""Rules about the whole file: Q205 no-faces, and Q901 unreadable (reported, never linted)."""
+"""Rules about the whole file: Q205 no-faces, Q902 missing-resource, and Q901 unreadable (reported, never linted)."""
 
 from __future__ import annotations
 
+import os
+import re
+
 import numpy as np
 
-from .registry import Rule, page_fields, rule
+from .registry import RULES, Rule, page_fields, rule
 
 FORMATS = (
     "The file formats read: Wavefront OBJ (Appendix B1 of the Advanced Visualizer manual, v/vt/vn/f), "
@@ -12,7 +15,7 @@ FORMATS = (
 )
 
 
-@rule(code="Q205", name="no-faces", scope="mesh", references=FORMATS)
+@rule(code="Q205", name="no-faces", unit="vertices", scope="mesh", references=FORMATS)
 def no_faces(mesh, settings) -> tuple | None:
     """The mesh has vertices but no faces.
 
@@ -31,7 +34,7 @@ def no_faces(mesh, settings) -> tuple | None:
         v 0 1 0
 
     Prints:
-        example.obj:1:1: Q205 no-faces: the mesh has vertices but no faces (4)
+        example.obj:1:1: Q205 no-faces: the mesh has vertices but no faces (4 vertices)
 
     How to fix:
         Re-export the mesh with faces enabled in the exporter's geometry options.
@@ -39,6 +42,104 @@ def no_faces(mesh, settings) -> tuple | None:
     if mesh.n_faces or not len(mesh.positions):
         return None
     return np.array([-1]), np.array([1]), np.array([float(len(mesh.positions))])
+
+
+_MTLLIB = re.compile(rb"^[ \t]*mtllib[ \t]+([^\r\n#]*)", re.MULTILINE)
+
+
+def _unusable(path: str, image: bool) -> str | None:
+    """Why the resource at ``path`` cannot be used (``"not found"``, ...), or None when it can."""
+    from ..loaders import LFS_POINTER
+    from ..loaders.imagesize import image_size
+
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(len(LFS_POINTER))
+    except FileNotFoundError:
+        return "not found"
+    except OSError as err:
+        return f"cannot be read ({err.strerror or err})"
+    if head == LFS_POINTER:
+        return "is a Git LFS pointer (run git lfs pull)"
+    if image and image_size(path) is None:
+        return "is not a PNG, JPEG, BMP or TGA image"
+    return None
+
+
+@rule(code="Q902", name="missing-resource", level="info", scope="mesh",
+      references="Wavefront OBJ and MTL (Advanced Visualizer manual, Appendix B1 and B2: mtllib, map_Kd).")
+def missing_resources(mesh, settings) -> tuple | None:
+    """An mtllib or map_Kd named by the file cannot be found or read.
+
+    What it does:
+        Reports, once per file and resource, an mtllib library or a map_Kd texture
+        that is missing, unreadable, not an image, or a Git LFS pointer. Q101's
+        texel unit then comes from the texture-size setting, and the finding says so.
+
+    Why it matters:
+        Without the texture the same quad reads a different number of texels (256
+        with texture-size 1024, 1024 with a 4096 texture): the finding keeps the
+        unit from changing behind the user's back. A checkout without textures is
+        common in CI, so it is info and does not fail the gate by itself.
+
+    Example:
+        # a material library that is not there
+        mtllib missing.mtl
+        v 0 0 0
+        v 1 0 0
+        v 1 1 0
+        f 1 2 3
+
+    Prints:
+        example.obj:2:1: Q902 missing-resource: an mtllib or map_Kd named by the file cannot be found or read: mtllib missing.mtl not found
+
+    How to fix:
+        Add the file next to the mesh (git lfs pull for LFS pointers), or fix the
+        name in the mtllib or map_Kd line.
+    """
+    # One scan of the file's bytes for mtllib lines (the reader resolves them but keeps
+    # no lines). A finding sits on its mtllib line (face -1); its detail names the
+    # resource and, where the texel unit would have come from that texture, the
+    # texture-size used instead. Returns (faces, lines, values, details) or None.
+    from ..loaders.mtl import read_material_textures
+
+    if not mesh.path.lower().endswith(".obj"):
+        return None
+    try:
+        with open(mesh.path, "rb") as fh:
+            data = fh.read()
+    except OSError:
+        return None
+    if data.find(b"mtllib") < 0:
+        return None
+    folder = os.path.dirname(mesh.path)
+    texels = mesh.texcoords is not None and "Q101" in RULES
+    used = mesh.texture_path()
+    fallback = f"; texels use texture-size {settings.texture_size}"
+    lines, details, seen = [], [], set()
+    for match in _MTLLIB.finditer(data):
+        name = match.group(1).decode("utf-8", "replace").strip()
+        library = os.path.normpath(os.path.join(folder, name))
+        if not name or library in seen:
+            continue
+        seen.add(library)
+        line = data.count(b"\n", 0, match.start()) + 1
+        problem = _unusable(library, image=False)
+        if problem:
+            lines.append(line)
+            details.append(f"mtllib {name} {problem}" + (fallback if texels and used is None else ""))
+            continue
+        for texture in dict.fromkeys(read_material_textures(library).values()):
+            problem = None if texture in seen else _unusable(texture, image=True)
+            seen.add(texture)
+            if problem:
+                shown = os.path.relpath(texture, folder) if folder else texture
+                lines.append(line)
+                details.append(f"map_Kd {shown} (in {name}) {problem}" + (fallback if texels and texture == used else ""))
+    if not lines:
+        return None
+    n = len(lines)
+    return np.full(n, -1), np.array(lines, dtype=np.int64), np.zeros(n), details
 
 
 UNREADABLE_PAGE = """File cannot be parsed.

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..geometry import degeneracy, folded_fraction, interior_angles, is_bowtie
+from ..geometry import degeneracy, folded_fraction, interior_angles, is_bowtie, squared_lengths
 from .registry import rule
 
 REFERENCES = ("Bloomenthal 2022, §3.4 (nonplanar and degenerate quads); "
@@ -33,7 +33,7 @@ def degenerate(quads) -> tuple:
         f 1 2 3 3
 
     Prints:
-        example.obj:5:1: Q201 degenerate-quad: zero area, collapsed edge or repeated corner (0 vs 1e-09 relative area)
+        example.obj:5:1: Q201 degenerate-quad: zero area, collapsed edge or repeated corner (0 vs 1e-09 relative area) [face 0]
 
     How to fix:
         Merge the collapsed corners (Blender: Mesh > Clean Up > Merge by Distance)
@@ -42,38 +42,83 @@ def degenerate(quads) -> tuple:
     return slice(None), degeneracy(quads.planar)
 
 
-@rule(code="Q202", name="nonplanar-quad", unit="relative warp", default_threshold=0.01, references=REFERENCES)
+def _fold(p: np.ndarray, normal: np.ndarray, a: int, b: int, c: int, d: int) -> np.ndarray:
+    """(Q,) float64 degrees between the normals of triangles (a, b, c) and (a, c, d):
+    the fold along the diagonal a-c of corners ``p`` (3, 4, Q).
+
+    Each triangle's normal is taken on the side of the quad's ``normal`` (3, Q)
+    (d02 x d13), so a flat concave or self-crossing quad, whose wrong split
+    overlaps itself, folds nothing (that is Q203's and Q204's). A triangle without
+    area has no normal and folds nothing either: that quad is Q201's.
+    """
+    e1, e2, e3 = p[:, b] - p[:, a], p[:, c] - p[:, a], p[:, d] - p[:, a]
+    n1, n2 = np.cross(e1, e2, axis=0), np.cross(e2, e3, axis=0)
+    n1 *= np.sign((n1 * normal).sum(axis=0))
+    n2 *= np.sign((n2 * normal).sum(axis=0))
+    sine = np.sqrt(squared_lengths(np.cross(n1, n2, axis=0)))
+    cosine = (n1 * n2).sum(axis=0)
+    return np.degrees(np.arctan2(sine, cosine))
+
+
+def fold_degrees(p: np.ndarray, diagonal: str, diagonals: np.ndarray | None = None) -> np.ndarray:
+    """(Q,) float64 fold angle in degrees of quads with corners ``p`` (3, 4, Q) float64.
+
+    The angle between the normals of the two triangles of the split along 0-2
+    (triangles 012 and 023) or 1-3 (123 and 130), as the dihedral angle of the
+    split surface: 0 for a planar quad (see :func:`_fold`), atan2(|n1 x n2|, n1 . n2).
+    ``diagonal`` is the setting: ``"02"``, ``"13"``, ``"both"`` (the worse of the
+    two) or ``"shortest"`` (the diagonal shorter in 3-D; ``diagonals`` (Q, 2)
+    holds the lengths of 0-2 and 1-3).
+    """
+    normal = np.cross(p[:, 2] - p[:, 0], p[:, 3] - p[:, 1], axis=0)
+    if diagonal == "02":
+        return _fold(p, normal, 0, 1, 2, 3)
+    if diagonal == "13":
+        return _fold(p, normal, 1, 2, 3, 0)
+    fold02, fold13 = _fold(p, normal, 0, 1, 2, 3), _fold(p, normal, 1, 2, 3, 0)
+    if diagonal == "shortest":
+        return np.where(diagonals[:, 0] <= diagonals[:, 1], fold02, fold13)
+    return np.maximum(fold02, fold13)
+
+
+@rule(code="Q202", name="nonplanar-quad", unit="degrees", default_threshold=45.0, references=REFERENCES)
 def nonplanar(quads) -> tuple:
-    """Corners do not lie in one plane (warp above tolerance).
+    """The split folds: the two triangles meet at an angle along the diagonal.
 
     What it does:
-        Measures the distance between the two diagonals relative to their mean
-        length and flags quads above the threshold; the affinity test runs on the
+        Measures the fold angle between the two triangles of the split along the
+        diagonal (the diagonal setting; with diagonal = both, the worse of the two
+        splits), in degrees, and flags quads above the threshold. 45 degrees is
+        where Blender's 3D-Print Toolbox calls a face distorted. A triangle without
+        area folds nothing here: that quad is Q201's. The affinity test runs on the
         projection onto the quad's plane.
 
     Why it matters:
-        A warped quad has no single flat shape: each diagonal split gives a
-        different surface and lighting, and no interpolation is exact.
+        A folded quad has no single flat shape: each diagonal split gives a
+        different surface and lighting, and no interpolation is exact. Slight folds
+        are the nature of base meshes built for subdivision; a sharp one shows as a
+        crease wherever the engine picks the other diagonal.
 
     Example:
-        # the unit square with one corner lifted by 0.2
+        # the unit square with one corner lifted by 1
         v 0 0 0
         v 1 0 0
-        v 1 1 0.2
+        v 1 1 1
         v 0 1 0
         f 1 2 3 4
 
     Prints:
-        example.obj:6:1: Q202 nonplanar-quad: corners do not lie in one plane (warp above tolerance) (0.06967 vs 0.01 relative warp)
+        example.obj:6:1: Q202 nonplanar-quad: the split folds: the two triangles meet at an angle along the diagonal (60 vs 45 degrees) [face 0]
 
     How to fix:
-        Flatten the quad (Blender: Mesh > Clean Up > Make Planar Faces) or
-        triangulate it along the intended diagonal.
+        Flatten the quad (Blender: Mesh > Clean Up > Make Planar Faces), subdivide
+        it, or triangulate it along the intended diagonal.
     """
-    return slice(None), quads.planar.warp
+    planar = quads.planar
+    return slice(None), fold_degrees(planar.components, quads.settings.diagonal, planar.diagonals)
 
 
-@rule(code="Q203", name="concave-quad", unit="degrees", default_threshold=180.0, references=REFERENCES)
+@rule(code="Q203", name="concave-quad", level="info", unit="degrees", default_threshold=180.0, references=REFERENCES)
 def concave(quads) -> tuple:
     """One corner is reflex.
 
@@ -83,7 +128,9 @@ def concave(quads) -> tuple:
 
     Why it matters:
         Splitting along the wrong diagonal folds a triangle outside the quad;
-        bilinear inversion is ambiguous.
+        bilinear inversion is ambiguous. Concave quads are often modelled on
+        purpose (darts along a silhouette) and every engine splits them through the
+        reflex corner, so the rule is info by default.
 
     Example:
         # a dart: the corner at (0.5, 0.5) points inward
@@ -94,7 +141,7 @@ def concave(quads) -> tuple:
         f 1 2 3 4
 
     Prints:
-        example.obj:6:1: Q203 concave-quad: one corner is reflex (233.1 vs 180 degrees)
+        example.obj:6:1: Q203 concave-quad: one corner is reflex (233.1 vs 180 degrees) [face 0]
 
     How to fix:
         Move the reflex corner outward, or split the quad into two triangles along
@@ -112,7 +159,7 @@ def concave(quads) -> tuple:
     return rows, interior_angles(planar.take(rows)).max(axis=1)
 
 
-@rule(code="Q204", name="bowtie-quad", level="error", references=REFERENCES)
+@rule(code="Q204", name="bowtie-quad", level="error", unit="folded fraction", references=REFERENCES)
 def bowtie(quads) -> tuple:
     """The quad crosses itself.
 
@@ -133,7 +180,7 @@ def bowtie(quads) -> tuple:
         f 1 2 3 4
 
     Prints:
-        example.obj:6:1: Q204 bowtie-quad: the quad crosses itself (0.5)
+        example.obj:6:1: Q204 bowtie-quad: the quad crosses itself (0.5 folded fraction) [face 0]
 
     How to fix:
         Reorder the corners (flip the crossing edge) or delete and refill the face

@@ -31,7 +31,7 @@ def uv_degenerate(quads) -> tuple:
         f 1/1 2/2 3/2 4/1
 
     Prints:
-        example.obj:8:1: Q301 uv-degenerate: zero area in texture space (0 vs 1e-09 relative area)
+        example.obj:8:1: Q301 uv-degenerate: zero area in texture space (0 vs 1e-09 relative area) [face 0]
 
     References:
         Bloomenthal 2022, §2 (the barycentric test divides by the uv triangles' areas).
@@ -42,7 +42,7 @@ def uv_degenerate(quads) -> tuple:
     return quads.uv[0], np.abs(relative_signed_area(quads.uv_planar))
 
 
-@rule(code="Q302", name="uv-flipped", worst="lowest", attribute="texcoords")
+@rule(code="Q302", name="uv-flipped", level="info", unit="relative area", worst="lowest", attribute="texcoords")
 def uv_flipped(quads) -> tuple:
     """Texture orientation reversed against the surface.
 
@@ -54,6 +54,9 @@ def uv_flipped(quads) -> tuple:
 
     Why it matters:
         Mirrored UVs flip the tangent frame: normal maps light the wrong way.
+        Mirroring is also a common way to save texture space and is invisible
+        without a normal map, so the rule is info by default (set its level to
+        warning in [levels] when the asset bakes normal maps).
 
     Example:
         # a UV island mirrored to save texture space
@@ -68,7 +71,7 @@ def uv_flipped(quads) -> tuple:
         f 1/1 2/2 3/3 4/4
 
     Prints:
-        example.obj:10:1: Q302 uv-flipped: texture orientation reversed against the surface (-1)
+        example.obj:10:1: Q302 uv-flipped: texture orientation reversed against the surface (-1 relative area) [face 0]
 
     References:
         Mikkelsen 2008, Simulation of wrinkled surfaces revisited (tangent frames at mirrored UVs).
