@@ -36,8 +36,8 @@ from .imagesize import image_size
 from .measures import (
     barycentric_score,
     color_steps,
-    misplacement_by_component,
     normal_degrees,
+    split_error_by_component,
     split_scale,
     texels,
 )
@@ -131,15 +131,18 @@ class _QuadBatch:
             return np.zeros(0, dtype=np.int64), np.zeros((width, 4, 0))
         return found
 
-    def misplacement(self, rows, attrs: np.ndarray) -> np.ndarray:
-        """(K, n) ``misplacement`` of attributes (K, 4, n) of the quads ``rows``."""
+    def split_error(self, rows, attrs: np.ndarray) -> np.ndarray:
+        """(K, n) ``split_error`` of attributes (K, 4, n) of the quads ``rows``, in the
+        settings' reading (``error`` or ``centre``; ``barycentric`` is uv only, so the
+        other attributes read ``error`` under it)."""
+        measure = self.settings.split_measure
         if isinstance(rows, slice):  # every quad: the split's scale is shared
-            return misplacement_by_component(self.planar, attrs, scale=self.split_scale)
-        return misplacement_by_component(self.planar.take(rows), attrs, self.settings.diagonal)
+            return split_error_by_component(self.planar, attrs, measure=measure, scale=self.split_scale)
+        return split_error_by_component(self.planar.take(rows), attrs, self.settings.diagonal, measure)
 
     @cached_property
     def split_scale(self) -> np.ndarray:
-        return split_scale(self.planar, self.settings.diagonal)
+        return split_scale(self.planar, self.settings.diagonal, self.settings.split_measure)
 
     @cached_property
     def uv(self) -> tuple[np.ndarray | slice, np.ndarray]:
@@ -178,17 +181,17 @@ def _uv_disaffinity(quads: _QuadBatch) -> tuple:
     diagonal = quads.settings.diagonal
     if quads.settings.measure == "barycentric":
         return rows, barycentric_score(quads.planar.take(rows), quads.uv_planar, diagonal)
-    return rows, texels(quads.misplacement(rows, uv).T, quads.texture_size)
+    return rows, texels(quads.split_error(rows, uv).T, quads.texture_size)
 
 
 def _color_disaffinity(quads: _QuadBatch) -> tuple:
     rows, colors = quads.complete("colors")
-    return rows, color_steps(quads.misplacement(rows, colors).T)
+    return rows, color_steps(quads.split_error(rows, colors).T)
 
 
 def _normal_disaffinity(quads: _QuadBatch) -> tuple:
     rows, unit = quads.complete("normals")  # unit length already (see _Tables.gather)
-    m = quads.misplacement(rows, unit)
+    m = quads.split_error(rows, unit)
     # The angle atan2(|m|, |mean normal|) exceeds the threshold only where
     # |m| > tan(threshold) |mean normal|: the arctangent is taken for those only.
     threshold = quads.settings.threshold("Q103")
@@ -308,27 +311,27 @@ def lint_mesh(mesh: Mesh, settings: Settings) -> list[RuleHits]:
     return hits
 
 
-def quad_uv_misplacement(mesh: Mesh, diagonal: str = "02") -> tuple[np.ndarray, np.ndarray]:
-    """Per-quad misplacement of the texture coordinates in uv units, for routing.
+def quad_uv_error(mesh: Mesh, diagonal: str = "02") -> tuple[np.ndarray, np.ndarray]:
+    """Per-quad split error (the ``error`` reading) of the texture coordinates in uv units.
 
-    The hybrid renderer sends a quad to mean value coordinates when this times the
-    quad's on-screen scale exceeds its pixel tolerance (design.md). The renderer's
-    split is along 0-2, hence the default diagonal.
+    The hybrid routes a quad whose uv quad is degenerate (Q301) by this times the
+    quad's screen scale (``affinity.routing``). The renderer's split is along 0-2,
+    hence the default diagonal.
 
     Returns
     -------
     faces : (Q,) int64
         Every quad of the mesh, as a face index in file order.
-    m : (Q,) float64
-        |m| in uv units; NaN for quads without texture coordinates at all corners.
+    error : (Q,) float64
+        |E| in uv units; NaN for quads without texture coordinates at all corners.
     """
 
     def measure(batch: _QuadBatch) -> np.ndarray:
-        m = np.full(len(batch), np.nan)
+        error = np.full(len(batch), np.nan)
         rows, uv = batch.uv
-        uv_m = misplacement_by_component(batch.planar.take(rows), uv, diagonal)
-        m[rows] = np.sqrt(uv_m[0] * uv_m[0] + uv_m[1] * uv_m[1])
-        return m
+        E = split_error_by_component(batch.planar.take(rows), uv, diagonal)
+        error[rows] = np.sqrt(E[0] * E[0] + E[1] * E[1])
+        return error
 
     faces = np.flatnonzero(mesh.face_sizes == 4)
     return faces, np.concatenate(_map_quad_batches(mesh, Settings(), measure, ("texcoords",)) or [np.zeros(0)])

@@ -22,8 +22,21 @@ from .rules import RULES
 #: The paper's own tolerance for the dimensionless barycentric reading.
 BARYCENTRIC_TOLERANCE = 0.01
 
-MEASURES = ("misplacement", "barycentric")
+MEASURES = ("error", "centre", "barycentric")
+#: Old measure names still accepted, with one warning line: name -> the measure it now means.
+DEPRECATED_MEASURES = {"misplacement": "error"}
 DIAGONALS = ("both", "02", "13", "shortest")
+
+
+def measure_name(name: str, where: str) -> str | None:
+    """The measure ``name`` means (None for an unknown name); a deprecated name gets one
+    warning line on stderr, prefixed by ``where`` (the flag or the configuration key)."""
+    if name in DEPRECATED_MEASURES:
+        import sys
+
+        sys.stderr.write(f"{where}: warning: {name!r} is deprecated, use {DEPRECATED_MEASURES[name]!r}\n")
+        return DEPRECATED_MEASURES[name]
+    return name if name in MEASURES else None
 
 
 @dataclass
@@ -32,8 +45,10 @@ class Settings:
 
     ``thresholds`` maps rule codes to thresholds in the rule's unit; rules not in
     it use their default. ``measure`` picks the reading used for Q101-Q103:
-    ``"misplacement"`` (attribute units) or ``"barycentric"`` (the paper's
-    dimensionless score; defined for uv only, so Q102/Q103 keep misplacement).
+    ``"error"`` (the split's largest error over the quad, attribute units),
+    ``"centre"`` (the split's shift at the corner mean) or ``"barycentric"``
+    (the paper's dimensionless score; defined for uv only, so Q102/Q103 read
+    ``error`` under it).
     ``diagonal`` picks which split the affinity test measures: ``"both"``,
     ``"02"``, ``"13"`` or ``"shortest"``. ``exclude`` lists globs of files not
     to check; ``per_file_ignores`` maps a glob to rule codes (or prefixes)
@@ -43,12 +58,23 @@ class Settings:
     select: list[str] | None = None
     ignore: list[str] | None = None
     thresholds: dict[str, float] = field(default_factory=dict)
-    measure: str = "misplacement"
+    measure: str = "error"
     diagonal: str = "both"
     texture_size: int = 1024
     exclude: list[str] = field(default_factory=list)
     per_file_ignores: dict[str, list[str]] = field(default_factory=dict)
     root: str | None = None
+
+    @property
+    def split_measure(self) -> str:
+        """The reading of Q102/Q103 (and of Q101 unless barycentric): ``error`` or ``centre``."""
+        return "centre" if self.measure == "centre" else "error"
+
+    def measure_of(self, code: str) -> str | None:
+        """The reading a finding of ``code`` was measured in (Q101-Q103), else None."""
+        if code == "Q101":
+            return self.measure
+        return self.split_measure if code in ("Q102", "Q103") else None
 
     def threshold(self, code: str) -> float | None:
         if code in self.thresholds:
