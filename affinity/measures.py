@@ -169,7 +169,8 @@ def split_error(quads: PlanarQuads, attrs: np.ndarray, diagonal: str = "both", m
 
     Returns
     -------
-    (Q, K) float64, always finite; its direction is R's.
+    (Q, K) float64 split minus bilinear at the worst point (at the corner mean
+    for ``"centre"``), always finite; its direction is +-R's.
     """
     return split_error_by_component(quads, np.transpose(attrs, (2, 1, 0)), diagonal, measure).T
 
@@ -240,14 +241,17 @@ def _diagonal_scale(quads: PlanarQuads, diagonal: str, measure: str) -> np.ndarr
     else:
         raise ValueError(f"measure must be error or centre; got {measure!r}")
     vanish = np.maximum(np.abs(T_a), np.abs(T_b)) <= quads.tolerance
-    return np.divide(1.0, denominator, out=np.zeros_like(denominator), where=~vanish & (denominator > 0))
+    # Split minus bilinear is +R c along 0-2 (corners 1, 3 have residuals -R / T_i) and
+    # -R c along 1-3 (corners 0, 2 have +R / T_i).
+    sign = 1.0 if diagonal == "02" else -1.0
+    return np.divide(sign, denominator, out=np.zeros_like(denominator), where=~vanish & (denominator > 0))
 
 
 def split_scale(quads: PlanarQuads, diagonal: str = "both", measure: str = "error") -> np.ndarray:
-    """c >= 0 with E = c R: 1 / (sqrt T_a + sqrt T_b)^2 for ``"error"``,
-    1 / (4 max(|T_a|, |T_b|)) for ``"centre"``, over the diagonal's two triangles;
-    the larger of the two diagonals' for ``"both"``; 0 where the diagonal's two
-    triangles both vanish.
+    """c with E = c R (split minus bilinear): +-1 / (sqrt T_a + sqrt T_b)^2 for
+    ``"error"``, +-1 / (4 max(|T_a|, |T_b|)) for ``"centre"``, over the diagonal's
+    two triangles, + along 0-2 and - along 1-3; the larger in magnitude of the two
+    diagonals' for ``"both"``; 0 where the diagonal's two triangles both vanish.
 
     Returns
     -------
@@ -259,7 +263,7 @@ def split_scale(quads: PlanarQuads, diagonal: str = "both", measure: str = "erro
         raise ValueError(f"diagonal must be one of both, 02, 13, shortest; got {diagonal!r}")
     along_02, along_13 = _diagonal_scale(quads, "02", measure), _diagonal_scale(quads, "13", measure)
     if diagonal == "both":
-        return np.maximum(along_02, along_13)
+        return np.where(np.abs(along_13) > np.abs(along_02), along_13, along_02)
     return np.where(quads.diagonals[:, 0] <= quads.diagonals[:, 1], along_02, along_13)
 
 
