@@ -42,19 +42,21 @@ RULES: dict[str, Rule] = {
             "Q101", "uv-disaffine",
             "texture coordinates are not an affine image of the positions",
             "texels", 0.5,
-            "Measures, per quad, how far the two-triangle split moves the texture "
-            "coordinate at the quad's centre, in texels (texture size from the "
-            "material's map_Kd image, else the texture-size setting), and flags quads "
-            "above the threshold. With --measure barycentric it uses the paper's "
-            "dimensionless score at .01 instead.",
+            "Measures, per quad, the largest difference between the two-triangle split "
+            "and the quad's own bilinear interpolation of its texture coordinates, in "
+            "texels (texture size from the material's map_Kd image, else the "
+            "texture-size setting), and flags quads above the threshold. With "
+            "--measure centre it takes the split's shift at the quad's centre instead, "
+            "with --measure barycentric the paper's dimensionless score at .01.",
             _CREASE,
             "A trapezoid, 2 wide at the bottom and 1 wide at the top (a quad near the "
             "pole of a lat-long sphere), carrying the whole unit square of uv: "
             "corners (-1, 0), (1, 0), (0.5, 1), (-0.5, 1) with uv (0, 0), (1, 0), "
-            "(1, 1), (0, 1). The split shifts the texture at its centre by a quarter "
-            "of its width, 256 texels at 1024, and the checker lines bend along the "
-            "diagonal. A parallelogram whose uv is a parallelogram (an affine map) is "
-            "never flagged.",
+            "(1, 1), (0, 1). The split shifts the texture at its centre by an eighth "
+            "of its width, 128 texels at 1024, and by 176 texels at its worst, "
+            "(1 - r) / (1 + sqrt r)^2 of the width for the side ratio r = 1/2; the "
+            "checker lines bend along the diagonal. A parallelogram whose uv is a "
+            "parallelogram (an affine map) is never flagged.",
             "Re-UV the quad as a parallelogram matching its shape (Blender: UV > "
             "Follow Active Quads, or straighten the island), subdivide it so each "
             "piece is closer to a parallelogram, or triangulate before baking so every "
@@ -64,8 +66,8 @@ RULES: dict[str, Rule] = {
             "Q102", "color-disaffine",
             "vertex colours are not an affine image of the positions",
             "1/255", 2.0,
-            "Measures how far the split moves the vertex colour at the quad's centre, "
-            "in 1/255 steps, and flags quads above the threshold.",
+            "Measures the largest difference between the split's and the quad's bilinear "
+            "vertex colour, in 1/255 steps, and flags quads above the threshold.",
             _CREASE,
             "A unit square with corner colours blue, red, green, black: the colours do "
             "not form a parallelogram in colour space, so the two triangles blend "
@@ -79,8 +81,9 @@ RULES: dict[str, Rule] = {
             "Q103", "normal-disaffine",
             "normals are not an affine image of the positions",
             "degrees", 2.0,
-            "Measures how far the split turns the interpolated normal at the quad's "
-            "centre, in degrees, and flags quads above the threshold.",
+            "Measures how far the split turns the interpolated normal at its worst "
+            "point, atan2(|split - bilinear|, |mean corner normal|) in degrees, and "
+            "flags quads above the threshold.",
             _CREASE,
             "A quad on a cylinder with smooth normals but uneven corner spacing: the "
             "lighting shows a bend along the diagonal.",

@@ -93,3 +93,40 @@ def test_never_above_the_corner_extent_on_random_convex_and_folded_quads():
             error = np.linalg.norm(split_error(quads, values, diagonal), axis=1)
             assert (error <= corner_extent(values) * (1 + 1e-12)).all()
             assert np.isfinite(error).all()
+
+
+MESHES = __import__("pathlib").Path(__file__).resolve().parents[2] / "shared" / "meshes"
+
+
+@pytest.mark.skipif(not MESHES.exists(), reason="../shared/meshes is absent")
+def test_never_above_the_corner_extent_on_the_shared_meshes():
+    """Every Q101-Q103 value of every quad (linted at threshold -inf) against the largest
+    distance between two of its corner values, in the rule's unit."""
+    from affinity.imagesize import image_size
+    from affinity.lint import lint_mesh
+    from affinity.loaders import load
+    from affinity.settings import Settings
+
+    checked = 0
+    for path in sorted(MESHES.glob("*.obj")):
+        mesh = load(str(path))
+        faces, corners = mesh.faces_of_size(4)
+        size = image_size(mesh.texture_path()) or (1024, 1024)
+        units = {"Q101": ("texcoords", lambda a: a * np.asarray(size, float)),
+                 "Q102": ("colors", lambda a: a * 255.0), "Q103": ("normals", None)}
+        for diagonal in ("both", "shortest"):
+            settings = Settings(diagonal=diagonal, thresholds={code: -np.inf for code in units})
+            for hits in lint_mesh(mesh, settings):
+                if hits.code not in units:
+                    continue
+                name, scale = units[hits.code]
+                values = mesh.corner_attribute(name, corners[np.searchsorted(faces, hits.faces)])
+                if hits.code == "Q103":  # degrees: the extent of unit normals turns the mean normal
+                    unit = values / np.linalg.norm(values, axis=2, keepdims=True)
+                    mean = np.linalg.norm(unit.mean(axis=1), axis=1)
+                    extent = np.degrees(np.arctan2(corner_extent(unit), mean))
+                else:
+                    extent = corner_extent(scale(values))
+                assert (hits.values <= extent * (1 + 1e-9) + 1e-12).all(), (path.name, hits.code)
+                checked += len(hits.values)
+    assert checked > 50000
