@@ -31,7 +31,14 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .check import UsageError
-from .settings import DIAGONALS, MEASURES, Settings, measure_name, unknown_codes, unthresholded_codes
+from .settings import (
+    DIAGONALS,
+    MEASURES,
+    Settings,
+    measure_name,
+    unknown_codes,
+    unthresholded_codes,
+)
 
 CONFIG_NAMES = ("affinity.toml", "pyproject.toml")
 

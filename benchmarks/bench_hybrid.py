@@ -4,9 +4,11 @@ For every mesh of ``../shared/meshes`` (skipped when absent) and the demo sphere
 render at SIZE x SIZE with a camera framing the whole mesh, once per method
 (split, hybrid, mvc), and print a markdown table: quads, share routed to mvc,
 covered fragments, best-of-N time per method and hybrid / split. Routing (the
-lint misplacement and the on-screen scale) is inside the hybrid's time.
+split's texture displacement per quad and its projection to pixels,
+``affinity.routing``) is inside the hybrid's time. ``--pixel-tolerance 1e9``
+routes nothing, so hybrid / split is the cost of the routing itself.
 
-    python benchmarks/bench_hybrid.py [--size 1024] [--repeat 3] [MESH ...]
+    python benchmarks/bench_hybrid.py [--size 1024] [--repeat 3] [--pixel-tolerance PX] [MESH ...]
 """
 
 from __future__ import annotations
@@ -50,16 +52,19 @@ def main() -> None:
     parser.add_argument("meshes", nargs="*")
     parser.add_argument("--size", type=int, default=1024)
     parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--pixel-tolerance", type=float, default=0.5)
+    parser.add_argument("--no-demo", action="store_true", help="leave out the demo sphere")
     args = parser.parse_args()
     paths = args.meshes or (sorted(str(p) for p in SHARED.glob("*.obj")) if SHARED.exists() else [])
-    scenes = [("demo sphere 16x8", demo_sphere(), "z")] + [(Path(p).name, load(p), up_axis(Path(p).name)) for p in paths]
+    scenes = ([] if args.no_demo else [("demo sphere 16x8", demo_sphere(), "z")]) + [(Path(p).name, load(p), up_axis(Path(p).name)) for p in paths]
 
     print(f"| mesh ({args.size}x{args.size}) | quads | to mvc | fragments | split s | hybrid s | mvc s | hybrid / split |")
     print("|---|---:|---:|---:|---:|---:|---:|---:|")
     for name, mesh, up in scenes:
         times = {}
         for method in METHODS:
-            options = RenderOptions(method=method, width=args.size, height=args.size, up=up, show="shaded")
+            options = RenderOptions(method=method, width=args.size, height=args.size, up=up, show="shaded",
+                                    pixel_tolerance=args.pixel_tolerance)
             times[method], result = best_time(mesh, options, args.repeat)
             if method == "hybrid":
                 share = float(np.mean(result.methods == "mvc"))

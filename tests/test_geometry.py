@@ -10,8 +10,8 @@ from affinity.geometry import (
     interior_angles,
     is_bowtie,
     nonplanarity,
-    plane_coordinates,
     planar_quads,
+    plane_coordinates,
     quad_normals,
     relative_signed_area,
 )

@@ -3,7 +3,12 @@
 import numpy as np
 from split_reference import random_convex_quad, sampled_sup
 
-from affinity.routing import displacement_pixels, route_by_view, screen_area, uv_displacement
+from affinity.routing import (
+    displacement_pixels,
+    route_by_view,
+    screen_area,
+    uv_displacement,
+)
 
 UNIT_UV = np.array([[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]])
 TRAPEZOID_UV = np.array([[[0.0, 0.0], [1.0, 0.0], [0.75, 1.0], [0.25, 1.0]]])
