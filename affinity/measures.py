@@ -72,14 +72,15 @@ the largest distance between two corners.
 
 Where the diagonal runs outside the quad (T_3 < 0: reflex corner 1) the quad is
 triangle (0, 2, 3) minus triangle (0, 1, 2), so the split shows L_(0,2,3) on all
-of it and |E| = |R| s (1-t) / T_1 peaks at (s, t) = (1, 0), corner 1 itself:
-|R| / T_1, the same closed form with T_3 taken as 0. Negative areas therefore
+of it and |E| = |R| s (1-t) / T_1 <= |R| / T_1, the value at corner 1's
+parameters (1, 0): the same closed form with T_3 taken as 0, so negative areas
 enter as 0. Where the diagonal runs inside a concave quad (reflex corner 0 or 2)
-or the quad is a bow-tie, the bilinear map folds and the point (s*, t*) may map
-outside the quad; the value there is an upper bound of the maximum over the
-parameters whose image lies inside, and it is capped at the attribute's corner
-extent (the largest distance between two corner values), which bounds that
-maximum.
+or the quad is a bow-tie, the bilinear map folds and (s*, t*) may map outside the
+quad. In these nonconvex cases the closed form is an upper bound of the largest
+error over the parameters whose image lies inside the quad (not that maximum
+itself: near a reflex corner the bilinear map folds outward), and it is capped at
+the attribute's corner extent (the largest distance between two corner values),
+which the split's values inside the quad cannot leave (Q203/Q204 report the shape).
 
 Which corners count is the ``diagonal`` setting: corners 1 and 3 measure the
 split along 0-2 (areas T_1, T_3 are its triangles), corners 0 and 2 the split
