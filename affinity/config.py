@@ -11,7 +11,7 @@ Keys (kebab-case, as in ruff)::
     select = ["Q1", "Q201"]          # rule codes or prefixes, "ALL"
     ignore = ["Q202"]
     threshold = 0.8                  # shorthand for thresholds.Q101
-    measure = "misplacement"         # or "barycentric"
+    measure = "error"                # or "centre", "barycentric" ("misplacement": old name of error)
     diagonal = "both"                # "02", "13", "shortest"
     texture-size = 2048
     exclude = ["legacy", "wip/*.ply"]  # replaces the default skips (.git, node_modules, ...)
@@ -39,7 +39,15 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .errors import UsageError
-from .settings import DIAGONALS, MEASURES, Settings, unknown_codes, unknown_levels, unthresholded_codes
+from .settings import (
+    DIAGONALS,
+    MEASURES,
+    Settings,
+    measure_name,
+    unknown_codes,
+    unknown_levels,
+    unthresholded_codes,
+)
 
 CONFIG_NAMES = ("affinity.toml", "pyproject.toml")
 
@@ -136,6 +144,11 @@ def _choice(value, choices: tuple[str, ...], where: str) -> str:
     return value
 
 
+def _measure(value, where: str) -> str:
+    measure = measure_name(value, where) if isinstance(value, str) else None
+    return measure if measure is not None else _choice(value, MEASURES, where)
+
+
 def _thresholds(value, where: str) -> dict[str, float]:
     if not isinstance(value, dict):
         raise ConfigError(f"{where}: expected a table of rule code = number")
@@ -169,7 +182,7 @@ _KEYS = {
     "select": ("select", _selection),
     "ignore": ("ignore", _codes),
     "thresholds": ("thresholds", _thresholds),
-    "measure": ("measure", lambda v, where: _choice(v, MEASURES, where)),
+    "measure": ("measure", _measure),
     "diagonal": ("diagonal", lambda v, where: _choice(v, DIAGONALS, where)),
     "texture-size": ("texture_size", _texture_size),
     "exclude": ("exclude", _globs),

@@ -28,6 +28,14 @@ import numpy as np
 #: used). The same figure is rule Q201's default threshold.
 DEGENERATE_AREA = 1e-9
 
+#: Doubled areas up to ROUNDING_AREA * eps * |largest coordinate| * longest edge are
+#: within rounding of zero: coordinates of magnitude |p| carry an error of eps |p| / 2
+#: each, which moves a doubled triangle area (a cross product of two edges) by up
+#: to about 2 sqrt(3) eps |p| times the edge length; twice that is the margin. A
+#: unit quad offset by 1e9 has a rounding area of about 4e-6, far above the
+#: relative tolerance above.
+ROUNDING_AREA = 8.0
+
 
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """(..., D), (..., D) -> (...) dot products."""
@@ -245,8 +253,16 @@ class PlanarQuads:
 
     @cached_property
     def tolerance(self) -> np.ndarray:
-        """(Q,) float64: the largest T_i (twice an area) that counts as zero."""
-        return 2 * DEGENERATE_AREA * self.size**2
+        """(Q,) float64: the largest T_i (twice an area) that counts as zero: the larger of
+        the relative tolerance 2 ``DEGENERATE_AREA`` size^2 and the :attr:`rounding` area."""
+        return np.maximum(2 * DEGENERATE_AREA * self.size**2, self.rounding)
+
+    @cached_property
+    def rounding(self) -> np.ndarray:
+        """(Q,) float64: doubled areas within rounding of zero for corners of this
+        magnitude, ``ROUNDING_AREA`` eps max_k |p_k| times the longest edge."""
+        magnitude = np.abs(self.components).max(axis=(0, 1))
+        return (ROUNDING_AREA * np.finfo(np.float64).eps) * magnitude * self.size
 
     def take(self, rows) -> PlanarQuads:
         """The quads selected by ``rows`` (an index array, a boolean mask or a slice)."""
@@ -316,15 +332,20 @@ def degeneracy(quads: PlanarQuads) -> np.ndarray:
 
     The triangles opposite the corners are the two triangles of either diagonal
     split, so a repeated corner, a collapsed edge, three collinear corners or a
-    zero-area quad all give 0. Rule Q201 flags values at or below its threshold;
-    with the default threshold those are exactly the quads where the affinity test
-    skips a corner.
+    zero-area quad all give 0, and so does a triangle whose area is within
+    rounding of zero for its coordinates' magnitude (``PlanarQuads.rounding``:
+    moving a mesh far from the origin must not turn a degenerate quad into a
+    sliver). Rule Q201 flags values at or below its threshold; with the default
+    threshold those are exactly the quads with a triangle the affinity test
+    treats as vanished.
 
     Returns
     -------
     (Q,) float64 in [0, ~0.5].
     """
-    return _relative(np.abs(quads.areas).min(axis=1) / 2, quads.size)
+    smallest = np.abs(quads.areas).min(axis=1)
+    smallest[smallest <= quads.rounding] = 0.0
+    return _relative(smallest / 2, quads.size)
 
 
 def relative_signed_area(quads: PlanarQuads) -> np.ndarray:

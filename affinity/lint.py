@@ -21,7 +21,7 @@ import numpy as np
 from .findings import RuleHits
 from .geometry import PlanarQuads, planar_quads_by_component, squared_lengths
 from .loaders.imagesize import image_size
-from .measures import misplacement_by_component, split_scale
+from .measures import split_error_by_component, split_scale
 from .mesh import ATTRIBUTE_NAMES, Mesh
 from .rules import RULES, resolve_codes
 from .settings import Settings
@@ -88,7 +88,7 @@ class QuadBatch:
     ``corners`` (4, Q) corner indices, ``settings``, ``texture_size`` (w, h)
     texels, ``planar`` (the quads in their own planes), ``uv`` and
     ``uv_planar`` (the quads with uv at all four corners), ``complete(name)``
-    and ``misplacement(rows, attrs)``.
+    and ``split_error(rows, attrs)``.
     """
 
     def __init__(self, tables: CornerTables, settings: Settings, faces, corners, texture_size):
@@ -115,15 +115,18 @@ class QuadBatch:
             return np.zeros(0, dtype=np.int64), np.zeros((width, 4, 0))
         return found
 
-    def misplacement(self, rows, attrs: np.ndarray) -> np.ndarray:
-        """(K, n) ``misplacement`` of attributes (K, 4, n) of the quads ``rows``."""
+    def split_error(self, rows, attrs: np.ndarray) -> np.ndarray:
+        """(K, n) ``split_error`` of attributes (K, 4, n) of the quads ``rows``, in the
+        settings' reading (``error`` or ``centre``; ``barycentric`` is uv only, so the
+        other attributes read ``error`` under it)."""
+        measure = self.settings.split_measure
         if isinstance(rows, slice):  # every quad: the split's scale is shared
-            return misplacement_by_component(self.planar, attrs, scale=self.split_scale)
-        return misplacement_by_component(self.planar.take(rows), attrs, self.settings.diagonal)
+            return split_error_by_component(self.planar, attrs, measure=measure, scale=self.split_scale)
+        return split_error_by_component(self.planar.take(rows), attrs, self.settings.diagonal, measure)
 
     @cached_property
     def split_scale(self) -> np.ndarray:
-        return split_scale(self.planar, self.settings.diagonal)
+        return split_scale(self.planar, self.settings.diagonal, self.settings.split_measure)
 
     @cached_property
     def uv(self) -> tuple[np.ndarray | slice, np.ndarray]:
@@ -209,27 +212,27 @@ def lint_mesh(mesh: Mesh, settings: Settings) -> list[RuleHits]:
     return sorted(hits, key=lambda h: order[h.code])
 
 
-def quad_uv_misplacement(mesh: Mesh, diagonal: str = "02") -> tuple[np.ndarray, np.ndarray]:
-    """Per-quad misplacement of the texture coordinates in uv units, for routing.
+def quad_uv_error(mesh: Mesh, diagonal: str = "02") -> tuple[np.ndarray, np.ndarray]:
+    """Per-quad split error (the ``error`` reading) of the texture coordinates in uv units.
 
-    The hybrid renderer sends a quad to mean value coordinates when this times the
-    quad's on-screen scale exceeds its pixel tolerance (design.md). The renderer's
-    split is along 0-2, hence the default diagonal.
+    The hybrid routes a quad whose uv quad is degenerate (Q301) by this times the
+    quad's screen scale (``affinity.draw.routing``). The renderer's split is along 0-2,
+    hence the default diagonal.
 
     Returns
     -------
     faces : (Q,) int64
         Every quad of the mesh, as a face index in file order.
-    m : (Q,) float64
-        |m| in uv units; NaN for quads without texture coordinates at all corners.
+    error : (Q,) float64
+        |E| in uv units; NaN for quads without texture coordinates at all corners.
     """
 
     def measure(batch: QuadBatch) -> np.ndarray:
-        m = np.full(len(batch), np.nan)
+        error = np.full(len(batch), np.nan)
         rows, uv = batch.uv
-        uv_m = misplacement_by_component(batch.planar.take(rows), uv, diagonal)
-        m[rows] = np.sqrt(uv_m[0] * uv_m[0] + uv_m[1] * uv_m[1])
-        return m
+        E = split_error_by_component(batch.planar.take(rows), uv, diagonal)
+        error[rows] = np.sqrt(E[0] * E[0] + E[1] * E[1])
+        return error
 
     faces = np.flatnonzero(mesh.face_sizes == 4)
     return faces, np.concatenate(_map_quad_batches(mesh, Settings(), measure, ("texcoords",)) or [np.zeros(0)])

@@ -24,33 +24,75 @@ i.e. b_i = (T_{i+1}, -T_{i+2}, T_{i+3}) / T_i, and the residual of corner i is
 All four residuals are one vector R divided by the corner's own area, so the
 largest belongs to the valid selected corner with the smallest |T_i|.
 
-Two readings are reported (design.md):
+Three readings are reported (design.md, "The affinity test"):
 
-* ``misplacement``: m = (a_i - sum_j b_ij a_j) / 4 for the corner i of largest
-  norm: how far the two-triangle split moves the attribute at the quad's centre.
-  For a parallelogram (all T_i equal) it is exactly the bilinear value at the
-  centre minus the split's value there, +-(a_0 - a_1 + a_2 - a_3) / 4. For other
-  planar quads the centre (the corner mean) lies in the larger triangle of the
-  split, so the exact shift is the residual of the diagonal's corner with the
-  larger |T_i|; the largest residual taken here (design.md) exceeds it by the
-  ratio of the two triangles' areas, e.g. (1 - r) / (4r) against (1 - r) / 4 on
-  a trapezoid with a unit-square uv whose parallel sides have the ratio r.
+* ``error`` (the default): the largest difference over the quad between the
+  two-triangle split and the bilinear interpolation of the corner values in the
+  quad's own parameters (s, t), the surface the quad describes;
+* ``centre``: the split's shift at the corner mean;
 * ``barycentric``: max_i |b_i(positions) - b_i(uv)|, the paper's dimensionless
   score (tolerance .01), invariant to translation, rotation and scale of either
   space.
 
+Derivation of ``error`` (split along 0-2; 1-3 is the same with the corners
+turned by one). Let P(s, t) = (1-s)(1-t) p0 + s(1-t) p1 + s t p2 + (1-s) t p3 be
+the bilinear position map and A(s, t) the same blend of the attribute values.
+The split draws triangle (0, 1, 2), of doubled area T_3, with the affine function
+L that takes the values a_0, a_1, a_2 at its corners. L o P is bilinear in (s, t)
+(an affine function of a bilinear map), equal to A at corners 0, 1, 2 and to
+L(p_3) at corner 3, so
+
+    L(P(s, t)) - A(s, t) = (1-s) t (L(p_3) - a_3) = (1-s) t R / T_3,
+
+since a_3 - L(p_3) is corner 3's residual -R / T_3. Likewise triangle (0, 2, 3),
+of doubled area T_1, gives s (1-t) R / T_1 (corner 1's residual is -R / T_1). The
+error is a multiple of the one vector R everywhere. The two triangles meet on the diagonal,
+whose preimage in (s, t) is where the signed area of (p_0, p_2, P(s, t)), the
+bilinear s (1-t) (-T_3) + (1-s) t T_1 (over 2), vanishes: the boundary curve
+
+    T_1 (1-s) t = T_3 s (1-t),
+
+from (0, 0) to (1, 1). On the side of corner 1 the error is (1-s) t R / T_3,
+which is the smaller of the two expressions there (and vice versa), so over a
+convex quad |E(s, t)| = |R| min((1-s) t / T_3, s (1-t) / T_1), whose maximum lies
+on the boundary curve. Along it t = T_3 s / (T_1 (1-s) + T_3 s); maximising
+(1-s) t gives
+
+    (s*, t*) = (sqrt T_1, sqrt T_3) / (sqrt T_1 + sqrt T_3)   (so t* = 1 - s*),
+
+    max |E| = |R| (1-s*) t* / T_3 = |R| / (sqrt T_1 + sqrt T_3)^2.
+
+On a parallelogram (T_1 = T_3 = T) that is |R| / (4 T), the shift at the centre;
+on an exact pole quad (p_0 = p_1: T_3 = 0, T_0 = T_1, R = T_1 (a_0 - a_1)) it is
+|a_0 - a_1|, the whole width of the quad's attribute. Nothing divides by a small
+area: the denominator is at least the larger of T_1, T_3, and a quad is skipped
+only when both vanish (Q201). For a convex quad the split's and the bilinear
+values are both convex combinations of the corner values, so |E| never exceeds
+the largest distance between two corners.
+
+Where the diagonal runs outside the quad (T_3 < 0: reflex corner 1) the quad is
+triangle (0, 2, 3) minus triangle (0, 1, 2), so the split shows L_(0,2,3) on all
+of it and |E| = |R| s (1-t) / T_1 <= |R| / T_1, the value at corner 1's
+parameters (1, 0): the same closed form with T_3 taken as 0, so negative areas
+enter as 0. Where the diagonal runs inside a concave quad (reflex corner 0 or 2)
+or the quad is a bow-tie, the bilinear map folds and (s*, t*) may map outside the
+quad. In these nonconvex cases the closed form is an upper bound of the largest
+error over the parameters whose image lies inside the quad (not that maximum
+itself: near a reflex corner the bilinear map folds outward), and it is capped at
+the attribute's corner extent (the largest distance between two corner values),
+which the split's values inside the quad cannot leave (Q203/Q204 report the shape).
+
 Which corners count is the ``diagonal`` setting: corners 1 and 3 measure the
-split along 0-2, corners 0 and 2 the split along 1-3; ``"both"`` takes all four,
-``"shortest"`` the diagonal shorter in 3-D.
+split along 0-2 (areas T_1, T_3 are its triangles), corners 0 and 2 the split
+along 1-3; ``"both"`` takes the worse diagonal (the larger scale, R being the
+same vector for both), ``"shortest"`` the diagonal shorter in 3-D.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from .geometry import PlanarQuads, lengths
-
-_ALTERNATING = np.array([1.0, -1.0, 1.0, -1.0])
+from .geometry import PlanarQuads, lengths, squared_lengths
 
 _CORNERS_OF_DIAGONAL = {
     "both": np.array([True, True, True, True]),
@@ -103,16 +145,20 @@ def corner_barycentrics(quads: PlanarQuads) -> np.ndarray:
     return np.divide(numerators, T[..., None], out=np.full(numerators.shape, np.nan), where=valid)
 
 
-def misplacement(quads: PlanarQuads, attrs: np.ndarray, diagonal: str = "both") -> np.ndarray:
-    """How far the two-triangle split moves an attribute at the quad's centre.
+#: The two triangles of each diagonal's split, by the corner each is opposite to:
+#: along 0-2 the triangles (0, 2, 3) and (0, 1, 2), of doubled areas T_1 and T_3.
+_TRIANGLES_OF_DIAGONAL = {"02": (1, 3), "13": (0, 2)}
 
-    m = (a_i - sum_j b_ij a_j) / 4 = (-1)^i R / (4 T_i),  R = sum_k (-1)^k T_k a_k,
 
-    for the corner i of largest |m| among the corners selected by ``diagonal``
-    whose reference triangle is not degenerate. Corners with a degenerate
-    reference triangle are skipped, so a pole quad (two corners at the pole) is
-    scored by its two other corners; a quad with no usable corner (collapsed to a
-    line or a point, reported by Q201) scores 0.
+def split_error(quads: PlanarQuads, attrs: np.ndarray, diagonal: str = "both", measure: str = "error") -> np.ndarray:
+    """The split's error vector E of an attribute, in the attribute's units.
+
+    ``measure="error"``: the largest split-minus-bilinear difference over the quad,
+    R / (sqrt T_a + sqrt T_b)^2 (module docstring); ``"centre"``: the difference at
+    the corner mean, R / (4 max(|T_a|, |T_b|)). T_a, T_b are the doubled areas of
+    the diagonal's two triangles, R = sum_k (-1)^k T_k a_k. With ``diagonal="both"``
+    the worse diagonal counts. A quad whose diagonal's two triangles both vanish
+    (Q201) scores 0.
 
     Parameters
     ----------
@@ -120,61 +166,119 @@ def misplacement(quads: PlanarQuads, attrs: np.ndarray, diagonal: str = "both") 
     attrs : (Q, 4, K) float64
         Attribute values at the corners, any dimension K.
     diagonal : {"both", "02", "13", "shortest"}
+    measure : {"error", "centre"}
 
     Returns
     -------
-    (Q, K) float64 vector m in the attribute's units; always finite.
+    (Q, K) float64 split minus bilinear at the worst point (at the corner mean
+    for ``"centre"``), always finite; its direction is +-R's.
     """
-    return misplacement_by_component(quads, np.transpose(attrs, (2, 1, 0)), diagonal).T
+    return split_error_by_component(quads, np.transpose(attrs, (2, 1, 0)), diagonal, measure).T
 
 
-def misplacement_by_component(quads: PlanarQuads, attrs: np.ndarray, diagonal: str = "both", scale: np.ndarray | None = None) -> np.ndarray:
-    """:func:`misplacement` of attributes laid out by component.
+def residual_by_component(areas: np.ndarray, attrs: np.ndarray) -> np.ndarray:
+    """R = sum_k (-1)^k T_k a_k, taken relative to corner 0 (exact, since
+    sum_k (-1)^k T_k = 0) so attributes far from zero keep their digits.
+
+    areas : (4, Q) float64, T_i of every quad at [i]; attrs : (K, 4, Q) float64.
+    Returns (K, Q) float64.
+    """
+    a0 = attrs[:, 0]
+    R = attrs[:, 2] - a0
+    R *= areas[2]
+    R -= (attrs[:, 1] - a0) * areas[1]
+    R -= (attrs[:, 3] - a0) * areas[3]
+    return R
+
+
+def split_error_by_component(quads: PlanarQuads, attrs: np.ndarray, diagonal: str = "both", measure: str = "error",
+                             scale: np.ndarray | None = None) -> np.ndarray:
+    """:func:`split_error` of attributes laid out by component.
 
     Parameters
     ----------
     quads : PlanarQuads of Q quads.
     attrs : (K, 4, Q) float64, component k of corner i of quad q at [k, i, q].
     diagonal : {"both", "02", "13", "shortest"}
-    scale : (Q,) float64, ``split_scale(quads, diagonal)`` when already known
-        (it depends on the positions only, so several attributes share it).
+    measure : {"error", "centre"}
+    scale : (Q,) float64, ``split_scale(quads, diagonal, measure)`` when already
+        known (it depends on the positions only, so several attributes share it).
 
     Returns
     -------
     (K, Q) float64
     """
-    T = quads.areas.T  # (4, Q): T[i] holds every quad's T_i
-    # Relative to corner 0 (sum_k (-1)^k T_k = 0 makes this exact), so attributes far
-    # from zero keep their digits.
-    a0 = attrs[:, 0]
-    R = attrs[:, 2] - a0
-    R *= T[2]
-    R -= (attrs[:, 1] - a0) * T[1]
-    R -= (attrs[:, 3] - a0) * T[3]
-    R *= split_scale(quads, diagonal) if scale is None else scale
-    return R
+    E = residual_by_component(quads.areas.T, attrs)
+    E *= split_scale(quads, diagonal, measure) if scale is None else scale
+    if measure == "error":
+        _cap_at_extent(quads, attrs, E)
+    return E
 
 
-def split_scale(quads: PlanarQuads, diagonal: str = "both") -> np.ndarray:
-    """1 / (4 (-1)^i T_i) for the corner i that :func:`misplacement` reads: among
-    the corners selected by ``diagonal`` whose reference triangle is not
-    degenerate, the one with the smallest |T_i| (the first of equals); 0 where
-    no corner is usable.
+def _cap_at_extent(quads: PlanarQuads, attrs: np.ndarray, E: np.ndarray) -> None:
+    """Scale E (K, Q) down, in place, to the attribute's corner extent on quads with a
+    reflex corner (concave, bow-tie), where the closed form is only an upper bound."""
+    folded = np.flatnonzero((quads.areas < -quads.tolerance[:, None]).any(axis=1))
+    if len(folded) == 0:
+        return
+    a = attrs[:, :, folded]
+    extent = np.zeros(len(folded))
+    for i, j in ((0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)):
+        np.maximum(extent, np.sqrt(squared_lengths(a[:, i] - a[:, j])), out=extent)
+    length = np.sqrt(squared_lengths(E[:, folded]))
+    E[:, folded] *= np.divide(extent, length, out=np.ones_like(length), where=length > extent)
+
+
+def _diagonal_scale(quads: PlanarQuads, diagonal: str, measure: str) -> np.ndarray:
+    """(Q,) scale of one diagonal ("02" or "13"); see :func:`split_scale`."""
+    a, b = _TRIANGLES_OF_DIAGONAL[diagonal]
+    T_a, T_b = quads.areas[:, a], quads.areas[:, b]
+    if measure == "centre":
+        denominator = 4 * np.maximum(np.abs(T_a), np.abs(T_b))
+    elif measure == "error":
+        # A negative area is the triangle outside the quad: it enters as 0 (module docstring).
+        denominator = np.sqrt(np.maximum(T_a, 0)) + np.sqrt(np.maximum(T_b, 0))
+        denominator *= denominator
+    else:
+        raise ValueError(f"measure must be error or centre; got {measure!r}")
+    vanish = np.maximum(np.abs(T_a), np.abs(T_b)) <= quads.tolerance
+    # Split minus bilinear is +R c along 0-2 (corners 1, 3 have residuals -R / T_i) and
+    # -R c along 1-3 (corners 0, 2 have +R / T_i).
+    sign = 1.0 if diagonal == "02" else -1.0
+    return np.divide(sign, denominator, out=np.zeros_like(denominator), where=~vanish & (denominator > 0))
+
+
+def split_scale(quads: PlanarQuads, diagonal: str = "both", measure: str = "error") -> np.ndarray:
+    """c with E = c R (split minus bilinear): +-1 / (sqrt T_a + sqrt T_b)^2 for
+    ``"error"``, +-1 / (4 max(|T_a|, |T_b|)) for ``"centre"``, over the diagonal's
+    two triangles, + along 0-2 and - along 1-3; the larger in magnitude of the two
+    diagonals' for ``"both"``; 0 where the diagonal's two triangles both vanish.
 
     Returns
     -------
     (Q,) float64
     """
-    T = quads.areas.T
-    usable = quads.valid.T & selected_corners(quads, diagonal).T
-    smallest = np.full(len(quads), np.inf)
-    signed_area = np.zeros(len(quads))  # (-1)^i T_i of the chosen corner i
-    for i in range(4):  # the four corners, each vectorized over all quads
-        candidate = np.where(usable[i], np.abs(T[i]), np.inf)
-        smaller = candidate < smallest
-        smallest = np.where(smaller, candidate, smallest)
-        signed_area = np.where(smaller, _ALTERNATING[i] * T[i], signed_area)
-    return np.divide(0.25, signed_area, out=np.zeros_like(signed_area), where=signed_area != 0)
+    if diagonal in _TRIANGLES_OF_DIAGONAL:
+        return _diagonal_scale(quads, diagonal, measure)
+    if diagonal not in ("both", "shortest"):
+        raise ValueError(f"diagonal must be one of both, 02, 13, shortest; got {diagonal!r}")
+    along_02, along_13 = _diagonal_scale(quads, "02", measure), _diagonal_scale(quads, "13", measure)
+    if diagonal == "both":
+        return np.where(np.abs(along_13) > np.abs(along_02), along_13, along_02)
+    return np.where(quads.diagonals[:, 0] <= quads.diagonals[:, 1], along_02, along_13)
+
+
+def split_error_point(T_a: np.ndarray, T_b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Parameters (s*, t*) of the largest split error along diagonal 0-2:
+    (sqrt T_1, sqrt T_3) / (sqrt T_1 + sqrt T_3), negative areas taken as 0.
+
+    T_a, T_b : (Q,) float64, T_1 and T_3. Returns two (Q,) float64; (0.5, 0.5)
+    where both vanish.
+    """
+    root_a, root_b = np.sqrt(np.maximum(T_a, 0)), np.sqrt(np.maximum(T_b, 0))
+    total = root_a + root_b
+    s = np.divide(root_a, total, out=np.full_like(total, 0.5), where=total > 0)
+    return s, 1 - s
 
 
 def barycentric_score(quads: PlanarQuads, uv_quads: PlanarQuads, diagonal: str = "both") -> np.ndarray:
@@ -201,11 +305,11 @@ def barycentric_score(quads: PlanarQuads, uv_quads: PlanarQuads, diagonal: str =
 
 
 def texels(m: np.ndarray, texture_size) -> np.ndarray:
-    """Misplacement of texture coordinates in texels: |(m_u W, m_v H)|.
+    """A split error of texture coordinates in texels: |(m_u W, m_v H)|.
 
     Parameters
     ----------
-    m : (Q, 2) float64 misplacement in uv units.
+    m : (Q, 2) float64 split error in uv units.
     texture_size : int or (width, height)
 
     Returns
@@ -216,7 +320,7 @@ def texels(m: np.ndarray, texture_size) -> np.ndarray:
 
 
 def color_steps(m: np.ndarray) -> np.ndarray:
-    """Misplacement of colours in [0, 1] in 1/255 steps: |m| * 255.
+    """A split error of colours in [0, 1] in 1/255 steps: |m| * 255.
 
     Parameters
     ----------
@@ -230,14 +334,14 @@ def color_steps(m: np.ndarray) -> np.ndarray:
 
 
 def normal_degrees(m: np.ndarray, normals: np.ndarray) -> np.ndarray:
-    """Misplacement of normals as the angle it turns the mean corner normal, in degrees.
+    """A split error of normals as the angle it turns the mean corner normal, in degrees.
 
     angle = atan2(|m|, |mean_k n_k|), the largest turn of the centre normal by a
     displacement m (atan2 stays accurate for small angles, unlike acos).
 
     Parameters
     ----------
-    m : (Q, 3) float64 misplacement measured on ``normals``.
+    m : (Q, 3) float64 split error measured on ``normals``.
     normals : (Q, 4, 3) float64 the corner normals m was measured on (unit length).
 
     Returns

@@ -19,10 +19,23 @@ from fnmatch import fnmatchcase
 
 from .rules import LEVELS, RULES
 
-MEASURES = ("misplacement", "barycentric")
+MEASURES = ("error", "centre", "barycentric")
+#: Old measure names still accepted, with one warning line: name -> the measure it now means.
+DEPRECATED_MEASURES = {"misplacement": "error"}
 #: Folders a directory walk never enters unless ``exclude`` is set (``extend-exclude`` adds to them).
 DEFAULT_EXCLUDE = (".git", "node_modules", "__pycache__")
 DIAGONALS = ("both", "02", "13", "shortest")
+
+
+def measure_name(name: str, where: str) -> str | None:
+    """The measure ``name`` means (None for an unknown name); a deprecated name gets one
+    warning line on stderr, prefixed by ``where`` (the flag or the configuration key)."""
+    if name in DEPRECATED_MEASURES:
+        import sys
+
+        sys.stderr.write(f"{where}: warning: {name!r} is deprecated, use {DEPRECATED_MEASURES[name]!r}\n")
+        return DEPRECATED_MEASURES[name]
+    return name if name in MEASURES else None
 
 
 @dataclass
@@ -31,8 +44,10 @@ class Settings:
 
     ``thresholds`` maps rule codes to thresholds in the rule's unit; rules not in
     it use their default. ``measure`` picks the reading used for Q101-Q103:
-    ``"misplacement"`` (attribute units) or ``"barycentric"`` (the paper's
-    dimensionless score; defined for uv only, so Q102/Q103 keep misplacement).
+    ``"error"`` (the split's largest error over the quad, attribute units),
+    ``"centre"`` (the split's shift at the corner mean) or ``"barycentric"``
+    (the paper's dimensionless score; defined for uv only, so Q102/Q103 read
+    ``error`` under it).
     ``diagonal`` picks which split the affinity test measures: ``"both"``,
     ``"02"``, ``"13"`` or ``"shortest"``. ``exclude`` lists globs of files not
     to check; ``per_file_ignores`` maps a glob to rule codes (or prefixes)
@@ -47,7 +62,7 @@ class Settings:
     select: list[str] | None = None
     ignore: list[str] | None = None
     thresholds: dict[str, float] = field(default_factory=dict)
-    measure: str = "misplacement"
+    measure: str = "error"
     diagonal: str = "both"
     texture_size: int = 1024
     exclude: list[str] = field(default_factory=lambda: list(DEFAULT_EXCLUDE))
@@ -56,6 +71,19 @@ class Settings:
     extend_exclude: list[str] = field(default_factory=list)
     root: str | None = None
     group_ignores: list[tuple[str, list[str]]] = field(default_factory=list)
+
+    @property
+    def split_measure(self) -> str:
+        """The reading of Q102/Q103 (and of Q101 unless barycentric): ``error`` or ``centre``."""
+        return "centre" if self.measure == "centre" else "error"
+
+    def measure_of(self, code: str) -> str | None:
+        """The reading a finding of a scored rule (Q101-Q103) was measured in, else None: the
+        settings' measure where the rule has that reading, else the split's (barycentric is uv only)."""
+        rule = RULES[code]
+        if not rule.scored:
+            return None
+        return self.measure if self.measure in rule.readings else self.split_measure
 
     def threshold(self, code: str) -> float | None:
         """The threshold of rule ``code``: the configured one, else the rule's default for the reading."""

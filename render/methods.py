@@ -101,7 +101,13 @@ def projective_corner_weights(clip) -> np.ndarray:
     a split triangle (for which the screen-space barycentrics are c_k w_k) is
     interpolating q a and q linearly on the screen. Quads that are not
     strictly convex on screen, or have a corner at w <= 0, have no such q:
-    they get rho = 1, the plain perspective-correct split.
+    they get rho = 1, the plain perspective-correct split. So does a quad with
+    a repeated corner, or one repeated to within rounding (a pole quad): its
+    diagonals meet at that corner, s or t is 0 or 1 up to rounding, and
+    projective there is defined as the split of its one non-degenerate
+    triangle. The guard is relative: s and t must keep a margin from 0 and 1 of
+    16 eps times the condition of their quotients, (|g| |f| + |g| |e|) / |e x f|
+    with g = q1 - q0 and e, f the diagonals, plus 16 eps.
     """
     W = clip[..., 3]
     projectable = (W > 0).all(axis=1)
@@ -114,7 +120,9 @@ def projective_corner_weights(clip) -> np.ndarray:
         s = (g[0] * f[1] - g[1] * f[0]) / ef
         t = (g[0] * e[1] - g[1] * e[0]) / ef
         rho = W * np.stack([1 / (1 - s), 1 / (1 - t), 1 / s, 1 / t], axis=1)
-    convex = projectable & (s > 0) & (s < 1) & (t > 0) & (t < 1)
+        length_g = np.hypot(*g)
+        margin = 16 * np.finfo(np.float64).eps * (1 + length_g * (np.hypot(*e) + np.hypot(*f)) / np.abs(ef))
+    convex = projectable & (s > margin) & (s < 1 - margin) & (t > margin) & (t < 1 - margin)
     return np.where(convex[:, None], rho, 1.0)
 
 

@@ -1,6 +1,6 @@
 """Configuration: affinity.toml / [tool.affinity], walking up, precedence, exclude, per-file-ignores.
 
-The trapezoid with a unit-square uv measures 256 texels (Q101, default
+The trapezoid with a unit-square uv measures 176 texels (Q101, default
 threshold 0.5), so a Q101 threshold of 1000 makes it clean and one of 1 keeps
 it flagged: the exit code tells which threshold was applied.
 """
@@ -57,8 +57,8 @@ def test_nearest_configuration_wins(tmp_path):
 def test_flags_win_and_thresholds_merge_per_rule(tmp_path):
     put(tmp_path, "affinity.toml", "measure = 'barycentric'\n[thresholds]\nQ101 = 1000\nQ102 = 7\n")
     mesh = str(put(tmp_path, "m.obj", BAD))
-    settings = Resolver({"thresholds": {"Q102": 3.0}, "measure": "misplacement"}).resolve(mesh).settings
-    assert (settings.threshold("Q101"), settings.threshold("Q102"), settings.measure) == (1000, 3, "misplacement")
+    settings = Resolver({"thresholds": {"Q102": 3.0}, "measure": "centre"}).resolve(mesh).settings
+    assert (settings.threshold("Q101"), settings.threshold("Q102"), settings.measure) == (1000, 3, "centre")
     assert Resolver({}, isolated=True).resolve(mesh).settings == Settings()
 
 

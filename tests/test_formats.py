@@ -2,8 +2,8 @@
 
 Unit tests build FileReport/RuleHits by hand; end-to-end tests run ``affinity
 check`` on a trapezoid carrying a unit-square uv (Q101: the split moves the
-texture at its centre by a quarter of its width, 256 texels at 1024) next to
-a square with affine uv (clean).
+texture by up to 175.7 texels at 1024, (1 - r) / (1 + sqrt r)^2 of its width for
+the side ratio r = 1/2) next to a square with affine uv (clean).
 """
 
 from __future__ import annotations
@@ -171,7 +171,7 @@ def test_github_format_end_to_end(meshes):
     assert result.returncode == 1, result.stderr
     assert result.stdout.splitlines() == [
         "::warning file=bad.obj,line=10,col=1,title=Q101 uv-disaffine::texture coordinates are not an affine "
-        "image of the positions (256 vs 0.5 texels), face 0 (line 10)",
+        "image of the positions (175.7 vs 0.5 texels), face 0 (line 10)",
     ]
 
 
@@ -192,7 +192,7 @@ def test_json_format_end_to_end(meshes):
     (finding,) = doc["findings"]
     assert {k: finding[k] for k in ("path", "line", "column", "code", "name", "face")} == {
         "path": "bad.obj", "line": 10, "column": 1, "code": "Q101", "name": "uv-disaffine", "face": 0}
-    assert finding["value"] == pytest.approx(256.0) and finding["threshold"] == 0.5
+    assert finding["value"] == pytest.approx(1024 * 0.5 / (1 + 0.5**0.5) ** 2, rel=1e-5) and finding["threshold"] == 0.5
     assert [f["findings"] for f in doc["files"]] == [1, 0]
 
 

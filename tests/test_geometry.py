@@ -10,8 +10,8 @@ from affinity.geometry import (
     interior_angles,
     is_bowtie,
     nonplanarity,
-    plane_coordinates,
     planar_quads,
+    plane_coordinates,
     quad_normals,
     relative_signed_area,
 )
@@ -141,3 +141,18 @@ def test_relative_signed_area_of_uv_quads():
     area = relative_signed_area(planar_quads(uv))
     np.testing.assert_allclose(area[:3], [1, -1, 1])
     assert area[3] == 0 and abs(area[4]) <= DEGENERATE_AREA
+
+
+def test_an_area_within_rounding_of_zero_is_degenerate():
+    """Corner 3 lies 1e-7 off the diagonal 0-2: a sliver of relative area 7e-8 at the origin
+    (above Q201's 1e-9), but within rounding of zero for coordinates of 1e9 (ulp 1.2e-7)."""
+    from affinity.geometry import degeneracy
+
+    sliver = np.array([[[0, 0, 0], [1, 0, 0], [1, 1, 0], [0.5, 0.5 + 1e-7, 0]]])
+    assert degeneracy(planar_quads(sliver))[0] > 1e-9
+    far = planar_quads(sliver + np.array([1e9, -1e9, 0]))
+    assert degeneracy(far)[0] == 0
+    assert not far.valid[0].all()
+    # A unit square there is not degenerate: the rounding area is about 4e-6 of it.
+    square = planar_quads(np.array([[[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]]) + 1e9)
+    assert far.rounding[0] < 1e-5 and degeneracy(square)[0] == pytest.approx(0.5)

@@ -8,11 +8,16 @@ from affinity.measures import (
     barycentric_score,
     color_steps,
     corner_barycentrics,
-    misplacement,
     normal_degrees,
     selected_corners,
+    split_error,
     texels,
 )
+
+
+def misplacement(quads, attrs, diagonal="both"):
+    """The ``centre`` reading: the split's shift at the corner mean."""
+    return split_error(quads, attrs, diagonal, "centre")
 
 UNIT_SQUARE_UV = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
 DIAGONALS = ["both", "02", "13", "shortest"]
@@ -25,7 +30,7 @@ def random_rotation(rng, dimension=3):
 
 
 def scores(corners, uv, diagonal="both"):
-    """(|misplacement|, barycentric score) of quads (Q, 4, 3) with uv (Q, 4, 2)."""
+    """(|centre shift|, barycentric score) of quads (Q, 4, 3) with uv (Q, 4, 2)."""
     quads = planar_quads(corners)
     m = np.linalg.norm(misplacement(quads, uv, diagonal), axis=1)
     return m, barycentric_score(quads, planar_quads(uv), diagonal)
@@ -79,14 +84,15 @@ def test_trapezoid_with_unit_square_uv_in_closed_form():
     """Isosceles trapezoid, bottom width w1 (corners 0, 1), top w2 = r w1 (2, 3), height h,
     unit-square uv. Corner 0 against triangle (1, 2, 3): the affine u of that triangle is
     u = (x + w2/2)/w2 + c (y - h) with u(p1) = 1, so c h = (w1 - w2)/(2 w2), and at p0
-    u = -(1 - r)/r instead of 0; v = y/h fits exactly. Hence m = ((1 - r)/(4r), 0).
+    u = -(1 - r)/r instead of 0; v = y/h fits exactly: the residual is (1 - r)/r.
     Barycentrics of p0: (1, -1/r, 1/r) against (1, -1, 1) in uv: distance sqrt(2)(1 - r)/r.
-    The corners against the long base give the smaller (1 - r)/4. Neither depends on
+    The centre lies in the larger triangle (against the long base), whose corner
+    residual is 1 - r: the centre shift is (1 - r)/4 on either diagonal. Neither depends on
     the size of the quad (tolerances are relative, not an absolute epsilon)."""
     for r in [0.25, 0.5, 0.75]:
         for size in [1e-6, 1.0, 1e6]:
             m, score = scores(trapezoid(r, width=3.0, height=0.7) * size, UNIT_SQUARE_UV[None])
-            np.testing.assert_allclose(m, [(1 - r) / (4 * r)])
+            np.testing.assert_allclose(m, [(1 - r) / 4])
             np.testing.assert_allclose(score, [np.sqrt(2) * (1 - r) / r])
         assert texels(misplacement(planar_quads(trapezoid(r)), UNIT_SQUARE_UV[None]), 1024)[0] > 0.5
 
@@ -94,7 +100,7 @@ def test_trapezoid_with_unit_square_uv_in_closed_form():
 def test_parallelogram_with_bilinear_uv_field_moves_the_centre_by_the_split_error():
     """On a parallelogram the bilinear uv at the centre is the corner mean; the split
     along 0-2 gives the midpoint of diagonal 0-2 there (the centre lies on it), along
-    1-3 the midpoint of 1-3. The misplacement is bilinear minus split."""
+    1-3 the midpoint of 1-3. The centre reading is split minus bilinear."""
     rng = np.random.default_rng(2)
     for _ in range(20):
         u, v = rng.normal(size=(2, 3))
@@ -103,8 +109,8 @@ def test_parallelogram_with_bilinear_uv_field_moves_the_centre_by_the_split_erro
         bilinear = uv.mean(axis=0)
         split_02, split_13 = (uv[0] + uv[2]) / 2, (uv[1] + uv[3]) / 2
         quads = planar_quads(corners[None])
-        np.testing.assert_allclose(misplacement(quads, uv[None], "02")[0], bilinear - split_02, atol=1e-12)
-        np.testing.assert_allclose(misplacement(quads, uv[None], "13")[0], bilinear - split_13, atol=1e-12)
+        np.testing.assert_allclose(misplacement(quads, uv[None], "02")[0], split_02 - bilinear, atol=1e-12)
+        np.testing.assert_allclose(misplacement(quads, uv[None], "13")[0], split_13 - bilinear, atol=1e-12)
         for diagonal in ("both", "shortest"):
             np.testing.assert_allclose(
                 np.linalg.norm(misplacement(quads, uv[None], diagonal)),
@@ -150,10 +156,13 @@ def test_lat_long_sphere_scores_grow_from_equator_to_poles(n_lon, n_lat, diagona
 
 def test_pole_quad_is_scored_by_the_corners_away_from_the_pole():
     # Corner 2 of the pole triangle predicts corner 3's uv as corner 2's: the
-    # split drops half the texture, a quarter of the u span at the centre.
+    # split drops half the texture, a quarter of the u span at the centre, and the
+    # whole u span at its worst (next to the pole).
     m, score = scores(trapezoid(0.0), UNIT_SQUARE_UV[None])
     np.testing.assert_allclose(m, [0.25])
     np.testing.assert_allclose(score, [np.sqrt(2)])
+    error = split_error(planar_quads(trapezoid(0.0)), UNIT_SQUARE_UV[None])
+    np.testing.assert_allclose(np.linalg.norm(error, axis=1), [1.0])
 
 
 def test_collapsed_quads_score_zero_not_nan():

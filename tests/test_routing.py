@@ -1,10 +1,17 @@
-"""The hybrid's routing rule against hand-computed screen sizes."""
+"""The hybrid's routing rule against hand-computed screen sizes and the sampled split displacement."""
 
 import numpy as np
+from split_reference import random_convex_quad, sampled_sup
 
-from affinity.draw.routing import attribute_area, route_by_view, screen_area, split_error_pixels
+from affinity.draw.routing import (
+    displacement_pixels,
+    route_by_view,
+    screen_area,
+    uv_displacement,
+)
 
 UNIT_UV = np.array([[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]])
+TRAPEZOID_UV = np.array([[[0.0, 0.0], [1.0, 0.0], [0.75, 1.0], [0.25, 1.0]]])
 
 
 def square_clip(half: float, w: float = 1.0, ccw: bool = True) -> np.ndarray:
@@ -27,31 +34,59 @@ def test_screen_area_of_a_centred_square():
     assert np.isnan(screen_area(behind, 200, 100)[0])
 
 
-def test_error_is_misplacement_times_pixels_per_uv_unit():
-    # 100 x 100 pixel square showing the unit uv square: 100 px per uv unit.
-    error = split_error_pixels(np.array([0.01]), UNIT_UV, screen_area(square_clip(0.5), 200, 200))
-    np.testing.assert_allclose(error, [1.0])
-    np.testing.assert_allclose(attribute_area(UNIT_UV * 2), [4.0])
+def test_displacement_equals_the_sampled_split_displacement_under_an_affine_camera():
+    """With w = 1 the screen is an affine image of the quad, so the pixel displacement is the
+    largest |split - bilinear| of the screen positions over the uv quad (roles swapped)."""
+    rng = np.random.default_rng(4)
+    for _ in range(10):
+        uv = random_convex_quad(rng)
+        screen = rng.uniform(-0.8, 0.8, size=(4, 2))
+        clip = np.zeros((1, 4, 4))
+        clip[0, :, :2], clip[0, :, 3] = screen, 1.0
+        pixels = displacement_pixels(uv_displacement(uv[None]), clip, 200, 100)[0]
+        uv3 = np.column_stack([uv, np.zeros(4)])
+        expected = sampled_sup(uv3, screen * [100, 50], "02")
+        np.testing.assert_allclose(pixels, expected, rtol=0.01)
 
 
-def test_routing_sends_only_visible_errors_to_mvc():
+def test_routing_sends_only_visible_displacements_to_mvc():
+    # A square of 100 x 100 pixels carrying a trapezoid of uv: the split moves the texture by
+    # (1 - r) / (1 + sqrt r)^2 of the quad's width along u, r = 1/2 the uv trapezoid's side ratio.
+    pixels = displacement_pixels(uv_displacement(TRAPEZOID_UV), square_clip(0.5), 200, 200)
+    np.testing.assert_allclose(pixels, [100 * 0.5 / (1 + np.sqrt(0.5)) ** 2], rtol=1e-9)
     clip = np.concatenate([square_clip(0.5), square_clip(0.5), square_clip(0.001), square_clip(0.5, ccw=False)])
-    uv = np.repeat(UNIT_UV, 4, axis=0)
-    m = np.array([0.01, 0.001, 0.5, 0.01])  # 1 px, 0.1 px, tiny quad, back-facing 1 px
-    np.testing.assert_array_equal(route_by_view(m, uv, clip, 200, 200), ["mvc", "split", "split", "mvc"])
-    np.testing.assert_array_equal(
-        route_by_view(m, uv, clip, 200, 200, cull_back_faces=True), ["mvc", "split", "split", "split"]
-    )
+    uv = np.concatenate([TRAPEZOID_UV, UNIT_UV, TRAPEZOID_UV, TRAPEZOID_UV])
+    moves = uv_displacement(uv)
+    np.testing.assert_array_equal(route_by_view(moves, uv, clip, 200, 200), ["mvc", "split", "split", "mvc"])
+    np.testing.assert_array_equal(route_by_view(moves, uv, clip, 200, 200, cull_backfaces=True),
+                                  ["mvc", "split", "split", "split"])
+    assert route_by_view(moves, uv, clip, 200, 200, pixel_tolerance=18)[0] == "split"  # 17.2 px
     off_screen = square_clip(0.5)
     off_screen[0, :, 0] += 5.0
-    assert route_by_view(m[:1], UNIT_UV, off_screen, 200, 200)[0] == "split"
+    assert route_by_view(uv_displacement(TRAPEZOID_UV), TRAPEZOID_UV, off_screen, 200, 200)[0] == "split"
 
 
-def test_affine_quads_stay_split_even_across_the_eye_plane():
+def test_affine_quads_stay_split_even_across_the_near_plane():
     clip = square_clip(0.5)
-    clip[0, 0, 3] = -0.5
-    assert route_by_view(np.array([0.0]), UNIT_UV, clip, 64, 64)[0] == "split"
-    assert route_by_view(np.array([1e-6]), UNIT_UV, clip, 64, 64)[0] == "mvc"
+    clip[0, :, 3] = [-0.5, 1.0, 2.5, 1.0]  # still a parallelogram in clip space, one corner behind the eye
+    assert route_by_view(uv_displacement(UNIT_UV), UNIT_UV, clip, 64, 64)[0] == "split"
+    assert route_by_view(uv_displacement(TRAPEZOID_UV), TRAPEZOID_UV, clip, 64, 64)[0] == "mvc"
+    near = square_clip(0.5)
+    near[0, 1, 2] = -2.0  # z < -w: in front of the eye but nearer than the near plane
+    assert route_by_view(uv_displacement(TRAPEZOID_UV), TRAPEZOID_UV, near, 64, 64)[0] == "mvc"
+
+
+def test_folded_uv_goes_to_mvc_and_degenerate_uv_by_the_lint_error():
+    folded = np.array([[[0.0, 0.0], [0.3, 0.6], [1.0, 1.0], [0.0, 1.0]]])  # corner 1 reflex: (0, 1, 2) clockwise
+    moves = uv_displacement(folded)
+    assert moves.folded[0] and route_by_view(moves, folded, square_clip(0.5), 200, 200)[0] == "mvc"
+    line = np.array([[[0.0, 0.0], [1.0, 0.0], [1.0, 0.0], [0.0, 0.0]]])  # Q301: no area in uv
+    moves = uv_displacement(line)
+    assert moves.degenerate[0] and not moves.folded[0]
+    # 100 x 100 pixels over a uv extent of 1 (longest edge): 100 px per uv unit.
+    assert route_by_view(moves, line, square_clip(0.5), 200, 200, uv_error=np.array([0.004]))[0] == "split"
+    assert route_by_view(moves, line, square_clip(0.5), 200, 200, uv_error=np.array([0.006]))[0] == "mvc"
+    assert route_by_view(moves, line, square_clip(0.5), 200, 200)[0] == "split"
 
 
 def test_screen_area_equals_the_shoelace_sum_on_any_quad():

@@ -307,8 +307,8 @@ def test_text_output_names_prim_and_face_within_it():
     assert result.returncode == 1
     assert result.stdout.splitlines()[:3] == [
         f"{SCENE}:/World/Panel:face 0: Q102 color-disaffine: {RULES['Q102'].summary} (127.5 vs 2/255)",
-        f"{SCENE}:/World/Panel:face 1: Q101 uv-disaffine: {RULES['Q101'].summary} (256 vs 0.5 texels)",
-        f"{SCENE}:/World/Panel:face 1: Q103 normal-disaffine: {RULES['Q103'].summary} (9.462 vs 2 degrees)",
+        f"{SCENE}:/World/Panel:face 1: Q101 uv-disaffine: {RULES['Q101'].summary} (175.7 vs 0.5 texels)",
+        f"{SCENE}:/World/Panel:face 1: Q103 normal-disaffine: {RULES['Q103'].summary} (6.525 vs 2 degrees)",
     ]
     assert result.stderr.splitlines() == [f"{SCENE}: note: {note}" for note in load(SCENE).notes]
 

@@ -25,7 +25,7 @@ def add_parser(sub) -> None:
     p.add_argument("-o", "--output", required=True, metavar="DIR", help="folder for the CSV, summary and charts")
     p.add_argument("--quick", action="store_true", help="three small built-in scenes, small images, two repeats")
     p.add_argument("--route", choices=["view", "lint"], default="view",
-                   help="lint: also sweep the lint threshold, in the misplacement and the barycentric reading")
+                   help="lint: also sweep the lint threshold, in the error and the barycentric reading")
     p.add_argument("--size", type=image_size, metavar="WxH", help="image size (default 800x600, 240x180 with --quick)")
     p.add_argument("--repeat", type=int, metavar="N", help="timed runs per configuration (default 7, 2 with --quick)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress lines")

@@ -69,6 +69,16 @@ def _time(text: str) -> float:
     return time
 
 
+def _measure(text: str) -> str:
+    """--measure NAME; the deprecated ``misplacement`` means ``error`` (one warning line on stderr)."""
+    from ..settings import MEASURES, measure_name
+
+    measure = measure_name(text, "--measure")
+    if measure is None:
+        raise argparse.ArgumentTypeError(f"invalid choice: {text!r} (choose from {', '.join(MEASURES)})")
+    return measure
+
+
 def add_parser(sub) -> None:
     from ..output import FORMATS
     from ..rules import LEVELS
@@ -91,8 +101,9 @@ def add_parser(sub) -> None:
         "--threshold", type=_threshold, action="append", default=[], metavar="[CODE=]VALUE",
         help="flag above VALUE: a bare number sets Q101 (uv); repeat CODE=VALUE for other rules",
     )
-    p.add_argument("--measure", choices=MEASURES,
-                   help="Q101 reading: misplacement in texels (default) or the paper's barycentric score")
+    p.add_argument("--measure", type=_measure, metavar="{" + ",".join(MEASURES) + "}",
+                   help="Q101-Q103 reading: the split's largest error (default), its shift at the centre, "
+                        "or (Q101) the paper's barycentric score")
     p.add_argument("--diagonal", choices=DIAGONALS,
                    help="which split diagonal the affinity test measures (default: both)")
     p.add_argument("--texture-size", type=int, metavar="PX",

@@ -79,26 +79,40 @@ def default_show(mesh: Mesh) -> str:
     return "color" if mesh.colors is not None else "shaded"
 
 
+def uv_routing_inputs(mesh: Mesh, faces: np.ndarray, uv: np.ndarray):
+    """The view-independent part of routing by view (``affinity.draw.routing``), once per mesh:
+    the split's texture displacement of every render quad, and the lint's uv error
+    (along 0-2, uv units) per render quad when some uv quad is degenerate, else None."""
+    from .routing import uv_displacement
+
+    moves = uv_displacement(uv)
+    uv_error = None
+    if moves.degenerate.any():
+        from ..lint import quad_uv_error
+
+        quad_faces, error = quad_uv_error(mesh, diagonal="02")
+        per_face = np.zeros(mesh.n_faces)
+        per_face[quad_faces] = np.nan_to_num(error)
+        uv_error = per_face[faces]
+    return moves, uv_error
+
+
 def choose_methods(mesh: Mesh, faces: np.ndarray, uv: np.ndarray | None, clip: np.ndarray,
                    show: str, options: RenderOptions) -> np.ndarray:
     """The method of every render quad: one name, or the hybrid's per-quad routing.
 
     ``uv`` (R, 4, 2) is the render quads' texture coordinates when the render
-    shows them, else None. Routing by view uses the uv misplacement (along the
-    renderer's diagonal 0-2) times the quad's on-screen scale; for colours and
+    shows them, else None. Routing by view projects the split's largest texture
+    displacement (along the renderer's diagonal 0-2) to pixels; for colours and
     normals, and with ``--route lint``, the lint rule of the attribute shown decides.
     """
     if options.method != "hybrid":
         return np.full(len(faces), options.method)
     routes_uv = uv is not None
     if options.route == "view" and routes_uv:
-        from ..lint import quad_uv_misplacement
-
-        quad_faces, m = quad_uv_misplacement(mesh, diagonal="02")
-        per_face = np.zeros(mesh.n_faces)
-        per_face[quad_faces] = np.nan_to_num(m)
-        return route_by_view(per_face[faces], uv, clip, options.width, options.height,
-                             options.pixel_tolerance, options.cull)
+        moves, uv_error = uv_routing_inputs(mesh, faces, uv)
+        return route_by_view(moves, uv, clip, options.width, options.height,
+                             options.pixel_tolerance, options.cull, uv_error)
     from ..lint import lint_mesh, scored_code_of
     from ..settings import Settings
 

@@ -1,32 +1,113 @@
 """Which quads need generalized barycentric coordinates in this view (the hybrid's decision).
 
-The lint's misplacement ``m`` says how far, in attribute units, the two-triangle
-split moves the attribute at a quad's centre. On screen that becomes
+The split moves the texture on the surface. Swap the roles of the lint's test
+(``affinity.measures``): the uv quad is the domain, its split along 0-2 carries
+the positions affinely, and the exact render shows the bilinear positions P(s, t)
+over it. A texture feature at uv u is drawn at x_split(u) instead of x_exact(u),
+and the same derivation gives
 
-    error_px = m * sqrt(screen_area / attribute_area)
+    x_split - x_exact = (1-s) t R_p / T_3  or  s (1-t) R_p / T_1,
+    R_p = sum_k (-1)^k T_k p_k,
 
-pixels, the quad's on-screen scale in pixels per attribute unit (design.md, "The
-affinity test"). A quad goes to ``mvc`` when ``error_px`` exceeds the pixel
-tolerance; everything else — affine quads, quads smaller than a pixel, quads off
-screen, back-facing quads when back faces are culled — goes to ``split``. A quad
-whose attributes are affine in 3-D has ``m = 0`` however it is projected, so the
-rule is perspective-safe. The decision lives here, never in ``render``.
+with T_k the doubled signed areas of the uv quad's triangles: a 3-D vector of
+fixed direction R_p, largest at (s*, t*) = (sqrt T_1, sqrt T_3) / (sqrt T_1 +
+sqrt T_3), where it is D = R_p / (sqrt T_1 + sqrt T_3)^2. Both D and the point
+P(s*, t*) are fixed combinations of the quad's corners (``UvDisplacement``, once
+per mesh), so in a view their clip-space images are the same combinations of
+the clip-space corners, and the screen displacement is the camera's Jacobian at
+P(s*, t*) applied to D:
+
+    d_ndc = (dX W - X dW) / W^2  (and y alike),  pixels = |d_ndc * (width, height) / 2|.
+
+A quad goes to ``mvc`` when that exceeds the pixel tolerance, and also when
+
+- its uv triangles have opposite orientation (a fold, e.g. at a wrapped seam),
+- it is disaffine and a corner lies at or behind the near plane;
+
+a quad whose uv quad is degenerate (Q301) has no displacement and is routed by
+the lint's uv error times its screen scale. Everything else -- affine quads,
+quads smaller than a pixel, quads off screen, back-facing quads when back faces
+are culled -- goes to ``split``. The decision lives here, never in ``render``.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
+
+from ..geometry import planar_quads, relative_signed_area
+from ..measures import split_error_point
+from ..rules import RULES
 
 SPLIT, MVC = "split", "mvc"
 
+#: A displacement below this fraction of the quad's clip-space extent is rounding: the quad is affine.
+AFFINE_DISPLACEMENT = 1e-9
 
-def _diagonal_cross(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """Signed area of quads from their corner coordinates (R, 4) each.
+
+@dataclass(frozen=True)
+class UvDisplacement:
+    """The view-independent part of the routing, per render quad (R quads).
+
+    Attributes
+    ----------
+    weights : (R, 4) float64
+        D = sum_k weights_k p_k is the texture's largest on-surface displacement
+        (weights sum to 0, so any affine image of the corners maps D alike).
+    at : (R, 4) float64
+        Bilinear weights of the point P(s*, t*) where it is largest.
+    folded : (R,) bool
+        The uv triangles (0, 2, 3) and (0, 1, 2) have opposite orientation.
+    degenerate : (R,) bool
+        The uv quad is degenerate (Q301 at its default threshold).
+    """
+
+    weights: np.ndarray
+    at: np.ndarray
+    folded: np.ndarray
+    degenerate: np.ndarray
+
+
+def uv_displacement(uv: np.ndarray) -> UvDisplacement:
+    """Corner weights of the split's largest texture displacement along diagonal 0-2.
+
+    Parameters
+    ----------
+    uv : (R, 4, 2) float64 texture coordinates of the render quads.
+    """
+    quads = planar_quads(uv)
+    # A mirrored uv quad (clockwise) is measured as its mirror image.
+    T = quads.areas * np.where(quads.areas[:, 1] + quads.areas[:, 3] < 0, -1.0, 1.0)[:, None]
+    tolerance = quads.tolerance
+    folded = (T[:, 1] < -tolerance) | (T[:, 3] < -tolerance)
+    degenerate = np.abs(relative_signed_area(quads)) <= RULES["Q301"].default_threshold
+    s, t = split_error_point(T[:, 1], T[:, 3])
+    at = np.stack([(1 - s) * (1 - t), s * (1 - t), s * t, (1 - s) * t], axis=1)
+    root = np.sqrt(np.maximum(T[:, 1], 0)) + np.sqrt(np.maximum(T[:, 3], 0))
+    scale = np.divide(1.0, root * root, out=np.zeros_like(root), where=~degenerate & (root > 0))
+    weights = T * np.array([1.0, -1.0, 1.0, -1.0]) * scale[:, None]
+    return UvDisplacement(weights, at, folded, degenerate)
+
+
+def _components(clip: np.ndarray) -> np.ndarray:
+    """(R, 4, 4) clip corners -> (4, 4, R) contiguous: [component, corner], so that the
+    per-quad arithmetic below runs on contiguous rows (several times faster than on
+    the interleaved layout)."""
+    return np.ascontiguousarray(np.transpose(clip, (2, 1, 0)))
+
+
+def _screen_area(c: np.ndarray, width: int, height: int) -> np.ndarray:
+    """:func:`screen_area` of clip corners laid out by component (4, 4, R).
 
     The shoelace sum of a quadrilateral equals half the cross product of its
     diagonals, (p2 - p0) x (p3 - p1) / 2, for any quad (convex, concave or bow-tie).
     """
-    return 0.5 * ((x[:, 2] - x[:, 0]) * (y[:, 3] - y[:, 1]) - (x[:, 3] - x[:, 1]) * (y[:, 2] - y[:, 0]))
+    w = c[3]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        x, y = c[0] / w, c[1] / w
+        area = ((x[2] - x[0]) * (y[3] - y[1]) - (x[3] - x[1]) * (y[2] - y[0])) * (0.125 * width * height)
+    return np.where((w > 0).all(axis=0), area, np.nan)
 
 
 def screen_area(clip: np.ndarray, width: int, height: int) -> np.ndarray:
@@ -41,64 +122,107 @@ def screen_area(clip: np.ndarray, width: int, height: int) -> np.ndarray:
     (R,) float64, NaN for quads with a corner at or behind the eye (w <= 0),
     whose projection is not a bounded quad.
     """
-    w = clip[..., 3]
-    in_front = (w > 0).all(axis=1)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        area = _diagonal_cross(clip[..., 0] / w, clip[..., 1] / w) * (0.25 * width * height)
-    return np.where(in_front, area, np.nan)
+    return _screen_area(_components(clip), width, height)
 
 
-def attribute_area(values: np.ndarray) -> np.ndarray:
-    """Unsigned area of each quad in a 2-D attribute space, (R, 4, 2) -> (R,)."""
-    return np.abs(_diagonal_cross(values[..., 0], values[..., 1]))
+def _on_screen(c: np.ndarray) -> np.ndarray:
+    """:func:`on_screen` of clip corners laid out by component (4, 4, R)."""
+    x, y, z, w = c
+    outside = ((x > w).all(0) | (x < -w).all(0) | (y > w).all(0) | (y < -w).all(0)
+               | (z > w).all(0) | (w <= 0).all(0))
+    return ~outside
 
 
 def on_screen(clip: np.ndarray) -> np.ndarray:
     """(R,) bool: the quad's clip-space bounds meet the view volume (conservative)."""
-    x, y, z, w = (clip[..., k] for k in range(4))
-    outside = ((x > w).all(1) | (x < -w).all(1) | (y > w).all(1) | (y < -w).all(1)
-               | (z > w).all(1) | (w <= 0).all(1))
-    return ~outside
+    return _on_screen(_components(clip))
 
 
-def split_error_pixels(misplacement: np.ndarray, uv: np.ndarray, area: np.ndarray) -> np.ndarray:
-    """How many pixels the split moves the texture at each quad's centre in this view.
+def _combine(weights: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """sum_k weights[:, k] c[:, k]: (R, 4) weights of the corners of (4, 4, R) -> (4, R)."""
+    total = c[:, 0] * weights[:, 0]
+    for k in range(1, 4):
+        total += c[:, k] * weights[:, k]
+    return total
+
+
+def _displacement_pixels(moves: UvDisplacement, c: np.ndarray, width: int, height: int) -> np.ndarray:
+    """:func:`displacement_pixels` of clip corners laid out by component (4, 4, R)."""
+    X, Y, _, W = _combine(moves.at, c)
+    d = _combine(moves.weights, c)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        dx = (d[0] * W - X * d[3]) / (W * W) * (0.5 * width)
+        dy = (d[1] * W - Y * d[3]) / (W * W) * (0.5 * height)
+        pixels = np.hypot(dx, dy)
+    extent = np.abs(c).max(axis=(0, 1))
+    affine = np.abs(d).max(axis=0) <= AFFINE_DISPLACEMENT * extent
+    near = ((c[2] < -c[3]) | (c[3] <= 0)).any(axis=0)
+    pixels = np.where(near, np.inf, np.nan_to_num(pixels, nan=np.inf))
+    return np.where(affine, 0.0, pixels)
+
+
+def displacement_pixels(moves: UvDisplacement, clip: np.ndarray, width: int, height: int) -> np.ndarray:
+    """The split's largest texture displacement on screen, in pixels.
 
     Parameters
     ----------
-    misplacement : (R,) float64, in uv units (lint misplacement along diagonal 0-2)
-    uv : (R, 4, 2) float64
-    area : (R,) float64, the quads' :func:`screen_area` (NaN across the eye plane)
+    moves : UvDisplacement of R quads
+    clip : (R, 4, 4) float64 clip-space corners
 
     Returns
     -------
-    (R,) float64 pixels; ``inf`` for a disaffine quad crossing the eye plane
-    (its on-screen size is unbounded) and for one with zero uv area.
+    (R,) float64; ``inf`` for a disaffine quad with a corner at or behind the
+    near plane (z < -w, or w <= 0), 0 for an affine one (a displacement below
+    ``AFFINE_DISPLACEMENT`` times the largest clip coordinate).
     """
-    area = np.where(np.isnan(area), np.inf, np.abs(area))
+    return _displacement_pixels(moves, _components(clip), width, height)
+
+
+def degenerate_uv_pixels(uv_error: np.ndarray, uv: np.ndarray, area: np.ndarray) -> np.ndarray:
+    """Pixels for quads whose uv quad is degenerate: the lint's uv error times the
+    screen scale sqrt(|screen area|) / (longest uv edge), pixels per uv unit.
+
+    uv_error : (R,) float64 in uv units; uv : (R, 4, 2); area : (R,) ``screen_area``
+    (NaN across the eye plane, which gives ``inf`` for a nonzero error).
+    """
+    edge = np.sqrt(((np.roll(uv, -1, axis=1) - uv) ** 2).sum(axis=2)).max(axis=1)
     with np.errstate(divide="ignore", invalid="ignore"):
-        error = misplacement * np.sqrt(area / attribute_area(uv))
-    return np.where(misplacement > 0, np.nan_to_num(error, nan=np.inf), 0.0)
+        error = uv_error * np.sqrt(np.abs(area)) / edge
+    return np.where(uv_error > 0, np.nan_to_num(error, nan=np.inf), 0.0)
 
 
 def route_by_view(
-    misplacement: np.ndarray,
+    moves: UvDisplacement,
     uv: np.ndarray,
     clip: np.ndarray,
     width: int,
     height: int,
     pixel_tolerance: float = 0.5,
-    cull_back_faces: bool = False,
+    cull_backfaces: bool = False,
+    uv_error: np.ndarray | None = None,
 ) -> np.ndarray:
-    """Per-quad method for the hybrid render: ``"mvc"`` where the split error is visible.
+    """Per-quad method for the hybrid render: ``"mvc"`` where the split's texture displacement shows.
+
+    Parameters
+    ----------
+    moves : ``uv_displacement(uv)``
+    uv : (R, 4, 2) float64
+    clip : (R, 4, 4) float64
+    uv_error : (R,) float64, the lint's uv error (uv units, diagonal 0-2) of each
+        quad, read for the quads whose uv quad is degenerate; None: they stay split.
 
     Returns
     -------
     (R,) array of str, ``"split"`` or ``"mvc"``.
     """
-    area = screen_area(clip, width, height)
-    visible = on_screen(clip) & ~(np.abs(area) < 1.0)
-    if cull_back_faces:
+    c = _components(clip)
+    area = _screen_area(c, width, height)
+    visible = _on_screen(c) & ~(np.abs(area) < 1.0)
+    if cull_backfaces:
         visible &= ~(area < 0)
-    needs = visible & (split_error_pixels(misplacement, uv, area) > pixel_tolerance)
+    pixels = _displacement_pixels(moves, c, width, height)
+    if moves.degenerate.any():
+        rows = np.flatnonzero(moves.degenerate)
+        pixels[rows] = 0.0 if uv_error is None else degenerate_uv_pixels(uv_error[rows], uv[rows], area[rows])
+    needs = visible & ((pixels > pixel_tolerance) | moves.folded)
     return np.where(needs, MVC, SPLIT)

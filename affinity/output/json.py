@@ -9,7 +9,8 @@ Document layout::
                  USD only: "up_axis", "meters_per_unit", "notes"}
                 | {"path", "error", "line"} | {"path", "skipped"}],
       "findings": [{"path", "line", "column", "code", "name", "face", "value",
-                    "threshold", "unit", "level", "group", "message", USD only: "prim"}],
+                    "threshold", "unit", "level", "group", "message", Q101-Q103 only: "measure",
+                    USD only: "prim"}],
       "summary": {"files", "checked", "unreadable", "skipped", "findings",
                   "baselined", "by_rule": {"Q101": n, ...}, "by_level": {"warning": n, ...}},
       with --max-findings N: "truncated": [{"path", "code", "kept", "total"}],
@@ -25,7 +26,9 @@ With ``--max-findings N`` each file keeps the worst N findings per rule and
 
 ``face`` is the 0-based index of the face in file order counting every face;
 ``line`` its 1-based source line (0 in binary PLY); ``value`` the measured score
-in the rule's unit, ``threshold`` the limit it exceeded. In a USD stage,
+in the rule's unit, ``threshold`` the limit it exceeded; ``measure`` the reading an
+affinity finding's value is in (``error``, ``centre`` or ``barycentric``, from the
+resolved ``settings``). In a USD stage,
 ``prim`` is the mesh prim's path, ``face`` counts within that prim and ``line``
 is 0. ``settings`` are the resolved settings for the working directory (a file
 governed by another configuration file was checked with that file's settings;
@@ -57,16 +60,19 @@ def _file_entry(report: FileReport) -> dict:
     return entry
 
 
-def _finding_entry(f: Finding) -> dict:
+def _finding_entry(f: Finding, settings) -> dict:
     entry = dataclasses.asdict(f)
     if f.prim is None:
         del entry["prim"]
+    measure = settings.measure_of(f.code)
+    if measure is not None:
+        entry["measure"] = measure
     return entry
 
 
 def document(run: CheckRun) -> dict:
     """The whole JSON document as Python objects."""
-    findings = [_finding_entry(f) for r in run.reports for f in run.kept(r)]
+    findings = [_finding_entry(f, run.settings) for r in run.reports for f in run.kept(r)]
     doc = {
         "schema": SCHEMA,
         "version": VERSION,

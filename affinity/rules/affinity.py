@@ -32,11 +32,16 @@ def uv_disaffinity(quads) -> tuple:
     """Texture coordinates are not an affine image of the positions.
 
     What it does:
-        Measures, per quad, how far the two-triangle split moves the texture
-        coordinate at the quad's centre, in texels (texture size from the
-        material's map_Kd image, else the texture-size setting), and flags quads
-        above the threshold. With --measure barycentric it uses the paper's
-        dimensionless score at .01 instead.
+        Measures, per quad, the largest difference between the two-triangle split
+        and the quad's own bilinear interpolation of its texture coordinates, in
+        texels (texture size from the material's map_Kd image, else the
+        texture-size setting), and flags quads above the threshold. With --measure
+        centre it takes the split's shift at the quad's centre instead, with
+        --measure barycentric the paper's dimensionless score at .01. On the
+        example's trapezoid (side ratio r = 1/2) the split shifts the texture at
+        its centre by an eighth of its width, 128 texels at 1024, and by 176 texels
+        at its worst, (1 - r) / (1 + sqrt r)^2 of the width. A parallelogram whose
+        uv is a parallelogram (an affine map) is never flagged.
 
     Example:
         # a trapezoid (a quad near the pole of a lat-long sphere) carrying the unit square of uv
@@ -51,7 +56,7 @@ def uv_disaffinity(quads) -> tuple:
         f 1/1 2/2 3/3 4/4
 
     Prints:
-        example.obj:10:1: Q101 uv-disaffine: texture coordinates are not an affine image of the positions (256 vs 0.5 texels) [face 0]
+        example.obj:10:1: Q101 uv-disaffine: texture coordinates are not an affine image of the positions (175.7 vs 0.5 texels) [face 0]
 
     How to fix:
         Re-UV the quad as a parallelogram matching its shape (Blender: UV > Follow
@@ -63,7 +68,7 @@ def uv_disaffinity(quads) -> tuple:
     diagonal = quads.settings.diagonal
     if quads.settings.measure == "barycentric":
         return rows, barycentric_score(quads.planar.take(rows), quads.uv_planar, diagonal)
-    return rows, texels(quads.misplacement(rows, uv).T, quads.texture_size)
+    return rows, texels(quads.split_error(rows, uv).T, quads.texture_size)
 
 
 @rule(code="Q102", name="color-disaffine", unit="1/255", default_threshold=2.0, attribute="colors", scored=True,
@@ -72,8 +77,8 @@ def color_disaffinity(quads) -> tuple:
     """Vertex colours are not an affine image of the positions.
 
     What it does:
-        Measures how far the split moves the vertex colour at the quad's centre,
-        in 1/255 steps, and flags quads above the threshold.
+        Measures the largest difference between the split's and the quad's bilinear
+        vertex colour, in 1/255 steps, and flags quads above the threshold.
 
     Example:
         # a unit square with corner colours blue, red, green, black: no parallelogram in colour space
@@ -91,7 +96,7 @@ def color_disaffinity(quads) -> tuple:
         subdivide the quad, or triangulate before baking so the diagonal is explicit.
     """
     rows, colors = quads.complete("colors")
-    return rows, color_steps(quads.misplacement(rows, colors).T)
+    return rows, color_steps(quads.split_error(rows, colors).T)
 
 
 @rule(code="Q103", name="normal-disaffine", unit="degrees", default_threshold=2.0, attribute="normals", scored=True,
@@ -100,9 +105,9 @@ def normal_disaffinity(quads) -> tuple:
     """Normals are not an affine image of the positions.
 
     What it does:
-        Measures how far the split turns the interpolated normal at the quad's
-        centre, in degrees (the angle the misplacement turns the mean corner normal
-        by), and flags quads above the threshold.
+        Measures how far the split turns the interpolated normal at its worst point,
+        atan2(|split - bilinear|, |mean corner normal|) in degrees, and flags quads
+        above the threshold.
 
     Example:
         # a flat square whose corner normals lean out unevenly: the lighting bends along the diagonal
@@ -125,7 +130,7 @@ def normal_disaffinity(quads) -> tuple:
         is fixed.
     """
     rows, unit = quads.complete("normals")  # unit length already (see affinity.lint.CornerTables.gather)
-    m = quads.misplacement(rows, unit)
+    m = quads.split_error(rows, unit)
     # The angle atan2(|m|, |mean normal|) exceeds the threshold only where
     # |m| > tan(threshold) |mean normal|: the arctangent is taken for those only.
     threshold = quads.settings.threshold("Q103")

@@ -28,7 +28,7 @@ METHOD_STYLE = {  # method: (colour, marker)
     "projective": ("#7e22ce", "D"),
     "exact": ("#111827", "*"),
 }
-ROUTE_STYLE = {"view": "#db2777", "lint misplacement": "#0891b2", "lint barycentric": "#ca8a04"}
+ROUTE_STYLE = {"view": "#db2777", "lint error": "#0891b2", "lint barycentric": "#ca8a04"}
 PANEL = (3.4, 2.7)  # inches per panel
 COLUMNS = 3
 

@@ -7,15 +7,15 @@ clip-space quads, at the same size):
   reference ``exact``; ``split-13``, the split along the other diagonal (the
   quads' corners renumbered 1, 2, 3, 0), for the diagonal dependence;
 - the hybrid routed by view (uv only) at every pixel tolerance: a quad goes to
-  mvc when its misplacement times its on-screen scale exceeds the tolerance
+  mvc when the split's largest texture displacement, projected to pixels, exceeds the tolerance
   (``affinity.draw.routing``);
 - the hybrid routed by the lint (with ``lint_route``, and always for colours,
   which the hybrid routes by the lint): a quad goes to mvc when its rule value
-  exceeds the threshold, in the misplacement reading and, for uv, in the
+  exceeds the threshold, in the error reading and, for uv, in the
   paper's barycentric reading.
 
 A hybrid's time includes its per-frame routing decision; the per-mesh measure
-it routes on (misplacement or lint values, computed once per asset) is timed
+it routes on (the uv displacement or lint values, computed once per asset) is timed
 once, as ``setup_s``. Errors are in the lint's units of the attribute shown
 (texels of a ``texture_size`` texture for uv, 1/255 steps for colours); uv
 errors are also given in screen pixels (``px_*``: texels over the exact
@@ -74,7 +74,8 @@ class PreparedScene:
     ``faces`` (R,) the mesh face of each render quad; ``clip`` (R, 4, 4);
     ``inputs`` the attributes drawn (``affinity.draw.shading.ShadingInputs``);
     ``code`` the lint rule of the attribute shown (Q101 uv, Q102 colours);
-    ``routes`` maps a hybrid route name to (its per-render-quad values (R,),
+    ``routes`` maps a hybrid route name to (its per-render-quad values (R,), for
+    ``"view"`` the ``affinity.draw.drawing.uv_routing_inputs``,
     the settings to sweep, the seconds the values took to compute).
     """
 
@@ -139,16 +140,16 @@ def prepare(case: Scene, settings: StudySettings) -> PreparedScene:
 
 def _routes(scene: PreparedScene, settings: StudySettings) -> dict:
     """Route name -> (values per render quad, settings to sweep, seconds to compute the values)."""
-    from ..lint import quad_scores, quad_uv_misplacement
+    from ..draw.drawing import uv_routing_inputs
+    from ..lint import quad_scores
     from ..settings import Settings
 
     routes = {}
     if scene.show == "uv":
         start = time.perf_counter()
-        quad_faces, m = quad_uv_misplacement(scene.mesh, diagonal="02")
-        routes["view"] = (_per_render_quad(scene, quad_faces, np.nan_to_num(m)), settings.tolerances,
-                          time.perf_counter() - start)
-    readings = [("misplacement", settings.misplacement_thresholds)]
+        inputs = uv_routing_inputs(scene.mesh, scene.faces, scene.inputs.attrs[..., scene.inputs.uv])
+        routes["view"] = (inputs, settings.tolerances, time.perf_counter() - start)
+    readings = [("error", settings.misplacement_thresholds)]
     if scene.show == "uv":
         readings.append(("barycentric", settings.barycentric_thresholds))
     if settings.lint_route or scene.show != "uv":
@@ -198,7 +199,8 @@ def _chooser(scene: PreparedScene, route: str, values: np.ndarray, setting: floa
 
     if route == "view":
         uv = scene.inputs.attrs[..., scene.inputs.uv]
-        return lambda: route_by_view(values, uv, scene.clip, width, height, setting)
+        moves, uv_error = values
+        return lambda: route_by_view(moves, uv, scene.clip, width, height, setting, uv_error=uv_error)
     return lambda: np.where(values > setting, MVC, SPLIT)
 
 

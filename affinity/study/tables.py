@@ -13,7 +13,7 @@ from .sweep import COLUMNS
 
 #: The hybrid setting the headline table shows: the renderer's default pixel
 #: tolerance (``RenderOptions.pixel_tolerance``) for uv, the Q102 default threshold for colours.
-HEADLINE_SETTINGS = {"view": 0.5, "lint misplacement": 2.0}
+HEADLINE_SETTINGS = {"view": 0.5, "lint error": 2.0}
 
 
 def write_csv(rows: list[dict], path: str) -> None:
