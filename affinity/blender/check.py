@@ -64,15 +64,14 @@ def check_object(obj, **options) -> ObjectCheck:
     conversion = convert_object(obj, **convert)
     mesh, texture = conversion.mesh, conversion.texture
     notes = list(conversion.notes)
+    if conversion.uv_layer is None and "Q101" in resolve_codes(options.get("select"), options.get("ignore")):
+        notes.append("Q101 skipped: the mesh has no UV map")
     if mesh.texture_path() is None and texture is not None and "texture_size" not in options:
         options["texture_size"] = max(texture.size)
         if texture.size[0] != texture.size[1]:
             notes.append(f"texture {texture.image} is not square and not a file: "
                          f"texels counted at {max(texture.size)} px both ways")
     settings = Settings(**options)
-    enabled = resolve_codes(settings.select, settings.ignore)
-    if "Q101" not in enabled or conversion.uv_layer is not None:
-        notes = [n for n in notes if not n.startswith("Q101 skipped")]
     hits = lint_mesh(mesh, settings)
     rows = _finding_dicts(mesh, hits, settings, conversion.original_face if convert.get("evaluated") else None)
     return ObjectCheck(conversion, settings, hits, rows, notes)
@@ -98,22 +97,40 @@ def _finding_dicts(mesh, hits, settings, original_face) -> list[dict]:
     return rows
 
 
-def face_error(hits, n_faces: int) -> np.ndarray:
-    """(n_faces,) float32: how many times over (or under) its limit each face's worst finding is.
+def severity(hits) -> np.ndarray:
+    """(n,) float64: how many times over (or under) its limit each finding of one rule is.
 
     A flagged value v against a positive threshold t reads max(v / t, t / v):
     2.0 is twice the limit for the rules that flag above it, half the limit
     for those that flag at or below it (Q201, Q301), without this module having
     to know which is which. Findings without a threshold, or with a value that
-    is not positive, count as 1.0. Faces without findings are 0.
+    is not positive, read 1.0. The worst finding of a rule is the most severe.
+
+    Parameters
+    ----------
+    hits : RuleHits with ``values`` (n,) float64 and ``threshold``
+    """
+    v = hits.values
+    ratio = np.ones(len(v))
+    if hits.threshold > 0:
+        positive = v > 0
+        ratio[positive] = np.maximum(v[positive] / hits.threshold, hits.threshold / v[positive])
+    return ratio
+
+
+def face_error(hits, face_map: np.ndarray, n_faces: int) -> np.ndarray:
+    """(n_faces,) float32 per-face error: the :func:`severity` of the face's worst finding, 0 if none.
+
+    Parameters
+    ----------
+    hits : list of RuleHits, faces numbered like the converted mesh
+    face_map : (F,) int64, the face of the ``n_faces`` target mesh each converted face
+        maps to (-1: none), e.g. :attr:`Conversion.original_face`
     """
     error = np.zeros(n_faces, dtype=np.float64)
     for h in hits:
-        on_face = h.faces >= 0  # Q205 is about the file, face -1
-        v = h.values[on_face]
-        ratio = np.ones(len(v))
-        if h.threshold > 0:
-            positive = v > 0
-            ratio[positive] = np.maximum(v[positive] / h.threshold, h.threshold / v[positive])
-        np.maximum.at(error, h.faces[on_face], ratio)
+        on_face = h.faces >= 0  # Q205 is about the whole mesh: face -1
+        target = face_map[h.faces[on_face]]
+        mapped = target >= 0
+        np.maximum.at(error, target[mapped], severity(h)[on_face][mapped])
     return error.astype(np.float32)

@@ -72,9 +72,16 @@ def srgb_colors(attribute) -> np.ndarray:
     return read_floats(attribute.data, "color_srgb", 4)[:, :3]
 
 
-def active_color_attribute(mesh):
-    """The mesh's active colour attribute, or None."""
-    return mesh.color_attributes.active_color
+def color_attribute(mesh, skip: str):
+    """The mesh's active colour attribute, or the first other one when the active one is ``skip``.
+
+    ``color_attributes.active_color`` (Blender 3.2+) replaced the legacy
+    ``vertex_colors.active``. None when the mesh has no colour attribute but ``skip``.
+    """
+    active = mesh.color_attributes.active_color
+    if active is not None and active.name != skip:
+        return active
+    return next((a for a in mesh.color_attributes if a.name != skip), None)
 
 
 def material_node_tree(material):

@@ -34,6 +34,10 @@ from . import compat
 
 #: Face attribute that carries original polygon indices (+ 1) through the modifier stack.
 ORIGINAL_FACE = "affinity_original_face"
+#: The extension's output: per-face error (float, face domain) and its picture (colour, corner
+#: domain) for the viewport's Attribute colouring. The colours are never read back as vertex colours.
+ERROR_ATTRIBUTE = "affinity_error"
+ERROR_COLOR = "affinity_error_color"
 
 
 @dataclass(eq=False)
@@ -144,25 +148,18 @@ def _convert(obj, me, uv_layer: str | None) -> Conversion:
     linear, offset = matrix[:3, :3], matrix[:3, 3]
 
     positions = compat.read_floats(me.vertices, "co", 3) @ linear.T + offset
-    loop_start = compat.read_ints(me.polygons, "loop_start")
-    loop_total = compat.read_ints(me.polygons, "loop_total")
-    face_start = np.concatenate([[0], np.cumsum(loop_total)]).astype(np.int64)
-    # Blender stores each polygon's loops contiguously; corner c of the Mesh is loop `loops[c]`.
-    loops = np.repeat(loop_start - face_start[:-1], loop_total) + np.arange(face_start[-1])
+    face_start, loops = polygon_corners(me)
     corner_vertex = compat.read_ints(me.loops, "vertex_index")[loops]
-    n_faces, n_corners = len(loop_total), len(loops)
+    n_faces, n_corners = len(face_start) - 1, len(loops)
 
     # Normals are covectors: they map with the inverse transpose (lint rescales them to unit length).
     normals = compat.corner_normals(me)[loops] @ np.linalg.inv(linear)
-    notes = []
 
     layer = me.uv_layers.get(uv_layer) if uv_layer is not None else me.uv_layers.active
     texcoords = compat.uv_coordinates(layer)[loops] if layer is not None else None
-    if layer is None:
-        notes.append("Q101 skipped: the mesh has no UV map")
 
     colors, color_name = None, None
-    color = compat.active_color_attribute(me)
+    color = compat.color_attribute(me, skip=ERROR_COLOR)
     if color is not None:
         color_name = color.name
         rgb = compat.srgb_colors(color)
@@ -194,7 +191,25 @@ def _convert(obj, me, uv_layer: str | None) -> Conversion:
         material_textures={name: t.path for name, t in textures.items() if t.path is not None},
     )
     texture = textures.get(active.name) if active is not None else None
-    return Conversion(mesh, None, layer.name if layer is not None else None, color_name, texture, notes)
+    return Conversion(mesh, None, layer.name if layer is not None else None, color_name, texture)
+
+
+def polygon_corners(me) -> tuple[np.ndarray, np.ndarray]:
+    """Corner layout of a ``bpy.types.Mesh``'s polygons, in polygon order.
+
+    Returns
+    -------
+    face_start : (F + 1,) int64
+        Polygon ``f`` owns corners ``face_start[f]:face_start[f + 1]``.
+    loops : (C,) int64
+        The Blender loop of every corner (the identity for every mesh Blender
+        makes, which stores a polygon's loops contiguously and in order).
+    """
+    loop_start = compat.read_ints(me.polygons, "loop_start")
+    loop_total = compat.read_ints(me.polygons, "loop_total")
+    face_start = np.concatenate([[0], np.cumsum(loop_total)]).astype(np.int64)
+    loops = np.repeat(loop_start - face_start[:-1], loop_total) + np.arange(face_start[-1])
+    return face_start, loops
 
 
 def _split_by_corner_color(positions, corner_vertex, corner_rgb):
