@@ -216,7 +216,7 @@ class AFFINITY_OT_check(bpy.types.Operator):
                 row.object_name, row.code, row.rule_name = obj.name, hits.code, RULES[hits.code].name
                 row.count, row.worst = len(hits), float(hits.values[order[0]])
                 row.unit = "" if props.measure == "barycentric" and hits.code == "Q101" else RULES[hits.code].unit
-                row.selectable = mapping is not None and hits.faces[0] >= 0
+                row.selectable = bool(mapping is not None and hits.faces[0] >= 0)
                 if row.selectable:
                     faces = mapping[hits.faces[order]]
                     faces = faces[faces >= 0]
