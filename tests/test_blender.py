@@ -19,9 +19,9 @@ import pytest
 
 bpy = pytest.importorskip("bpy")
 
-from affinity.blender import addon, findings, mesh_from_object  # noqa: E402
-from affinity.blender.check import check_object  # noqa: E402
-from affinity.blender.convert import ERROR_ATTRIBUTE, ERROR_COLOR, ORIGINAL_FACE  # noqa: E402
+from affinity.blender import addon, findings, mesh_from_object
+from affinity.blender.check import check_object
+from affinity.blender.convert import ERROR_ATTRIBUTE, ERROR_COLOR, ORIGINAL_FACE
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -76,7 +76,7 @@ def textured(obj, image_path: Path, size=(512, 256)):
 def cli_json(path: Path, *args: str) -> dict:
     result = subprocess.run(
         [sys.executable, "-m", "affinity.cli", "check", "--format", "json", *args, str(path)],
-        capture_output=True, text=True, timeout=300,
+        capture_output=True, text=True, timeout=300, check=False,
     )
     assert result.returncode in (0, 1), result.stderr
     return json.loads(result.stdout)
@@ -294,7 +294,7 @@ def _run_isolated(script: str, env_extra: dict, cwd: Path) -> subprocess.Complet
     env.update(env_extra)
     return subprocess.run(
         [sys.executable, "-S", "-c", script, site_packages],
-        capture_output=True, text=True, env=env, cwd=cwd, timeout=600,
+        capture_output=True, text=True, env=env, cwd=cwd, timeout=600, check=False,
     )
 
 
@@ -341,7 +341,7 @@ print("bpy installed:", importlib.util.find_spec("bpy") is not None)
     site_packages = sysconfig.get_paths()["purelib"]  # where bpy and NumPy are installed
     result = subprocess.run(
         [sys.executable, "-S", "-c", script, str(ROOT), site_packages],
-        capture_output=True, text=True, cwd=tmp_path, timeout=300,
+        capture_output=True, text=True, cwd=tmp_path, timeout=300, check=False,
     )
     assert result.returncode == 0, result.stderr
     assert "bpy loaded: False" in result.stdout

@@ -186,7 +186,7 @@ class AFFINITY_OT_check(bpy.types.Operator):
 
     bl_idname = "affinity.check"
     bl_label = "Check"
-    bl_options = {"REGISTER", "UNDO"}
+    bl_options = {"REGISTER", "UNDO"}  # noqa: RUF012 (Blender reads a set)
 
     @classmethod
     def poll(cls, context):
@@ -261,7 +261,7 @@ class AFFINITY_OT_select(bpy.types.Operator):
 
     bl_idname = "affinity.select"
     bl_label = "Select Flagged"
-    bl_options = {"REGISTER", "UNDO"}
+    bl_options = {"REGISTER", "UNDO"}  # noqa: RUF012 (Blender reads a set)
 
     index: IntProperty(name="Row", default=-1, description="Results row; -1 takes the active one")
 
@@ -280,7 +280,7 @@ class AFFINITY_OT_next(bpy.types.Operator):
 
     bl_idname = "affinity.next"
     bl_label = "Next"
-    bl_options = {"REGISTER", "UNDO"}
+    bl_options = {"REGISTER", "UNDO"}  # noqa: RUF012 (Blender reads a set)
 
     index: IntProperty(name="Row", default=-1, description="Results row; -1 takes the active one")
 
