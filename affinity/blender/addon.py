@@ -256,30 +256,9 @@ def _flagged_faces(operator, row):
     return obj, faces
 
 
-class AFFINITY_OT_select(bpy.types.Operator):
-    """Select the faces this rule flagged, in Edit Mode"""
+class _RowOperator:
+    """Mixin of the operators that act on one results row's faces."""
 
-    bl_idname = "affinity.select"
-    bl_label = "Select Flagged"
-    bl_options = {"REGISTER", "UNDO"}  # noqa: RUF012 (Blender reads a set)
-
-    index: IntProperty(name="Row", default=-1, description="Results row; -1 takes the active one")
-
-    def execute(self, context):
-        found = _flagged_faces(self, _row(context, self.index))
-        if found is None:
-            return {"CANCELLED"}
-        obj, faces = found
-        select_faces(context, obj, faces)
-        self.report({"INFO"}, f"{len(faces)} faces selected on {obj.name}")
-        return {"FINISHED"}
-
-
-class AFFINITY_OT_next(bpy.types.Operator):
-    """Select the next worst face this rule flagged and frame it in the view"""
-
-    bl_idname = "affinity.next"
-    bl_label = "Next"
     bl_options = {"REGISTER", "UNDO"}  # noqa: RUF012 (Blender reads a set)
 
     index: IntProperty(name="Row", default=-1, description="Results row; -1 takes the active one")
@@ -289,14 +268,34 @@ class AFFINITY_OT_next(bpy.types.Operator):
         found = _flagged_faces(self, row)
         if found is None:
             return {"CANCELLED"}
-        obj, faces = found
+        self.act(context, row, *found)
+        return {"FINISHED"}
+
+
+class AFFINITY_OT_select(_RowOperator, bpy.types.Operator):
+    """Select the faces this rule flagged, in Edit Mode"""
+
+    bl_idname = "affinity.select"
+    bl_label = "Select Flagged"
+
+    def act(self, context, row, obj, faces):
+        select_faces(context, obj, faces)
+        self.report({"INFO"}, f"{len(faces)} faces selected on {obj.name}")
+
+
+class AFFINITY_OT_next(_RowOperator, bpy.types.Operator):
+    """Select the next worst face this rule flagged and frame it in the view"""
+
+    bl_idname = "affinity.next"
+    bl_label = "Next"
+
+    def act(self, context, row, obj, faces):
         row.cursor = (row.cursor + 1) % len(faces)
         select_faces(context, obj, faces[row.cursor : row.cursor + 1])
         if context.area is not None and context.area.type == "VIEW_3D":
             bpy.ops.view3d.view_selected()
         self.report({"INFO"}, f"{row.code} on {obj.name}: face {faces[row.cursor]} "
                               f"({row.cursor + 1} of {len(faces)})")
-        return {"FINISHED"}
 
 
 class AFFINITY_UL_results(bpy.types.UIList):
