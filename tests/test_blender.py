@@ -119,6 +119,16 @@ def test_texel_unit_follows_the_base_color_image(tmp_path):
     np.testing.assert_allclose([at_256[f] for f in faces], [at_default[f] / 4 for f in faces], rtol=1e-9)
 
 
+def test_panel_names_the_texture_that_sets_the_texel_unit(tmp_path):
+    sphere = uv_sphere()
+    props = bpy.context.scene.affinity
+    assert addon.texture_line(sphere, props) == "Texture size: 1024 px (no Base Color image)"
+    props.texture_size = 300
+    assert addon.texture_line(sphere, props) == "Texture size: 300 px (set here)"
+    textured(sphere, tmp_path / "checker.png")
+    assert addon.texture_line(sphere, props) == "Texture: checker 512 x 256 px (file)"
+
+
 def test_world_matrix_is_applied():
     bpy.ops.mesh.primitive_plane_add(size=2, location=(1, 2, 3))
     plane = bpy.context.object

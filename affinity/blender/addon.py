@@ -56,8 +56,8 @@ def _settings_annotations() -> dict:
         ),
         "texture_size": IntProperty(
             name="Texture size", default=0, min=0, soft_max=16384,
-            description="Pixels for the texel unit; 0 takes the Base Color image of the material, "
-                        f"else {defaults.texture_size}",
+            description="Pixels for the texel unit when the Base Color image is not a file on disk "
+                        f"(0: that image's size, or {defaults.texture_size} without one)",
         ),
         "use_modifiers": BoolProperty(
             name="With modifiers", default=False,
@@ -312,14 +312,19 @@ class AFFINITY_UL_results(bpy.types.UIList):
 
 
 def texture_line(obj, props) -> str:
-    """What the panel says about the texel unit of the active object."""
+    """What the panel says about the texel unit of the active object.
+
+    As in ``affinity check``, an image file wins over the size set here; the set
+    size wins over a packed or generated image's own size.
+    """
+    texture = base_color_texture(obj.active_material) if obj is not None and obj.type == "MESH" else None
+    if texture is not None and texture.path is not None:
+        return f"Texture: {texture.image} {texture.size[0]} x {texture.size[1]} px (file)"
     if props.texture_size > 0:
         return f"Texture size: {props.texture_size} px (set here)"
-    texture = base_color_texture(obj.active_material) if obj is not None and obj.type == "MESH" else None
-    if texture is None:
-        return f"Texture size: {Settings().texture_size} px (no Base Color image)"
-    width, height = texture.size
-    return f"Texture: {texture.image} {width} x {height} px"
+    if texture is not None:
+        return f"Texture: {texture.image} {texture.size[0]} x {texture.size[1]} px (not a file)"
+    return f"Texture size: {Settings().texture_size} px (no Base Color image)"
 
 
 class AFFINITY_PT_panel(bpy.types.Panel):
