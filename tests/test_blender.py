@@ -94,8 +94,11 @@ def test_uv_sphere_gives_the_same_findings_as_its_obj_export_checked_by_the_cli(
     bpy.ops.wm.obj_export(filepath=str(exported), path_mode="COPY", export_materials=True)
     assert (exported.parent / "checker.png").is_file()
 
-    in_memory = by_code_and_face(findings(sphere))
+    rows = findings(sphere)
+    in_memory = by_code_and_face(rows)
     document = cli_json(exported)
+    assert set(document["findings"][0]) <= set(rows[0])  # every key of a JSON finding, and more
+    assert {rows[0]["unit"], rows[0]["level"], rows[0]["group"]} == {"texels", "warning", sphere.name}
     on_file = by_code_and_face(document["findings"])
     assert document["files"][0]["faces"] == len(sphere.data.polygons)
     assert {code for code, _ in in_memory} == {"Q101"}
@@ -205,6 +208,20 @@ def test_next_walks_the_flagged_faces_worst_first():
     values = {r["face"]: r["value"] for r in q101}
     assert [values[f] for f in seen] == sorted((values[f] for f in seen), reverse=True)
     assert values[seen[0]] == q101[0]["value"] and len(set(seen)) == 3
+
+
+def test_check_lints_every_selected_mesh_object():
+    with_uv = uv_sphere()
+    without_uv = uv_sphere()
+    without_uv.data.uv_layers.remove(without_uv.data.uv_layers[0])
+    bpy.ops.object.camera_add()  # selected too, and not a mesh
+    for obj in (with_uv, without_uv):
+        obj.select_set(True)
+    assert bpy.ops.affinity.check() == {"FINISHED"}
+    props = bpy.context.scene.affinity
+    assert [(r.object_name, r.code) for r in props.results] == [(with_uv.name, "Q101")]
+    assert props.notes == f"{without_uv.name}: Q101 skipped: the mesh has no UV map"
+    assert props.checked == 2
 
 
 def test_mesh_without_uv_skips_q101_and_says_so():
