@@ -1,0 +1,136 @@
+"""Lint a Blender object in memory: findings as JSON-like dicts, and a per-face error.
+
+``affinity.lint`` and ``affinity.settings`` are imported when a check runs, not
+when this module is imported (the lint core is being restructured; these two
+import paths stay).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .convert import Conversion, convert_object
+
+_CONVERSION_OPTIONS = ("evaluated", "uv_layer")
+
+
+@dataclass(eq=False)
+class ObjectCheck:
+    """The outcome of linting one object.
+
+    ``hits`` are the lint's :class:`~affinity.findings.RuleHits` (faces numbered
+    like the converted mesh's polygons); ``findings`` the same as dicts with the
+    keys of a JSON finding plus ``unit`` and ``level`` (and ``original_face`` for
+    an evaluated mesh); ``notes`` say what was skipped and why.
+    """
+
+    conversion: Conversion
+    settings: object
+    hits: list
+    findings: list[dict]
+    notes: list[str] = field(default_factory=list)
+
+
+def findings(obj, **settings) -> list[dict]:
+    """Lint the mesh of ``obj`` and return every finding as a dict.
+
+    Keyword arguments are the fields of :class:`affinity.settings.Settings`
+    (``select``, ``ignore``, ``thresholds``, ``measure``, ``diagonal``,
+    ``texture_size``) plus ``evaluated`` and ``uv_layer`` of
+    :func:`~affinity.blender.convert.mesh_from_object`. Each dict has the keys
+    of a finding in ``affinity check --format json`` (``path`` is the object's
+    name, ``line`` and ``column`` are 0, ``face`` the polygon index) and
+    ``unit`` and ``level``.
+    """
+    return check_object(obj, **settings).findings
+
+
+def check_object(obj, **options) -> ObjectCheck:
+    """:func:`findings` with the conversion, the raw hits and the notes for the panel.
+
+    Texture size for the texel unit, in order: the image file named by a material
+    (as ``affinity check`` reads ``map_Kd``), an explicit ``texture_size``, the
+    size of the active material's Base Color image (packed or generated), the
+    default of :class:`~affinity.settings.Settings`.
+    """
+    from ..lint import lint_mesh
+    from ..rules import resolve_codes
+    from ..settings import Settings
+
+    convert = {k: options.pop(k) for k in _CONVERSION_OPTIONS if k in options}
+    conversion = convert_object(obj, **convert)
+    mesh, texture = conversion.mesh, conversion.texture
+    notes = list(conversion.notes)
+    if conversion.uv_layer is None and "Q101" in resolve_codes(options.get("select"), options.get("ignore")):
+        notes.append("Q101 skipped: the mesh has no UV map")
+    if mesh.texture_path() is None and texture is not None and "texture_size" not in options:
+        options["texture_size"] = max(texture.size)
+        if texture.size[0] != texture.size[1]:
+            notes.append(f"texture {texture.image} is not square and not a file: "
+                         f"texels counted at {max(texture.size)} px both ways")
+    settings = Settings(**options)
+    hits = lint_mesh(mesh, settings)
+    rows = _finding_dicts(mesh, hits, settings, conversion.original_face if convert.get("evaluated") else None)
+    return ObjectCheck(conversion, settings, hits, rows, notes)
+
+
+def _finding_dicts(mesh, hits, settings, original_face) -> list[dict]:
+    from ..findings import FileReport
+    from ..output import file_findings
+    from ..rules import RULES
+
+    report = FileReport(path=mesh.path, counts=mesh.counts(), hits=hits, group_names=mesh.group_names)
+    rows = []
+    for finding in file_findings(report)[0]:
+        row = dataclasses.asdict(finding)
+        del row["prim"]
+        rule = RULES[finding.code]
+        barycentric = settings.measure == "barycentric" and finding.code == "Q101"
+        row.setdefault("unit", "" if barycentric else rule.unit)
+        row.setdefault("level", rule.level)
+        if original_face is not None:
+            row["original_face"] = int(original_face[finding.face]) if finding.face >= 0 else -1
+        rows.append(row)
+    return rows
+
+
+def severity(hits) -> np.ndarray:
+    """(n,) float64: how many times over (or under) its limit each finding of one rule is.
+
+    A flagged value v against a positive threshold t reads max(v / t, t / v):
+    2.0 is twice the limit for the rules that flag above it, half the limit
+    for those that flag at or below it (Q201, Q301), without this module having
+    to know which is which. Findings without a threshold, or with a value that
+    is not positive, read 1.0. The worst finding of a rule is the most severe.
+
+    Parameters
+    ----------
+    hits : RuleHits with ``values`` (n,) float64 and ``threshold``
+    """
+    v = hits.values
+    ratio = np.ones(len(v))
+    if hits.threshold > 0:
+        positive = v > 0
+        ratio[positive] = np.maximum(v[positive] / hits.threshold, hits.threshold / v[positive])
+    return ratio
+
+
+def face_error(hits, face_map: np.ndarray, n_faces: int) -> np.ndarray:
+    """(n_faces,) float32 per-face error: the :func:`severity` of the face's worst finding, 0 if none.
+
+    Parameters
+    ----------
+    hits : list of RuleHits, faces numbered like the converted mesh
+    face_map : (F,) int64, the face of the ``n_faces`` target mesh each converted face
+        maps to (-1: none), e.g. :attr:`Conversion.original_face`
+    """
+    error = np.zeros(n_faces, dtype=np.float64)
+    for h in hits:
+        on_face = h.faces >= 0  # Q205 is about the whole mesh: face -1
+        target = face_map[h.faces[on_face]]
+        mapped = target >= 0
+        np.maximum.at(error, target[mapped], severity(h)[on_face][mapped])
+    return error.astype(np.float32)
