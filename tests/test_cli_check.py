@@ -50,7 +50,7 @@ def test_trapezoid_is_flagged_with_ruff_style_line(tmp_path):
     match = TEXT_LINE.match(lines[0])
     assert match, lines[0]
     assert (match["line"], match["col"], match["code"], match["name"]) == ("10", "1", "Q101", "uv-disaffine")
-    assert (match["value"], match["threshold"], match["unit"], match["face"]) == ("256", "0.5", "texels", "0")
+    assert (match["value"], match["threshold"], match["unit"], match["face"]) == ("175.7", "0.5", "texels", "0")
 
 
 def test_json_document_carries_every_field(tmp_path):
