@@ -238,14 +238,6 @@ class PlanarQuads:
         return plane_coordinates(corners) if len(self.components) == 3 else corners
 
     @cached_property
-    def warp(self) -> np.ndarray:
-        """(Q,) float64 ``nonplanarity`` of 3-D quads."""
-        e0 = self.components[:, 1] - self.components[:, 0]
-        d02, d13 = self.diagonals[:, 0], self.diagonals[:, 1]
-        parallel = np.sqrt(squared_lengths(self.normals)) <= DEGENERATE_AREA * d02 * d13
-        return _warp(e0, self.normals, d02, d13, parallel)
-
-    @cached_property
     def valid(self) -> np.ndarray:
         """(Q, 4) bool: the triangle opposite corner i is not degenerate
         (its area exceeds ``DEGENERATE_AREA`` times the squared longest edge)."""

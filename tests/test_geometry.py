@@ -156,3 +156,33 @@ def test_an_area_within_rounding_of_zero_is_degenerate():
     # A unit square there is not degenerate: the rounding area is about 4e-6 of it.
     square = planar_quads(np.array([[[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]]) + 1e9)
     assert far.rounding[0] < 1e-5 and degeneracy(square)[0] == pytest.approx(0.5)
+
+
+@pytest.mark.parametrize("diagonal", ["02", "13", "both"])
+def test_q202_fold_angle_agrees_with_libigl_face_normals(diagonal):
+    """The value Q202 reports is the angle between libigl's normals of the split's two triangles."""
+    igl = pytest.importorskip("igl")
+    from affinity.lint import lint_mesh
+    from affinity.mesh import mesh_from_polygons
+    from affinity.settings import Settings
+
+    rng = np.random.default_rng(5)
+    base = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], float)
+    corners = base + rng.normal(scale=0.15, size=(400, 4, 3))
+    # Convex quads only: on a concave one the fold is taken on the quad's side (a flat dart folds nothing).
+    normal = np.cross(corners[:, 2] - corners[:, 0], corners[:, 3] - corners[:, 1])
+    edges = np.roll(corners, -1, axis=1) - corners
+    turns = np.einsum("qck,qk->qc", np.cross(edges, np.roll(edges, -1, axis=1)), normal)
+    corners = corners[(turns > 0).all(axis=1)][:300]
+    mesh = mesh_from_polygons("random", corners.reshape(-1, 3), np.arange(1200).reshape(-1, 4))
+    (hits,) = lint_mesh(mesh, Settings(select=["Q202"], thresholds={"Q202": -1.0}, diagonal=diagonal))
+    assert hits.faces.tolist() == list(range(300))
+
+    def fold(triangles):
+        faces = np.arange(1200).reshape(-1, 4)[:, triangles].reshape(-1, 3)
+        normals = igl.per_face_normals(corners.reshape(-1, 3), faces, np.zeros(3)).reshape(-1, 2, 3)
+        return np.degrees(np.arccos(np.clip((normals[:, 0] * normals[:, 1]).sum(axis=1), -1, 1)))
+
+    folds = {"02": fold([[0, 1, 2], [0, 2, 3]]), "13": fold([[1, 2, 3], [1, 3, 0]])}
+    expected = np.maximum(folds["02"], folds["13"]) if diagonal == "both" else folds[diagonal]
+    np.testing.assert_allclose(hits.values, expected, atol=1e-6)
