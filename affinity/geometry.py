@@ -193,14 +193,6 @@ def _corner_turns(e: np.ndarray) -> np.ndarray:
     return turns
 
 
-def _warp(e0: np.ndarray, normal: np.ndarray, d02: np.ndarray, d13: np.ndarray, parallel: np.ndarray) -> np.ndarray:
-    """Relative warp |e0 . n| / (|n| (|d02| + |d13|) / 2), 0 where the diagonals are
-    ``parallel``; e0 (3, Q), n (3, Q) = d02 x d13, diagonal lengths (Q,)."""
-    distance = np.abs(e0[0] * normal[0] + e0[1] * normal[1] + e0[2] * normal[2])
-    denominator = np.sqrt(squared_lengths(normal)) * (d02 + d13) / 2
-    return np.divide(distance, denominator, out=np.zeros_like(distance), where=~parallel)
-
-
 @dataclass(frozen=True)
 class PlanarQuads:
     """Quads seen in their own planes, with what the measures share.
@@ -380,7 +372,10 @@ def nonplanarity(corners: np.ndarray) -> np.ndarray:
         normal[d] = d02[u] * d13[v] - d02[v] * d13[u]
     length02, length13 = np.sqrt(squared_lengths(d02)), np.sqrt(squared_lengths(d13))
     parallel = np.sqrt(squared_lengths(normal)) <= DEGENERATE_AREA * length02 * length13
-    return _warp(p[:, 1] - p[:, 0], normal, length02, length13, parallel)
+    e0 = p[:, 1] - p[:, 0]
+    distance = np.abs(e0[0] * normal[0] + e0[1] * normal[1] + e0[2] * normal[2])
+    denominator = np.sqrt(squared_lengths(normal)) * (length02 + length13) / 2
+    return np.divide(distance, denominator, out=np.zeros_like(distance), where=~parallel)
 
 
 def _reflex(quads: PlanarQuads) -> np.ndarray:
