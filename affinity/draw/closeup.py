@@ -23,6 +23,8 @@ TILT_DEGREES = 20.0
 FILL = 0.85
 #: Faces whose centroid is within this many ring radii of the place are drawn.
 DRAWN_RADII = 2.5
+#: A ring reaching farther than this many place radii (long neighbours, a pole) is framed at that distance.
+RING_RADII = 3.0
 
 
 @dataclass(frozen=True)
@@ -82,13 +84,16 @@ def mean_normal(mesh: Mesh, faces: np.ndarray) -> np.ndarray:
 def closeup_view(mesh: Mesh, place: np.ndarray, aspect: float = 1.0) -> CloseupView:
     """Frame a camera on ``place`` (P,) int64 mesh faces: along their mean normal, tilted by ``TILT_DEGREES``.
 
-    The distance fits the bounding sphere of the place's ring (:func:`ring_of`)
-    into ``FILL`` of the narrower half field of view.
+    The distance fits the bounding sphere of the place's ring (:func:`ring_of`),
+    at most ``RING_RADII`` times the place's own, into ``FILL`` of the narrower
+    half field of view.
     """
     ring = ring_of(mesh, place)
     ring_points = mesh.positions[face_vertices(mesh, ring)[0]]
-    target = mesh.positions[face_vertices(mesh, place)[0]].mean(axis=0)
-    radius = float(np.linalg.norm(ring_points - target, axis=1).max())
+    place_points = mesh.positions[face_vertices(mesh, place)[0]]
+    target = place_points.mean(axis=0)
+    own = float(np.linalg.norm(place_points - target, axis=1).max())
+    radius = min(float(np.linalg.norm(ring_points - target, axis=1).max()), RING_RADII * own)
     radius = radius if radius > 0 else 1.0
     normal = mean_normal(mesh, place)
     # Tilt toward the world axis least aligned with the normal: a fixed, reproducible side.

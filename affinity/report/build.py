@@ -60,6 +60,7 @@ class MeshResult:
     and ``up`` are the view of the renders and the overview. ``places`` are every
     flagged place, ranked (:func:`affinity.report.places.choose_places` with no
     limit); ``closeups`` the pictures of the first ``options.max_views``.
+    ``stability`` is the scene's :class:`affinity.report.stiffness.SceneStability`.
     """
 
     input: MeshInput
@@ -83,6 +84,7 @@ class MeshResult:
     places: list = field(default_factory=list)
     closeups: list = field(default_factory=list)
     closeup_seconds: float = 0.0
+    stability: object | None = None
 
     @property
     def readable(self) -> bool:
@@ -212,6 +214,12 @@ def collect_mesh(item: MeshInput, settings: Settings, step: Callable[[str], None
         _view(result)
         texture = options.texture or (checker(512, item.view.checks) if item.view.checks and has_uv else None)
         _render(result, texture, step)
+        if "hybrid" in result.renders:
+            from .stiffness import scene_stability
+
+            step("stability")
+            result.stability = scene_stability(result.mesh, result.renders["hybrid"], result.camera, result.up,
+                                               options.size)
         _overview(result, step)
         if result.mesh.n_faces:
             _closeups(result, step)

@@ -48,6 +48,10 @@ def svg_markup(figure) -> str:
         figure.savefig(out, format="svg", metadata={"Date": None, "Creator": None})
     text = out.getvalue()
     text = text[text.index("<svg"):]
+    # Inline in HTML, the SVG needs no namespace declarations (the parser knows svg and xlink:href) nor the
+    # RDF metadata; both would only put URLs into a page that references nothing outside itself.
+    text = re.sub(r"<metadata>.*?</metadata>\s*", "", text, flags=re.S)
+    text = re.sub(r'\s+xmlns(:\w+)?="[^"]*"', "", text)
     text = re.sub(r'(<svg[^>]*?) width="([\d.]+)pt" height="([\d.]+)pt"', r'\1 width="\2" height="\3" class="chart"', text, count=1)
     return text
 
@@ -95,6 +99,15 @@ STUDY_METHODS = {"split": "#c2410c", "mvc": "#1d4ed8", "bilinear": "#15803d", "p
 HYBRID_COLOUR = "#db2777"
 
 
+def _plain_log(axis, subs) -> None:
+    """Label a log axis with plain numbers at ``subs`` times each decade, and no minor labels."""
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+    axis.set_major_locator(LogLocator(base=10, subs=subs, numticks=6))
+    axis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
+    axis.set_minor_formatter(NullFormatter())
+
+
 def study_chart(rows: list[dict], scenes: list[str]) -> str:
     """Error against run time from the committed study, one panel per scene (2 columns), as inline SVG.
 
@@ -125,6 +138,8 @@ def study_chart(rows: list[dict], scenes: list[str]) -> str:
                             color=STUDY_METHODS[row["method"]], markersize=5, capsize=2, label=row["method"])
         ax.set_xscale("log")
         ax.set_yscale("log")
+        _plain_log(ax.xaxis, (1.0, 2.0, 5.0))
+        _plain_log(ax.yaxis, (1.0,))
         ax.set_title(scene, fontsize=TEXT_PX, loc="left")
         ax.set_xlabel("time (ms), median of repeats", fontsize=TEXT_PX)
         ax.set_ylabel(f"RMS error ({of_scene[0]['unit']})", fontsize=TEXT_PX)

@@ -354,6 +354,28 @@ def uv_layout_section(result: MeshResult) -> Section:
     return Section("uv-layout", title, {"svg": svg, "flagged": int(flagged.sum()), "labelled": min(len(labelled), 8)})
 
 
+def stability_section(result: MeshResult) -> Section:
+    """The drawn pixels of this scene whose mean value coordinates are stiff, checked against mpmath."""
+    from .stiffness import STIFF_CONDITION
+
+    title = "Numerical stability"
+    found = result.stability
+    if found is None:
+        return leave_out("stability", title, f"cannot render: {result.render_error}")
+    if found.screened == 0:
+        return leave_out("stability", title, "no pixel is drawn with mean value coordinates in this view, so none "
+                                             "can be stiff (split pixels are triangle barycentrics)")
+    if not found.stiff:
+        worst = max((pixel.condition for pixel in found.checked), default=0.0)
+        return leave_out("stability", title, f"nothing is stiff: of {found.screened} mvc pixels, the "
+                         f"{len(found.checked)} where float32 strays most from float64 have condition at most "
+                         f"{worst:.3g} (stiff: {STIFF_CONDITION:g}) and errors within tolerance against mpmath")
+    rows = [{"face": p.face, "pixel": f"{p.pixel[0]}, {p.pixel[1]}", "condition": f"{p.condition:.3g}",
+             "e64": f"{p.error64:.2g}", "t64": f"{p.tolerance64:.2g}", "e32": f"{p.error32:.2g}",
+             "t32": f"{p.tolerance32:.2g}", "stiff": p.stiff} for p in found.checked]
+    return Section("stability", title, {"rows": rows, "screened": found.screened, "limit": f"{STIFF_CONDITION:g}"})
+
+
 def overview_section(result: MeshResult) -> Section:
     """The 3-D overview from pyvista: the mesh coloured by affinity score, flagged quads outlined."""
     title = "3-D overview"
@@ -384,8 +406,8 @@ def _viridis_bar(low: float, top: float, label: str) -> str:
 
 #: Sections of each readable mesh, in page order.
 MESH_SECTIONS = (
-    findings_section, closeups_section, uv_layout_section, renders_section, overlay_section, error_heatmaps_section, score_histograms_section,
-    overview_section,
+    findings_section, closeups_section, uv_layout_section, renders_section, overlay_section, error_heatmaps_section,
+    score_histograms_section, stability_section, overview_section,
 )
 #: Sections after the meshes, about the whole product.
 CLOSING_SECTIONS = (study_section,)
