@@ -3,8 +3,8 @@
 A close-up looks at a place (one or more neighbouring faces) along its mean
 normal, tilted a little, from the distance that fits the place and its ring of
 neighbouring faces in the picture. Only the faces near the place are drawn
-(:func:`neighbourhood`), so the place shows whether or not the rest of the mesh
-hides it from the overview's camera.
+(within a few radii, and nothing more than a radius in front of it), so the place
+shows whether or not the rest of the mesh hides it from the overview's camera.
 """
 
 from __future__ import annotations
@@ -107,8 +107,10 @@ def closeup_view(mesh: Mesh, place: np.ndarray, aspect: float = 1.0) -> CloseupV
     distance = radius / (FILL * np.sin(narrow))
     eye = target + distance * direction
     up = "xyz"[int(np.argmin(np.abs(direction)))]
-    centroids = face_centroids(mesh)
-    drawn = np.flatnonzero(np.linalg.norm(centroids - target, axis=1) <= DRAWN_RADII * radius)
+    # Draw what lies around the place, but nothing more than a radius in front of it: an occluder (an eyelid,
+    # a helper cube inside the body, the other side of a thin part) would hide the place.
+    offset = face_centroids(mesh) - target
+    drawn = np.flatnonzero((np.linalg.norm(offset, axis=1) <= DRAWN_RADII * radius) & (offset @ direction <= radius))
     drawn = np.union1d(drawn, ring)
     return CloseupView((tuple(eye.tolist()), tuple(target.tolist()), CLOSEUP_FOV), up, drawn, ring)
 
