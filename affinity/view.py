@@ -11,10 +11,10 @@ import importlib.util
 
 import numpy as np
 
-from .mesh import Mesh
 from .draw.framing import UP_AXES
 from .draw.shading import FLAG_COLOUR
 from .lint import QuadScores
+from .mesh import Mesh
 
 INSTALL_HINT = "pip install 'quad-affinity[view]'"
 SURFACE_GREY = "#d1d5db"

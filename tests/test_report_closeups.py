@@ -96,14 +96,13 @@ def test_places_take_turns_between_rules_worst_first():
 
 
 def test_closeup_camera_looks_at_the_place_along_its_normal_and_fits_its_ring():
-    from render import to_clip
-
     from affinity.draw.closeup import TILT_DEGREES, closeup_view, face_subset
     from affinity.draw.framing import camera_for
+    from render import to_clip
 
     mesh = welded_grid(10)
     view = closeup_view(mesh, np.array([55]))
-    eye, target, fov = view.camera
+    eye, target, _ = view.camera
     np.testing.assert_allclose(target, [5.5, 5.5, 0.0])
     direction = np.subtract(eye, target) / np.linalg.norm(np.subtract(eye, target))
     assert np.degrees(np.arccos(direction[2])) == pytest.approx(TILT_DEGREES)  # the normal is +z

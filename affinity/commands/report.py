@@ -14,8 +14,8 @@ import os
 import sys
 
 from ..errors import UsageError
-from . import EXIT_CLEAN, EXIT_ERROR, require
 from ..report import MAX_VIEWS, RENDER_SIZE
+from . import EXIT_CLEAN, EXIT_ERROR, require
 from .render import _camera, _size
 
 

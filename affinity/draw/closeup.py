@@ -70,7 +70,7 @@ def face_centroids(mesh: Mesh) -> np.ndarray:
 
 def mean_normal(mesh: Mesh, faces: np.ndarray) -> np.ndarray:
     """(3,) unit area-weighted normal of ``faces`` (Newell's vector area of each polygon), or +z if they cancel."""
-    vertices, owner = face_vertices(mesh, faces)
+    vertices, _ = face_vertices(mesh, faces)
     p = mesh.positions[vertices]
     sizes = mesh.face_sizes[faces]
     first = np.repeat(np.cumsum(sizes) - sizes, sizes)

@@ -40,8 +40,8 @@ def guess_up_axis(mesh: Mesh) -> str:
     OBJ convention (Maya, Blender's OBJ export, MakeHuman); pass ``--up z`` for a
     z-up file that is not a surface of revolution (the OpenSubdiv car).
     """
-    from .quads import render_corners
     from ..geometry import quad_normals
+    from .quads import render_corners
 
     if mesh.n_faces == 0:
         return "y"

@@ -19,11 +19,11 @@ import numpy as np
 from ..findings import FileReport
 from ..lint import QuadScores, quad_scores, scored_codes
 from ..mesh import Mesh
-from ..settings import Settings
 from ..scenes import View
+from ..settings import Settings
+from . import MAX_VIEWS, RENDER_SIZE
 from .demo import MeshInput
 
-from . import MAX_VIEWS, RENDER_SIZE
 #: Methods drawn beside the hybrid when it sent quads to mvc (``exact``: the ray / bilinear-patch reference).
 COMPARED_METHODS = ("split", "mvc", "exact")
 #: Side of a close-up picture, pixels.
@@ -198,8 +198,8 @@ def _closeups(result: MeshResult, step: Callable[[str], None]) -> None:
 def collect_mesh(item: MeshInput, settings: Settings, step: Callable[[str], None] = lambda name: None,
                  options: ReportOptions = ReportOptions()) -> MeshResult:
     """Lint, score, render and picture one mesh; an unreadable file gives a result with ``file.error``."""
-    from ..pipeline.check import load_and_check
     from ..draw.texture import checker
+    from ..pipeline.check import load_and_check
 
     start = time.perf_counter()
     step("lint")

@@ -50,7 +50,7 @@ def svg_markup(figure) -> str:
     text = text[text.index("<svg"):]
     # Inline in HTML, the SVG needs no namespace declarations (the parser knows svg and xlink:href) nor the
     # RDF metadata; both would only put URLs into a page that references nothing outside itself.
-    text = re.sub(r"<metadata>.*?</metadata>\s*", "", text, flags=re.S)
+    text = re.sub(r"<metadata>.*?</metadata>\s*", "", text, flags=re.DOTALL)
     text = re.sub(r'\s+xmlns(:\w+)?="[^"]*"', "", text)
     text = re.sub(r'(<svg[^>]*?) width="([\d.]+)pt" height="([\d.]+)pt"', r'\1 width="\2" height="\3" class="chart"', text, count=1)
     return text

@@ -4,7 +4,8 @@ The faces are rasterized with the project's own renderer, uv taken as screen
 positions (an orthographic view of the texture square), so a layout of a
 million quads costs one render. Edges are the pixels where the face changes.
 Faces too small to cover a pixel centre still mark the pixel under their
-centroid, so no flagged face vanishes from the picture.
+centroid, and flagged faces are drawn over the others where faces overlap in uv,
+so no flagged face vanishes from the picture.
 """
 
 from __future__ import annotations
@@ -49,7 +50,9 @@ def layout_image(mesh: Mesh, flagged: np.ndarray, size: int) -> tuple[np.ndarray
         return None
     low, side = uv_bounds(uv.reshape(-1, 2))
     ndc = (uv - low) / side * 2.0 - 1.0
-    clip = np.concatenate([ndc, np.zeros(ndc.shape[:2] + (1,)), np.ones(ndc.shape[:2] + (1,))], axis=-1)
+    # Flagged faces are nearer, so where faces overlap in uv (per-face unit squares, mirrored halves) they show.
+    depth = np.repeat(np.where(flagged[faces], -0.5, 0.0)[:, None, None], 4, axis=1)
+    clip = np.concatenate([ndc, depth, np.ones(ndc.shape[:2] + (1,))], axis=-1)
     frame = rasterize_quads(clip, np.zeros(ndc.shape[:2] + (1,)), size, size, method="split")
     face = np.where(frame.face >= 0, faces[np.maximum(frame.face, 0)], -1)
     image = np.ones((size, size, 3))
