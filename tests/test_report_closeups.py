@@ -253,3 +253,16 @@ def test_every_shared_mesh_with_flags_gets_closeups():
             hits = next(h for h in file.hits if h.code == closeup.place.code)
             assert closeup.place.worst in hits.faces
             assert (np.all(np.isclose(closeup.images["split"], [1.0, 0.1, 0.6], atol=1e-6), axis=2)).sum() >= 10
+
+
+def test_a_pixel_is_stiff_where_the_catalogue_says_the_coordinates_are_ill_conditioned():
+    from affinity.report.stiffness import STIFF_CONDITION, _check
+    from affinity.stability.cases import catalogue
+
+    cases = {case.name: case for case in catalogue()}
+    inside, far = cases["inside"], cases["far-1e4"]  # far outside a quad: weights grow, the condition with them
+    calm = _check(np.asarray(inside.points[0]), np.asarray(inside.quad), np.ones(4), 0, (0, 0))
+    stiff = _check(np.asarray(far.points[0]), np.asarray(far.quad), np.ones(4), 0, (0, 0))
+    assert calm.condition < 10 and not calm.stiff
+    assert calm.error64 <= calm.tolerance64 and calm.error32 <= calm.tolerance32
+    assert stiff.condition > STIFF_CONDITION and stiff.stiff
