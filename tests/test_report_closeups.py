@@ -266,3 +266,23 @@ def test_a_pixel_is_stiff_where_the_catalogue_says_the_coordinates_are_ill_condi
     assert calm.condition < 10 and not calm.stiff
     assert calm.error64 <= calm.tolerance64 and calm.error32 <= calm.tolerance32
     assert stiff.condition > STIFF_CONDITION and stiff.stiff
+
+
+def test_report_options_max_views_and_a_bad_texture(tmp_path):
+    write_obj(grid_mesh(6, bent=[(1, 1), (4, 4)]), tmp_path / "two.obj")
+
+    def report(*args):
+        return subprocess.run([sys.executable, "-m", "affinity.cli", "report", "-q", "two.obj", "-o", "out.html", *args],
+                              capture_output=True, text=True, cwd=tmp_path, timeout=300)
+
+    done = report("--max-views", "1", "--size", "200x150", "--up", "z")
+    assert done.returncode == 0, done.stderr
+    html = (tmp_path / "out.html").read_text(encoding="utf-8")
+    assert html.count("<figure class=\"closeup\"") == 1 and "1 more flagged places not drawn" in html
+    done = report("--max-views", "0")
+    assert done.returncode == 0 and "data-face" not in (tmp_path / "out.html").read_text(encoding="utf-8")
+    (tmp_path / "out.html").unlink()
+    (tmp_path / "not-an-image.png").write_text("hello")
+    failed = report("--texture", "not-an-image.png")
+    assert failed.returncode == 2 and "not-an-image.png: not a readable image" in failed.stderr
+    assert "Traceback" not in failed.stderr and not (tmp_path / "out.html").exists()
