@@ -24,6 +24,7 @@ from .places import Place
 CLOSEUP_METHODS = ("split", "hybrid", "exact")
 #: A place with more faces than this is framed on its worst face and that face's ring.
 FRAMED_FACES = 12
+PLAIN = np.ones((1, 1, 3), dtype=np.float32)
 #: Attribute shown for each scored rule; the geometric rules show uv when the mesh has it.
 SHOW_FOR = {"texcoords": "uv", "colors": "color", "normals": "normal"}
 
@@ -102,8 +103,9 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
     in_place = np.isin(view.drawn, place.faces)
     frames = {}
     for method in CLOSEUP_METHODS:
+        # With the grid, the render's own texture is replaced pixel by pixel: a 1-texel one costs nothing to sample.
         options = RenderOptions(method=method, show=show, width=size, height=size, camera=view.camera, up=view.up,
-                                texture=image_file, pixel_tolerance=pixel_tolerance)
+                                texture=image_file if cell is None else PLAIN, pixel_tolerance=pixel_tolerance)
         try:
             drawn = render_mesh(sub, options)
         except NotImplementedError as err:
