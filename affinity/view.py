@@ -11,10 +11,10 @@ import importlib.util
 
 import numpy as np
 
-from .mesh import Mesh
 from .draw.framing import UP_AXES
 from .draw.shading import FLAG_COLOUR
 from .lint import QuadScores
+from .mesh import Mesh
 
 INSTALL_HINT = "pip install 'quad-affinity[view]'"
 SURFACE_GREY = "#d1d5db"
@@ -43,21 +43,32 @@ def polydata(mesh: Mesh):
     return pv.PolyData(mesh.positions, flat)
 
 
-def build_scene(plotter, mesh: Mesh, scores: QuadScores | None) -> None:
-    """Add the mesh to ``plotter``: coloured by ``scores`` (log scale, grey where unscored), flagged quads outlined."""
+def score_range(scores: QuadScores) -> tuple[float, float]:
+    """The colour range (low, top) of the scores' log colour scale.
+
+    It spans the scores and a decade either side of the threshold; a log scale
+    cannot show 0, so affine quads (score 0 up to rounding) take the lowest colour.
+    """
+    low = min(scores.threshold / 10, max(float(scores.values.min()), scores.threshold * 1e-3))
+    top = max(float(scores.values[np.isfinite(scores.values)].max(initial=low)), scores.threshold * 10)
+    return low, top
+
+
+def build_scene(plotter, mesh: Mesh, scores: QuadScores | None, scalar_bar: bool = True) -> None:
+    """Add the mesh to ``plotter``: coloured by ``scores`` (log scale, grey where unscored), flagged quads outlined.
+
+    ``scalar_bar`` False leaves the colour bar to the caller (the report draws it beside the picture).
+    """
     surface = polydata(mesh)
     if scores is None or len(scores.faces) == 0:
         plotter.add_mesh(surface, color=SURFACE_GREY, show_edges=True, edge_color="#6b7280")
         return
-    # The colour range spans the scores and a decade either side of the threshold; a log
-    # scale cannot show 0, so affine quads (score 0 up to rounding) take the lowest colour.
-    low = min(scores.threshold / 10, max(float(scores.values.min()), scores.threshold * 1e-3))
-    top = max(float(scores.values[np.isfinite(scores.values)].max(initial=low)), scores.threshold * 10)
+    low, top = score_range(scores)
     per_face = np.full(mesh.n_faces, np.nan)
     per_face[scores.faces] = np.clip(scores.values, low, top)
     surface.cell_data[scores.unit] = per_face
     plotter.add_mesh(surface, scalars=scores.unit, cmap="viridis", log_scale=True, clim=(low, top),
-                     nan_color=SURFACE_GREY, show_edges=True, edge_color="#374151",
+                     nan_color=SURFACE_GREY, show_edges=True, edge_color="#374151", show_scalar_bar=scalar_bar,
                      scalar_bar_args={"title": f"{scores.attribute} ({scores.unit})\n", "fmt": "%.2g", "vertical": True,
                                       "position_x": 0.86, "position_y": 0.1, "height": 0.75, "width": 0.06,
                                       "title_font_size": 14, "label_font_size": 12, "color": "#1f2937"})
@@ -66,20 +77,19 @@ def build_scene(plotter, mesh: Mesh, scores: QuadScores | None) -> None:
         plotter.add_mesh(surface.extract_cells(flagged).extract_all_edges(), color=FLAG_COLOUR, line_width=3)
 
 
-def place_camera(plotter, camera: tuple | None, up: str | None) -> None:
-    """``camera`` (eye, target, vertical fov) as in ``RenderOptions``, or pyvista's framing with ``up``."""
-    if camera is None:
-        plotter.view_isometric()
-        if up is not None:
-            plotter.set_viewup(UP_AXES[up])
-        return
-    eye, target, fov = camera
-    plotter.camera_position = [tuple(eye), tuple(target), UP_AXES[up or "y"]]
+def place_camera(plotter, mesh: Mesh, camera: tuple | None, up: str | None, size: tuple[int, int]) -> None:
+    """``camera`` (eye, target, vertical fov) as in ``RenderOptions``; None frames the whole mesh from its
+    broad side with its up axis (``affinity.draw.framing.overview_camera``, the report's view)."""
+    from .draw.framing import overview_camera, up_axis_of
+
+    up = up_axis_of(mesh, up)
+    eye, target, fov = camera or overview_camera(mesh, size[0], size[1], up)
+    plotter.camera_position = [tuple(eye), tuple(target), UP_AXES[up]]
     plotter.camera.view_angle = fov
 
 
 def overview_image(mesh: Mesh, scores: QuadScores | None, camera: tuple | None, up: str | None,
-                   size: tuple[int, int]) -> np.ndarray:
+                   size: tuple[int, int], scalar_bar: bool = True) -> np.ndarray:
     """The scene rendered off-screen: (H, W, 3) uint8."""
     import pyvista as pv
 
@@ -87,8 +97,8 @@ def overview_image(mesh: Mesh, scores: QuadScores | None, camera: tuple | None, 
     plotter = pv.Plotter(off_screen=True, window_size=list(size))
     try:
         plotter.set_background("white")
-        build_scene(plotter, mesh, scores)
-        place_camera(plotter, camera, up)
+        build_scene(plotter, mesh, scores, scalar_bar)
+        place_camera(plotter, mesh, camera, up, size)
         return np.asarray(plotter.screenshot(return_img=True))[..., :3]
     finally:
         plotter.close()
@@ -101,5 +111,5 @@ def show(mesh: Mesh, scores: QuadScores | None, up: str | None) -> None:
     plotter = pv.Plotter(title=f"affinity view: {mesh.path}")
     plotter.set_background("white")
     build_scene(plotter, mesh, scores)
-    place_camera(plotter, None, up)
+    place_camera(plotter, mesh, None, up, tuple(plotter.window_size))
     plotter.show()

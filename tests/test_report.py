@@ -93,6 +93,26 @@ def left_out(node: Node) -> str | None:
     return lines[0].text() if lines else None
 
 
+def left_out_of(article: Node, key: str) -> str | None:
+    """The reason a mesh's section ``key`` is left out, from the mesh's one left-out line; None if it is shown."""
+    lines = article.find_all("p", "mesh-left-out")
+    spans = [span for line in lines for span in line.find_all("span") if span.attrs.get("data-section") == key]
+    assert len(lines) <= 1 and len(spans) <= 1
+    if spans:
+        assert not article.find_all("section", key), "left out and shown"
+        return spans[0].text()
+    return None
+
+
+def charts(node: Node) -> list[str]:
+    """The inline SVG charts' names (their figure's data-chart)."""
+    return [figure.attrs["data-chart"] for figure in node.find_all("figure") if "data-chart" in figure.attrs]
+
+
+def closeup_figures(node: Node) -> list[Node]:
+    return [figure for figure in node.find_all("figure") if "data-face" in figure.attrs]
+
+
 def image_alts(node: Node) -> list[str]:
     return [img.attrs.get("alt", "") for img in node.find_all("img")]
 
@@ -119,16 +139,20 @@ def test_demo_report_builds_with_every_scene(demo):
     trapezoid = mesh_article(doc, "trapezoid.obj")
     renders = section(trapezoid, "renders")
     assert {"split render", "hybrid render", "mvc render"} <= set(image_alts(renders))
-    assert "mvc, face 0" in image_alts(renders)  # the zoomed crop on the one flagged quad
     assert "exact render" in image_alts(renders)
+    (closeup,) = closeup_figures(section(trapezoid, "closeups"))  # the one flagged quad
+    assert (closeup.attrs["data-face"], closeup.attrs["data-rule"]) == ("0", "Q101")
+    assert image_alts(closeup) == ["split, face 0", "hybrid, face 0", "exact, face 0",
+                                   "split error against exact, face 0"]
+    assert "8 cells across face 0" in closeup.text()
+    assert [f.attrs.get("data-view") for f in section(trapezoid, "uv-layout").find_all("figure")] == ["uv-layout"]
     assert len(section(trapezoid, "errors").find_all("img")) == 3  # split, hybrid, mvc against exact
     assert "flagged-quads overlay" in image_alts(section(trapezoid, "overlay"))
-    assert "uv score histogram" in image_alts(section(trapezoid, "scores"))
-    study = section(doc, "study")
-    assert left_out(study) is None and "error against run time chart" in image_alts(study)
-    assert len(study.find_all("table", "study")[0].find_all("tr")) == 1 + 3 * 4  # split, hybrid, mvc, exact per scene
-    stability = section(doc, "stability")
-    assert left_out(stability) is None and "mean_value" in stability.text()
+    assert charts(section(trapezoid, "scores")) == ["uv score histogram"]
+    assert "nothing is stiff" in left_out_of(trapezoid, "stability")  # one mvc quad, well conditioned
+    study = section(doc, "study")  # the committed study's chart, from the package data
+    assert left_out(study) is None and charts(study) == ["error against run time"]
+    assert "trapezoid front" in study.text() and "sphere 100x40 pole" in study.text()
 
 
 def test_demo_report_references_nothing_outside_itself(demo):
@@ -160,20 +184,30 @@ def test_sections_a_mesh_lacks_are_left_out_and_the_others_remain(tmp_path):
     scores = section(colours, "scores")
     assert left_out(scores) is None
     assert "uv (no texture coordinates)" in scores.text()
-    assert "color score histogram" in image_alts(scores) and "uv score histogram" not in image_alts(scores)
+    assert charts(scores) == ["color score histogram"]
+    assert "no texture coordinates" in left_out_of(colours, "uv-layout")
+    (closeup,) = closeup_figures(section(colours, "closeups"))
+    assert (closeup.attrs["data-face"], closeup.attrs["data-rule"]) == ("0", "Q102")  # the disaffine square
+    assert "vertex colours" in closeup.text()
     renders = section(colours, "renders")
     assert "vertex colours" in renders.text()
     assert {"split render", "hybrid render", "mvc render"} <= set(image_alts(renders))
     assert "Q102" in section(colours, "findings").text()
 
-    affine = mesh_article(doc, "affine.obj")  # nothing flagged
-    assert "nothing flagged" in left_out(section(affine, "findings"))
+    affine = mesh_article(doc, "affine.obj")  # nothing flagged, nothing stiff: one left-out line
+    assert "nothing flagged" in left_out_of(affine, "findings")
+    assert "no place to look at" in left_out_of(affine, "closeups") and not closeup_figures(affine)
+    assert "no pixel is drawn with mean value coordinates" in left_out_of(affine, "stability")
     renders = section(affine, "renders")
     assert left_out(renders) is None
     assert image_alts(renders) == ["hybrid render"]
     assert "nothing needed mvc" in renders.text()
-    assert "nothing was sent to mvc" in left_out(section(affine, "overlay"))
-    assert "affine up to rounding" in left_out(section(affine, "scores"))
+    assert "nothing was sent to mvc" in left_out_of(affine, "overlay")
+    assert "affine up to rounding" in left_out_of(affine, "scores")
+    headings = [h.text() for h in affine.find_all("h3")]
+    assert "Numerical stability" not in headings and "Close-ups of the flagged places" not in headings
+    (study,) = [p for p in doc.find_all("p", "left-out") if p.attrs.get("id") == "study"]  # not the demo: no chart
+    assert "one timed render per method is noise" in study.text()
     files = section(doc, "summary").find_all("table", "files")[0].find_all("tr")[1:]
     statuses = [row.find_all("span", "status")[0].text() for row in files]
     assert statuses == ["findings", "clean"]
@@ -245,21 +279,6 @@ def test_scores_are_the_sampled_split_error_of_every_quad():
         value = scores.values[scores.faces == face][0]
         assert value == pytest.approx(worst, rel=0.01, abs=1e-6), face
     assert (scores.flagged == (scores.values > 0.5)).all()
-
-
-def test_crop_window_is_square_holds_the_quad_and_stays_in_the_image():
-    from affinity.report.images import MIN_CROP, crop_box
-
-    mask = np.zeros((120, 160), dtype=bool)
-    mask[50:54, 100:104] = True
-    top, bottom, left, right = crop_box(mask)
-    assert bottom - top == right - left == MIN_CROP
-    assert top <= 50 and bottom >= 54 and left <= 100 and right >= 104
-    mask[:] = False
-    mask[0:3, 155:160] = True  # in the corner: the window shifts inside
-    top, bottom, left, right = crop_box(mask)
-    assert (top, right) == (0, 160) and bottom - top == MIN_CROP
-    assert crop_box(np.zeros((4, 4), dtype=bool)) is None
 
 
 def test_error_heatmaps_compare_split_hybrid_and_mvc_with_the_exact_render():

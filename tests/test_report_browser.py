@@ -170,3 +170,97 @@ def test_screenshot_is_not_blank(loaded_report):
     assert pixels.std() > 20  # text, tables and pictures, not one flat colour
     colours = np.unique(pixels.astype(np.int64) @ np.array([1 << 16, 1 << 8, 1]))
     assert len(colours) > 200  # the checker renders and anti-aliased text
+
+
+MESHES = Path(__file__).resolve().parents[2] / "shared" / "meshes"
+MAKEHUMAN = MESHES / "makehuman_base_hm08.obj"
+
+#: Every SVG text's rendered height in CSS pixels: its getBBox() height times the screen scale of its element.
+TEXT_HEIGHTS = """Array.from(document.querySelectorAll("svg text")).filter(t => t.textContent.trim()).map(t => {
+    const box = t.getBBox(), m = t.getScreenCTM();
+    return [box.height * Math.hypot(m.b, m.d), t.textContent.trim().slice(0, 30)];
+})"""
+FIGURES = """Array.from(document.querySelectorAll("figure[data-face]")).map(f => ({
+    face: Number(f.dataset.face), rule: f.dataset.rule, src: f.querySelector("img").src}))"""
+
+
+def _evaluate(browser, session, expression):
+    return browser.call("Runtime.evaluate", {"expression": expression, "returnByValue": True, "awaitPromise": True},
+                        session=session)["result"]["value"]
+
+
+def _set_width(browser, session, width):
+    browser.call("Emulation.setDeviceMetricsOverride",
+                 {"width": width, "height": 1000, "deviceScaleFactor": 1, "mobile": False}, session=session)
+    _evaluate(browser, session, "new Promise(r => requestAnimationFrame(() => requestAnimationFrame(r)))")
+
+
+@pytest.fixture(scope="module")
+def makehuman_report(tmp_path_factory):
+    """The report on MakeHuman opened in Chromium at 1280 px: (devtools, session, lint JSON)."""
+    if not MAKEHUMAN.is_file():
+        pytest.skip("../shared/meshes is absent")
+    folder = tmp_path_factory.mktemp("makehuman")
+    report = folder / "report.html"
+    built = subprocess.run([sys.executable, "-m", "affinity.cli", "report", "-q", str(MAKEHUMAN), "-o", str(report)],
+                           capture_output=True, text=True, timeout=600)
+    assert built.returncode == 0, built.stderr
+    lint = subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--format", "json", str(MAKEHUMAN)],
+                          capture_output=True, text=True, timeout=300)
+    findings = json.loads(lint.stdout)["findings"]
+    browser = DevTools(folder / "profile")
+    try:
+        target = browser.call("Target.createTarget", {"url": "about:blank"})["targetId"]
+        session = browser.call("Target.attachToTarget", {"targetId": target, "flatten": True})["sessionId"]
+        browser.call("Page.enable", session=session)
+        _set_width(browser, session, 1280)
+        browser.call("Page.navigate", {"url": report.as_uri()}, session=session)
+        browser.wait_for("Page.loadEventFired", timeout=60)
+        yield browser, session, findings
+    finally:
+        browser.close()
+
+
+def test_makehuman_closeups_name_flagged_faces_and_outline_them(makehuman_report):
+    from PIL import Image
+
+    from affinity.draw.shading import FLAG_COLOUR
+
+    browser, session, findings = makehuman_report
+    figures = _evaluate(browser, session, FIGURES)
+    flagged = {(f["code"], f["face"]) for f in findings}
+    assert len(figures) >= 5
+    assert len({(f["rule"], f["face"]) for f in figures}) == len(figures)  # one figure per place
+    assert {f["rule"] for f in figures} == {f["code"] for f in findings}  # every flagged rule gets a view
+    flag = [int(FLAG_COLOUR[i:i + 2], 16) for i in (1, 3, 5)]
+    for figure in figures:
+        assert (figure["rule"], figure["face"]) in flagged
+        png = base64.b64decode(figure["src"].split(",", 1)[1])
+        pixels = np.asarray(Image.open(io.BytesIO(png)).convert("RGB")).reshape(-1, 3)
+        assert (pixels == flag).all(axis=1).sum() >= 20, figure  # the place's outline
+
+
+def test_makehuman_has_a_uv_layout(makehuman_report):
+    browser, session, _ = makehuman_report
+    layout = _evaluate(browser, session, """Array.from(document.querySelectorAll('figure[data-view="uv-layout"]'))
+        .map(f => [f.querySelector("svg image").getBoundingClientRect().width, f.querySelectorAll("svg text").length])""")
+    assert len(layout) == 1
+    width, labels = layout[0]
+    assert width >= 400 and labels >= 5
+
+
+@pytest.mark.parametrize("width", [1280, 800])
+def test_makehuman_fits_the_width_and_chart_text_is_legible(makehuman_report, width):
+    browser, session, _ = makehuman_report
+    _set_width(browser, session, width)
+    try:
+        scroll, client = _evaluate(browser, session,
+                                   "[document.documentElement.scrollWidth, document.documentElement.clientWidth]")
+        heights = _evaluate(browser, session, TEXT_HEIGHTS)
+    finally:
+        _set_width(browser, session, 1280)
+    if width == 1280:
+        assert scroll <= client  # no horizontal scroll
+    assert len(heights) > 20  # histogram, colour bars, UV labels
+    small = [(round(h, 1), text) for h, text in heights if h < 11]
+    assert small == []

@@ -235,28 +235,6 @@ def test_committed_table_is_current(rows64):
     assert "condition" in (COMMITTED / "stability.md").read_text()
 
 
-def test_report_section_shows_the_summary(tmp_path, monkeypatch, rows64):
-    from affinity.report import sections
-
-    monkeypatch.setattr(sections, "STABILITY_RESULTS", (tmp_path / "missing.csv",))
-    assert sections.stability_section(None).left_out
-    path = tmp_path / "stability.csv"
-    path.write_text(table.to_csv(rows64))
-    monkeypatch.setattr(sections, "STABILITY_RESULTS", (tmp_path / "missing.csv", path))
-    section = sections.stability_section(None)
-    assert section.left_out is None
-    from jinja2 import Environment, FileSystemLoader, StrictUndefined
-
-    from affinity.report.page import TEMPLATES
-
-    environment = Environment(loader=FileSystemLoader(TEMPLATES), autoescape=True, undefined=StrictUndefined)
-    html = environment.get_template("section.html.j2").render(section=section, section_id="s", heading="h2")
-    assert "needle-tilted-1e4" in html and "naive" not in html.split("<table")[1].split("</table>")[0]
-    assert section.data["cases"] == len(catalogue())
-    assert [(s["method"], s["passed"]) for s in section.data["methods"]] == [
-        ("mean_value", len(catalogue())), ("inverse_bilinear", sum(c.bilinear for c in catalogue()))]
-
-
 def test_reading_a_committed_table_needs_no_mpmath(tmp_path):
     """The report reads stability.csv; mpmath is for computing references, not for reading rows."""
     import subprocess

@@ -11,11 +11,13 @@ writes nothing.
 
 from __future__ import annotations
 
+import argparse
 import os
 import sys
 
 from ..errors import UsageError
-from . import EXIT_CLEAN, EXIT_ERROR, require
+from ..report import MAX_VIEWS, RENDER_SIZE
+from . import EXIT_CLEAN, EXIT_ERROR, camera, image_size, pixel_tolerance, require
 
 
 def add_parser(sub) -> None:
@@ -30,8 +32,30 @@ def add_parser(sub) -> None:
     p.add_argument("meshes", nargs="*", metavar="MESH", help=".obj/.ply/.off files or directories")
     p.add_argument("-o", "--output", default="report.html", metavar="HTML",
                    help="where to write the report (default: report.html)")
+    p.add_argument("--up", choices=["x", "y", "z"], default=None,
+                   help="world up axis (default: the stage's upAxis for USD, else guessed: z for a surface of "
+                        "revolution standing on z, else y)")
+    p.add_argument("--size", type=image_size, default=RENDER_SIZE, metavar="WxH",
+                   help=f"size of the renders and the 3-D overview (default: {RENDER_SIZE[0]}x{RENDER_SIZE[1]})")
+    p.add_argument("--camera", type=camera, metavar="EX,EY,EZ,TX,TY,TZ,FOV",
+                   help="the overview's camera for every mesh (default: the whole mesh from its broad side)")
+    p.add_argument("--texture", metavar="IMAGE", help="texture image for uv (default: map_Kd, else a grid)")
+    p.add_argument("--pixel-tolerance", type=pixel_tolerance, default=0.5, metavar="PX",
+                   help="the hybrid routes a quad to mvc when the split moves its texture by more than PX pixels")
+    p.add_argument("--max-views", type=_count, default=MAX_VIEWS, metavar="N",
+                   help=f"close-ups per mesh, worst flagged places first (default: {MAX_VIEWS}; 0: none)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no result line")
     p.set_defaults(run=run)
+
+
+def _count(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"not a count: {text!r} (use 0 or more)")
+    return value
 
 
 def _check_writable(path: str) -> None:
@@ -75,17 +99,26 @@ def run(args) -> int:
     from tqdm import tqdm
 
     from ..config import Resolver
-    from ..report.build import collect_run
+    from ..report.build import ReportOptions, collect_run
     from ..report.page import render_page
 
     require(("PIL", "jinja2", "matplotlib", "mpmath"), "report")
     _check_writable(args.output)
+    if args.texture:
+        from ..draw.texture import TextureError, load_image
+
+        try:
+            load_image(args.texture)
+        except TextureError as err:
+            raise UsageError(str(err)) from None
+    options = ReportOptions(up=args.up, size=args.size, camera=args.camera, texture=args.texture,
+                            pixel_tolerance=args.pixel_tolerance, max_views=args.max_views)
     resolver = Resolver({})
     inputs = _inputs(args.meshes, resolver)
     with tqdm(total=len(inputs), unit="file", file=sys.stderr, leave=False, delay=1.0,
               disable=args.quiet or not sys.stderr.isatty()) as bar:
         report = collect_run(inputs, lambda path: resolver.resolve(path).settings.for_file(path),
-                             resolver.resolve(os.curdir).settings, bar)
+                             resolver.resolve(os.curdir).settings, bar, options, demo=not args.meshes)
         skipped = [result.file for result in report.meshes if result.file.skipped is not None]
         if len(inputs) == 1 and skipped:  # a report of nothing: say so, write nothing
             raise UsageError(f"{skipped[0].path}: skipped ({skipped[0].skipped}): nothing to report")

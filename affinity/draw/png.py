@@ -14,11 +14,15 @@ def to_pixels(image: np.ndarray) -> np.ndarray:
 
 
 def png_bytes(pixels: np.ndarray) -> bytes:
-    """An optimised PNG of (H, W, 3) or (H, W) uint8 pixels."""
+    """A PNG of (H, W, 3) or (H, W) uint8 pixels, zlib level 6.
+
+    Level 6 (zlib's default) writes renders about 10 % larger than Pillow's
+    ``optimize`` (level 9) at a sixth of the time, which is most of a close-up's cost.
+    """
     from PIL import Image
 
     out = io.BytesIO()
-    Image.fromarray(pixels).save(out, format="PNG", optimize=True)
+    Image.fromarray(pixels).save(out, format="PNG", compress_level=6)
     return out.getvalue()
 
 

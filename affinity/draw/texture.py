@@ -73,3 +73,44 @@ def sample_bilinear(image: np.ndarray, uv: np.ndarray) -> np.ndarray:
     top = image[y0, x0] * (1 - fx) + image[y0, x1] * fx
     bottom = image[y1, x0] * (1 - fx) + image[y1, x1] * fx
     return (top * (1 - fy) + bottom * fy).astype(np.float32)
+
+
+#: Cells of the close-up grid across the largest uv extent of the quad it is about.
+GRID_CELLS = 8
+
+
+def grid_cell(uv: np.ndarray, cells: int = GRID_CELLS) -> float:
+    """The grid cell (uv units) that puts ``cells`` cells across a quad's largest uv extent.
+
+    ``uv`` (4, 2) float64: the quad's corner texture coordinates. A quad with no
+    uv extent gets cells of 1/``cells``.
+    """
+    extent = float(np.ptp(uv, axis=0).max())
+    return (extent if extent > 0 else 1.0) / cells
+
+
+def grid_colours(uv: np.ndarray, cell: float) -> np.ndarray:
+    """A procedural UV grid, a checker of ``cell``-sized squares with lines on the cell edges.
+
+    Computed from the coordinates themselves rather than sampled from an image, so
+    it stays sharp at any scale: a close-up on a quad a thousandth of the atlas
+    wide still shows eight cells across it, and a bent diagonal bends the lines.
+
+    Parameters
+    ----------
+    uv : (N, 2) float, texture coordinates
+    cell : the side of one square, in uv units
+
+    Returns
+    -------
+    (N, 3) float32 RGB: the checker's two colours, grid lines (1/12 of a cell wide) in red.
+    """
+    scaled = np.asarray(uv, dtype=np.float64) / cell
+    whole = np.floor(scaled)
+    parity = (whole[:, 0] + whole[:, 1]) % 2
+    light, dark, line = np.array([0.93, 0.90, 0.82]), np.array([0.22, 0.36, 0.55]), np.array([0.85, 0.25, 0.15])
+    colour = np.where(parity[:, None] == 0, light, dark)
+    fraction = scaled - whole
+    near_edge = (np.minimum(fraction, 1.0 - fraction) < 1.0 / 24).any(axis=1)
+    colour[near_edge] = line
+    return colour.astype(np.float32)

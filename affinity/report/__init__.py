@@ -8,9 +8,15 @@ The pipeline, one module per step:
 - :mod:`.sections` — one function per section, each deciding from the
   collected data whether it appears or is left out with a one-line reason;
 - :mod:`.page` — renders the sections with the Jinja2 templates (autoescaped);
-- :mod:`.images`, :mod:`.charts`, :mod:`.errors` — pictures, charts and
-  per-pixel errors for the sections.
+- :mod:`.places`, :mod:`.closeups`, :mod:`.uvlayout` — the flagged places,
+  their close-ups and the texture-space view;
+- :mod:`.images`, :mod:`.charts` — pictures, colour bars and inline SVG charts.
 
 Nothing heavy is imported here: Pillow, Jinja2, matplotlib and pyvista are
 imported by the functions that use them.
 """
+
+#: Size of the renders and the 3-D overview (``--size``), and close-ups per mesh (``--max-views``): here, so the
+#: command line reads them without importing the builder.
+RENDER_SIZE = (480, 360)
+MAX_VIEWS = 6

@@ -19,13 +19,31 @@ import numpy as np
 from ..findings import FileReport
 from ..lint import QuadScores, quad_scores, scored_codes
 from ..mesh import Mesh
-from ..settings import Settings
 from ..scenes import View
+from ..settings import Settings
+from . import MAX_VIEWS, RENDER_SIZE
 from .demo import MeshInput
 
-RENDER_SIZE = (480, 360)
 #: Methods drawn beside the hybrid when it sent quads to mvc (``exact``: the ray / bilinear-patch reference).
 COMPARED_METHODS = ("split", "mvc", "exact")
+#: Side of a close-up picture, pixels.
+CLOSEUP_SIZE = 240
+
+
+@dataclass(frozen=True)
+class ReportOptions:
+    """The render options ``affinity report`` takes (None: the mesh's own or the default).
+
+    ``camera`` and ``up`` replace every mesh's view; ``size`` is the overview and
+    render size (width, height); ``texture`` replaces map_Kd and the grid.
+    """
+
+    up: str | None = None
+    size: tuple[int, int] = RENDER_SIZE
+    camera: tuple | None = None
+    texture: str | None = None
+    pixel_tolerance: float = 0.5
+    max_views: int = MAX_VIEWS
 
 
 @dataclass(eq=False)
@@ -38,7 +56,11 @@ class MeshResult:
     it sent quads to mvc, ``split``, ``mvc``, ``exact``) to its render;
     ``missing`` a method that could not be drawn to the reason. ``overlay`` is
     the hybrid with the mvc quads tinted. ``overview`` is the pyvista picture
-    (H, W, 3) uint8, else ``overview_note`` says why there is none.
+    (H, W, 3) uint8, else ``overview_note`` says why there is none. ``camera``
+    and ``up`` are the view of the renders and the overview. ``places`` are every
+    flagged place, ranked (:func:`affinity.report.places.choose_places` with no
+    limit); ``closeups`` the pictures of the first ``options.max_views``.
+    ``stability`` is the scene's :class:`affinity.report.stiffness.SceneStability`.
     """
 
     input: MeshInput
@@ -56,6 +78,13 @@ class MeshResult:
     overview: np.ndarray | None = None
     overview_note: str | None = None
     warnings: list[str] = field(default_factory=list)
+    options: ReportOptions = ReportOptions()
+    camera: tuple | None = None
+    up: str | None = None
+    places: list = field(default_factory=list)
+    closeups: list = field(default_factory=list)
+    closeup_seconds: float = 0.0
+    stability: object | None = None
 
     @property
     def readable(self) -> bool:
@@ -70,11 +99,14 @@ class ReportRun:
     settings: Settings
     started: datetime.datetime
     seconds: float
+    demo: bool = False
 
 
-def _texture_label(mesh: Mesh, view: View) -> str:
+def _texture_label(mesh: Mesh, view: View, texture: str | None = None) -> str:
     if mesh.texcoords is None:
         return ""
+    if texture:
+        return f"texture {os.path.basename(texture)} (--texture)"
     if view.checks:
         return f"checker texture, {view.checks} squares across"
     from ..loaders.imagesize import image_size
@@ -92,11 +124,11 @@ def _render(result: MeshResult, texture: np.ndarray | None, step: Callable[[str]
     from ..draw.routing import MVC
     from ..draw.texture import TextureError
 
-    view = result.input.view
+    size = result.options.size
 
     def draw(warn=lambda line: None, **options):
-        chosen = RenderOptions(width=RENDER_SIZE[0], height=RENDER_SIZE[1], camera=view.camera, up=view.up,
-                               texture=texture, **options)
+        chosen = RenderOptions(width=size[0], height=size[1], camera=result.camera, up=result.up,
+                               texture=texture, pixel_tolerance=result.options.pixel_tolerance, **options)
         return render_mesh(result.mesh, chosen, warn)
 
     step("render hybrid")
@@ -129,48 +161,86 @@ def _overview(result: MeshResult, step: Callable[[str], None]) -> None:
         return
     step("3-D overview")
     scores = result.scores.get(result.shown)
-    view = result.input.view
     try:
-        result.overview = overview_image(result.mesh, scores, view.camera, view.up, RENDER_SIZE)
+        result.overview = overview_image(result.mesh, scores, result.camera, result.up, result.options.size,
+                                         scalar_bar=False)
     except RuntimeError as err:  # pyvista's way of saying the off-screen render failed
         result.overview_note = f"pyvista could not render off-screen: {err}"
 
 
-def collect_mesh(item: MeshInput, settings: Settings, step: Callable[[str], None] = lambda name: None) -> MeshResult:
+def _view(result: MeshResult) -> None:
+    """The camera and up axis of the renders and the overview: ``--camera``/``--up``, else the scene's view,
+    else the whole mesh from its broad side (:func:`affinity.draw.framing.overview_camera`)."""
+    from ..draw.framing import overview_camera, up_axis_of
+
+    options, view = result.options, result.input.view
+    result.up = up_axis_of(result.mesh, options.up or view.up)
+    result.camera = options.camera or view.camera
+    if result.camera is None and result.mesh.n_faces:
+        result.camera = overview_camera(result.mesh, *options.size, result.up)
+
+
+def _closeups(result: MeshResult, step: Callable[[str], None]) -> None:
+    """Rank every flagged place; draw the first ``max_views``."""
+    from .closeups import closeup
+    from .places import choose_places, places_of
+
+    by_rule = {hits.code: places_of(result.mesh, hits) for hits in result.file.hits}
+    result.places = choose_places(by_rule, sum(len(p) for p in by_rule.values()))
+    start = time.perf_counter()
+    for k, place in enumerate(result.places[:result.options.max_views]):
+        step(f"close-up {k + 1}")
+        result.closeups.append(closeup(result.mesh, place, result.settings, CLOSEUP_SIZE,
+                                       result.options.pixel_tolerance, result.options.texture))
+    result.closeup_seconds = time.perf_counter() - start
+
+
+def collect_mesh(item: MeshInput, settings: Settings, step: Callable[[str], None] = lambda name: None,
+                 options: ReportOptions = ReportOptions()) -> MeshResult:
     """Lint, score, render and picture one mesh; an unreadable file gives a result with ``file.error``."""
-    from ..pipeline.check import load_and_check
     from ..draw.texture import checker
+    from ..pipeline.check import load_and_check
 
     start = time.perf_counter()
     step("lint")
     file, mesh = load_and_check(item.path, settings)
-    result = MeshResult(item, file, settings, mesh=mesh)
+    result = MeshResult(item, file, settings, mesh=mesh, options=options)
     if result.readable:
         step("scores")
         result.scores = {code: quad_scores(result.mesh, settings, code) for code in scored_codes(result.mesh)}
         result.shown = next(iter(result.scores), None)  # uv, else colours, else normals
-        result.texture = _texture_label(result.mesh, item.view)
+        result.texture = _texture_label(result.mesh, item.view, options.texture)
         has_uv = result.mesh.texcoords is not None
-        _render(result, checker(512, item.view.checks) if item.view.checks and has_uv else None, step)
+        _view(result)
+        texture = options.texture or (checker(512, item.view.checks) if item.view.checks and has_uv else None)
+        _render(result, texture, step)
+        if "hybrid" in result.renders:
+            from .stiffness import scene_stability
+
+            step("stability")
+            result.stability = scene_stability(result.mesh, result.renders["hybrid"], result.camera, result.up,
+                                               options.size)
         _overview(result, step)
+        if result.mesh.n_faces:
+            _closeups(result, step)
     result.seconds = time.perf_counter() - start
     return result
 
 
 def collect_run(items: list[MeshInput], settings_for: Callable[[str], Settings], settings: Settings,
-                progress) -> ReportRun:
+                progress, options: ReportOptions = ReportOptions(), demo: bool = False) -> ReportRun:
     """Collect every input in order.
 
     ``settings_for(path)`` gives the lint settings of a file (its configuration);
     ``settings`` are the current folder's, for the summary's thresholds.
     ``progress`` is a tqdm bar (possibly disabled): it shows the file and step and
-    advances once per file.
+    advances once per file. ``demo``: the inputs are the built-in demo scenes.
     """
     started = datetime.datetime.now().astimezone()
     start = time.perf_counter()
     meshes = []
     for item in items:
         progress.set_description(os.path.basename(item.path), refresh=False)
-        meshes.append(collect_mesh(item, settings_for(item.path), progress.set_postfix_str))
+        meshes.append(collect_mesh(item, settings_for(item.path), progress.set_postfix_str, options))
         progress.update()
-    return ReportRun(meshes, settings, started, time.perf_counter() - start)
+    return ReportRun(meshes, settings, started, time.perf_counter() - start, demo)

@@ -1,20 +1,21 @@
-"""Pictures for the report: PNG data URIs, zoomed crops and error heatmaps (Pillow, NumPy).
+"""Pictures for the report: PNG data URIs, error heatmaps and their colour bars (Pillow, NumPy).
 
-Everything is embedded in the HTML file, so PNGs are optimised and kept small.
+Everything is embedded in the HTML file, so PNGs are optimised and kept small;
+colour bars are inline SVG, so their labels are text at the page's own size.
 """
 
 from __future__ import annotations
 
 import base64
+from html import escape
 
 import numpy as np
 
 from ..draw.png import png_bytes, to_pixels
 
-#: A crop never shows less than this many pixels across, so a tiny quad keeps some context.
-MIN_CROP = 16
-#: Nor more than this: a large quad is zoomed at its centre, where the split moves the attribute most.
-MAX_CROP = 96
+#: The heatmaps' ramp, white (no error) -> orange -> dark red (the scale's top): ordered, and prints well.
+HEAT_STOPS = ((1.0, 1.0, 1.0), (0.99, 0.55, 0.24), (0.50, 0.0, 0.05))
+UNCOVERED = (0.93, 0.93, 0.93)
 
 
 def data_uri(png: bytes) -> str:
@@ -27,46 +28,42 @@ def image_uri(image: np.ndarray) -> str:
     return data_uri(png_bytes(to_pixels(image)))
 
 
-def crop_box(mask: np.ndarray) -> tuple[int, int, int, int] | None:
-    """A square window on the pixels of ``mask`` (H, W) bool: (top, bottom, left, right), or None if empty.
-
-    The window is centred on the pixels' centroid and spans 1.3 times their
-    larger extent, clamped to [MIN_CROP, MAX_CROP] and shifted to stay inside
-    the image (it shrinks only when the image itself is smaller).
-    """
-    rows, cols = np.nonzero(mask)
-    if len(rows) == 0:
-        return None
-    height, width = mask.shape
-    extent = max(np.ptp(rows), np.ptp(cols)) + 1
-    side = int(min(max(1.3 * extent, MIN_CROP), MAX_CROP, height, width))
-    top = int(np.clip(round(rows.mean() - side / 2), 0, height - side))
-    left = int(np.clip(round(cols.mean() - side / 2), 0, width - side))
-    return top, top + side, left, left + side
-
-
-def zoomed_uri(image: np.ndarray, box: tuple[int, int, int, int], size: int) -> str:
-    """Data URI of ``image`` (H, W, 3) float cut to ``box`` and scaled to ``size`` pixels square.
-
-    Nearest-neighbour scaling: the pixels stay visible as pixels, so a crease is
-    not blurred away.
-    """
-    from PIL import Image
-
-    top, bottom, left, right = box
-    crop = Image.fromarray(to_pixels(image[top:bottom, left:right]))
-    return data_uri(png_bytes(np.asarray(crop.resize((size, size), Image.Resampling.NEAREST))))
-
-
 def heatmap_uri(error: np.ndarray, covered: np.ndarray, vmax: float) -> str:
     """Data URI of a per-pixel error (H, W) as a heatmap: white 0 to dark red ``vmax``; uncovered pixels light grey.
 
     One ``vmax`` for every heatmap of a mesh, so their colours compare.
     """
     t = np.clip(np.nan_to_num(error) / vmax, 0.0, 1.0)[..., None] if vmax > 0 else np.zeros(error.shape + (1,))
-    # White -> orange -> dark red: a perceptually ordered ramp that prints well.
-    stops = np.array([[1.0, 1.0, 1.0], [0.99, 0.55, 0.24], [0.50, 0.0, 0.05]])
+    stops = np.array(HEAT_STOPS)
     low = stops[0] + (stops[1] - stops[0]) * np.minimum(2 * t, 1.0)
     colour = np.where(t < 0.5, low, stops[1] + (stops[2] - stops[1]) * (2 * t - 1.0))
-    colour[~covered] = (0.93, 0.93, 0.93)
+    colour[~covered] = UNCOVERED
     return image_uri(colour)
+
+
+def _hex(rgb) -> str:
+    return "#" + "".join(f"{round(c * 255):02x}" for c in rgb)
+
+
+def colour_bar(stops, ticks: list[tuple[float, str]], label: str, width: int = 240) -> str:
+    """An inline SVG colour bar: the ramp through ``stops`` (RGB in [0, 1], evenly spaced), tick labels, a unit label.
+
+    ``ticks`` are (position in [0, 1] along the bar, text); ``label`` names the
+    quantity and its unit. Text is 12 px, so it stays legible wherever the bar is.
+    """
+    gradient = "".join(f'<stop offset="{k / (len(stops) - 1):.3f}" stop-color="{_hex(c)}"/>' for k, c in enumerate(stops))
+    bar_id = f"bar{abs(hash((tuple(map(tuple, stops)), label))) % 10**8}"
+    marks = "".join(
+        f'<line x1="{8 + t * (width - 16):.1f}" x2="{8 + t * (width - 16):.1f}" y1="20" y2="25" stroke="#374151"/>'
+        f'<text x="{8 + t * (width - 16):.1f}" y="38" text-anchor="{"start" if t == 0 else "end" if t == 1 else "middle"}">'
+        f'{escape(text)}</text>' for t, text in ticks)
+    return (f'<svg class="colour-bar" role="img" aria-label="colour bar: {escape(label)}" width="{width}" height="58" '
+            f'viewBox="0 0 {width} 58" font-size="12" fill="#1f2937" font-family="system-ui, sans-serif">'
+            f'<defs><linearGradient id="{bar_id}">{gradient}</linearGradient></defs>'
+            f'<rect x="8" y="6" width="{width - 16}" height="14" fill="url(#{bar_id})" stroke="#9ca3af"/>'
+            f'{marks}<text x="{width / 2:.0f}" y="54" text-anchor="middle">{escape(label)}</text></svg>')
+
+
+def heat_bar(vmax: float, label: str) -> str:
+    """The colour bar of :func:`heatmap_uri` at scale ``vmax``, labelled ``label`` (quantity and unit)."""
+    return colour_bar(HEAT_STOPS, [(0.0, "0"), (0.5, f"{vmax / 2:.3g}"), (1.0, f"≥ {vmax:.3g}")], label)

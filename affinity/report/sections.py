@@ -17,7 +17,7 @@ import numpy as np
 from ..mesh import ATTRIBUTE_NAMES
 from ..rules import RULES, resolve_codes, with_unit
 from .build import MeshResult, ReportRun
-from .images import crop_box, data_uri, heatmap_uri, image_uri, png_bytes, zoomed_uri
+from .images import data_uri, heat_bar, heatmap_uri, image_uri, png_bytes
 
 #: Methods in the order the renders are shown.
 METHOD_ORDER = ("split", "hybrid", "mvc", "exact")
@@ -28,18 +28,11 @@ METHOD_CAPTIONS = {
     "exact": "reference: ray / bilinear-patch intersection",
 }
 WORST_LISTED = 5
-ZOOMED_QUADS = 3
-ZOOM_SIZE = 168
-#: A flagged quad needs this many pixels in the view to be worth a zoomed crop.
-MIN_VISIBLE_PIXELS = 9
 #: Scores below this fraction of the threshold are affine up to rounding; they go in the first bin.
 SCORE_FLOOR = 1e-3
 MISSING_ATTRIBUTE = {"texcoords": "no texture coordinates", "colors": "no vertex colours", "normals": "no normals"}
-#: Where the stability section looks for ``affinity stability``'s table, in order.
-STABILITY_RESULTS = (
-    Path("reports/stability/stability.csv"),
-    Path(__file__).resolve().parents[2] / "reports" / "stability" / "stability.csv",
-)
+#: The committed study (``affinity bench``'s table), shipped as package data for the demo report.
+STUDY_RESULTS = Path(__file__).resolve().parents[1] / "data" / "study" / "study.csv"
 
 
 @dataclass
@@ -131,57 +124,24 @@ def summary_section(run: ReportRun) -> Section:
 
 
 def study_section(run: ReportRun) -> Section:
-    """Error against exact over render time of split, hybrid and mvc, per mesh that needed mvc.
+    """Error against run time: the committed study's chart (package data), in the demo report only.
 
-    From the renders the report made (one run each, routing included): a first
-    look; ``affinity bench`` times with warm-up and repeats and sweeps the
-    hybrid's settings.
+    A report on the user's meshes has one render per method, and one timing is
+    noise (the hybrid can come out slower than exact), so it draws no chart;
+    ``affinity bench`` times them with warm-up and repeats.
     """
-    from ..draw.drawing import RenderOptions
-    from ..study.charts import error_against_time
-    from ..study.sweep import mark_pareto
+    import csv
+
+    from .charts import study_chart
 
     title = "Error against run time"
-    rows = []
-    for result in run.meshes:
-        errors = _errors_against_exact(result) if result.readable and "exact" in result.renders else None
-        if errors is None:
-            continue
-        unit = RULES[result.shown].unit_for(result.settings.measure)
-        of_mesh = [
-            {"scene": result.input.label, "method": method, "route": "view" if method == "hybrid" else "",
-             "setting": RenderOptions.pixel_tolerance if method == "hybrid" else np.nan,
-             "seconds": result.renders[method].seconds, "unit": unit,
-             "err_rms": float(np.sqrt(np.mean(error[covered] ** 2))) if covered.any() else 0.0}
-            for method, (error, covered) in errors.items()
-        ]
-        mark_pareto(of_mesh)
-        rows += of_mesh
-    if not rows:
-        return leave_out("study", title,
-                         "no mesh has an exact render to compare with (nothing needed mvc in any view)")
-    table = [{"mesh": row["scene"], "method": row["method"], "ms": f"{row['seconds'] * 1e3:.1f}",
-              "rms": with_unit(number(row["err_rms"]), row["unit"]), "pareto": row["pareto"]} for row in rows]
-    chart = error_against_time(rows, time_label="render time (ms), one run")
-    return Section("study", title, {"src": data_uri(chart), "rows": table})
-
-
-def stability_section(run: ReportRun) -> Section:
-    """The summary of the stability table (issue 11) from the CSV ``affinity stability`` writes:
-    in the current folder's reports/stability/, else the one committed beside the package."""
-    from ..stability.table import from_csv, summary
-
-    title = "Numerical stability"
-    path = next((p for p in STABILITY_RESULTS if p.is_file()), None)
-    if path is None:
-        return leave_out("stability", title, "no stability results: `affinity stability` writes them to reports/stability/")
-    rows = from_csv(path.read_text(encoding="utf-8"))
-    stats = summary(rows)
-    return Section("stability", title, {
-        "path": "reports/stability/stability.csv", "cases": len({r.case for r in rows}),
-        "methods": [s for s in stats if not s["naive"]],
-        "naive": [s for s in stats if s["naive"] and s["precision"] == "float64"],
-    })
+    if not run.demo:
+        return leave_out("study", title, "one timed render per method is noise, not a measurement: `affinity bench "
+                                         "MESH` times every method with warm-up and repeats")
+    rows = list(csv.DictReader(STUDY_RESULTS.read_text(encoding="utf-8").splitlines()))
+    scenes = [scene for scene in dict.fromkeys(row["scene"] for row in rows) if not scene.endswith(".obj")]
+    repeats = min(int(row["repeats"]) for row in rows if row["repeats"])
+    return Section("study", title, {"svg": study_chart(rows, scenes), "repeats": repeats, "scenes": len(scenes)})
 
 
 # --- one mesh ---------------------------------------------------------------------------------
@@ -216,41 +176,8 @@ def _shown_text(result: MeshResult) -> str:
     return "shading (the mesh has no texture coordinates or vertex colours)"
 
 
-def _mesh_face_of_pixel(render) -> np.ndarray:
-    """(H, W) int64: the mesh face seen at each pixel of a render, -1 where empty."""
-    face = render.frame.face
-    return np.where(face >= 0, render.faces[np.maximum(face, 0)], -1)
-
-
-def _zoomed_quads(result: MeshResult) -> tuple[list[dict], str | None]:
-    """Crops of every method's render on the worst flagged quads in view, or a note why there are none."""
-    scores = result.scores.get(result.shown)
-    if scores is None or not scores.flagged.any():
-        return [], "no quad is flagged for the attribute shown, so there is nothing to zoom on"
-    seen = _mesh_face_of_pixel(result.renders["hybrid"])
-    pixels = np.bincount(seen[seen >= 0], minlength=result.mesh.n_faces)
-    faces, values = scores.faces[scores.flagged], scores.values[scores.flagged]
-    # Worst score first; among equal scores, the quad seen largest.
-    order = np.lexsort((-pixels[faces], -values))
-    worst = [i for i in order if pixels[faces[i]] >= MIN_VISIBLE_PIXELS][:ZOOMED_QUADS]
-    if not worst:
-        return [], f"none of the {len(faces)} flagged quads is visible in this view"
-    rows = []
-    for i in worst:
-        face = int(faces[i])
-        box = crop_box(seen == face)
-        rows.append({
-            "face": face, "line": int(result.mesh.face_line[face]),
-            "group": result.mesh.group_names[result.mesh.face_group[face]],
-            "value": with_unit(number(values[i]), scores.unit), "code": scores.code,
-            "crops": [(method, zoomed_uri(result.renders[method].image, box, ZOOM_SIZE))
-                      for method in METHOD_ORDER if method in result.renders],
-        })
-    return rows, None
-
-
 def renders_section(result: MeshResult) -> Section:
-    """split | hybrid | mvc (| exact) side by side, zoomed on the worst flagged quads.
+    """split | hybrid | mvc (| exact) side by side, in the overview's view.
 
     When nothing needed mvc, only the hybrid (which is then the split) and the line saying so.
     """
@@ -271,12 +198,8 @@ def renders_section(result: MeshResult) -> Section:
          "seconds": result.renders[method].seconds}
         for method in METHOD_ORDER if method in result.renders
     ]
-    zoomed = []
-    if routed:
-        zoomed, why_not = _zoomed_quads(result)
-        notes += [why_not] if why_not else []
     return Section("renders", title, {
-        "figures": figures, "zoomed": zoomed, "shown": _shown_text(result), "routed": routed,
+        "figures": figures, "shown": _shown_text(result), "routed": routed,
         "quads": len(hybrid.methods), "from_other_faces": len(hybrid.methods) - result.file.counts["quads"],
     }, notes)
 
@@ -345,7 +268,8 @@ def error_heatmaps_section(result: MeshResult) -> Section:
          "max": with_unit(number(float(error[covered].max(initial=0.0))), unit)}
         for method, (error, covered) in errors.items()
     ]
-    return Section("errors", title, {"figures": figures, "scale": with_unit(number(scale), unit)})
+    return Section("errors", title, {"figures": figures, "scale": with_unit(number(scale), unit),
+                                     "bar": heat_bar(scale, f"error against exact ({unit})")})
 
 
 def score_histograms_section(result: MeshResult) -> Section:
@@ -368,7 +292,7 @@ def score_histograms_section(result: MeshResult) -> Section:
         chart = score_histogram(scores.values, scores.threshold, floor, scores.unit,
                                 f"{attribute}: {RULES[code].name} ({code})")
         charts.append({
-            "attribute": attribute, "src": data_uri(chart), "quads": len(scores.values),
+            "attribute": attribute, "svg": chart, "quads": len(scores.values),
             "flagged": int(np.count_nonzero(scores.flagged)),
             "threshold": with_unit(number(scores.threshold), scores.unit),
             "median": with_unit(number(float(np.median(scores.values))), scores.unit),
@@ -379,22 +303,111 @@ def score_histograms_section(result: MeshResult) -> Section:
     return Section("scores", title, {"charts": charts}, ["left out: " + "; ".join(skipped)] if skipped else [])
 
 
+def closeups_section(result: MeshResult) -> Section:
+    """One close-up per flagged place, worst first: split | hybrid | exact with the place outlined, and the
+    split's error against exact with its colour bar."""
+    title = "Close-ups of the flagged places"
+    if not result.places:
+        return leave_out("closeups", title, "nothing flagged, so no place to look at")
+    if not result.closeups:
+        return leave_out("closeups", title, f"--max-views {result.options.max_views}: "
+                                            f"{len(result.places)} flagged places not drawn")
+    figures = []
+    for view in result.closeups:
+        place, mesh = view.place, result.mesh
+        rule = RULES[place.code]
+        unit = rule.unit_for(result.settings.measure)
+        error = None
+        if view.error is not None:
+            scale = float(view.error[view.covered].max(initial=0.0))
+            error = {"src": heatmap_uri(view.error, view.covered, scale),
+                     "bar": heat_bar(scale, f"split error against exact ({view.unit})")}
+        figures.append({
+            "face": place.worst, "code": place.code, "name": rule.name, "level": rule.level,
+            "value": with_unit(number(place.value), unit), "faces": len(place.faces),
+            "line": int(mesh.face_line[place.worst]), "group": mesh.group_names[mesh.face_group[place.worst]],
+            "texture": view.texture, "framed": view.framed, "error": error,
+            "images": [(method, image_uri(image)) for method, image in view.images.items()],
+            "missing": view.missing,
+        })
+    notes = []
+    if len(result.places) > len(figures):
+        notes.append(f"{len(result.places) - len(figures)} more flagged places not drawn (--max-views "
+                     f"{result.options.max_views}); the UV layout marks every flagged face")
+    return Section("closeups", title, {"figures": figures, "places": len(result.places)}, notes)
+
+
+def uv_layout_section(result: MeshResult) -> Section:
+    """Every face in texture space, flagged faces in the flag colour, the worst places labelled."""
+    from .uvlayout import layout_svg
+
+    title = "UV layout"
+    if result.mesh.texcoords is None:
+        return leave_out("uv-layout", title, "the mesh has no texture coordinates")
+    flagged = np.zeros(result.mesh.n_faces, dtype=bool)
+    for hits in result.file.hits:
+        flagged[hits.faces[hits.faces >= 0]] = True
+    labelled = list(dict.fromkeys((place.worst, place.code) for place in result.places))
+    svg = layout_svg(result.mesh, flagged, labelled)
+    if svg is None:
+        return leave_out("uv-layout", title, "no face has texture coordinates at every corner")
+    return Section("uv-layout", title, {"svg": svg, "flagged": int(flagged.sum()), "labelled": min(len(labelled), 8)})
+
+
+def stability_section(result: MeshResult) -> Section:
+    """The drawn pixels of this scene whose mean value coordinates are stiff, checked against mpmath."""
+    from .stiffness import STIFF_CONDITION
+
+    title = "Numerical stability"
+    found = result.stability
+    if found is None:
+        return leave_out("stability", title, f"cannot render: {result.render_error}")
+    if found.screened == 0:
+        return leave_out("stability", title, "no pixel is drawn with mean value coordinates in this view, so none "
+                                             "can be stiff (split pixels are triangle barycentrics)")
+    if not found.stiff:
+        worst = max((pixel.condition for pixel in found.checked), default=0.0)
+        return leave_out("stability", title, f"nothing is stiff: of {found.screened} mvc pixels, the "
+                         f"{len(found.checked)} where float32 strays most from float64 have condition at most "
+                         f"{worst:.3g} (stiff: {STIFF_CONDITION:g}) and errors within tolerance against mpmath")
+    rows = [{"face": p.face, "pixel": f"{p.pixel[0]}, {p.pixel[1]}", "condition": f"{p.condition:.3g}",
+             "e64": f"{p.error64:.2g}", "t64": f"{p.tolerance64:.2g}", "e32": f"{p.error32:.2g}",
+             "t32": f"{p.tolerance32:.2g}", "stiff": p.stiff} for p in found.checked]
+    return Section("stability", title, {"rows": rows, "screened": found.screened, "limit": f"{STIFF_CONDITION:g}"})
+
+
 def overview_section(result: MeshResult) -> Section:
     """The 3-D overview from pyvista: the mesh coloured by affinity score, flagged quads outlined."""
     title = "3-D overview"
     if result.overview is None:
         return leave_out("overview", title, result.overview_note)
+    from ..view import score_range
+
     scores = result.scores.get(result.shown)
+    bar = ""
+    if scores is not None and len(scores.faces):
+        bar = _viridis_bar(*score_range(scores), f"{scores.attribute} score ({scores.unit}, log scale)")
     return Section("overview", title, {
-        "src": data_uri(png_bytes(result.overview)),
+        "src": data_uri(png_bytes(result.overview)), "bar": bar,
         "colour": f"{scores.attribute} score ({scores.unit}, log scale)" if scores is not None else "",
     })
 
 
+def _viridis_bar(low: float, top: float, label: str) -> str:
+    """The overview's log colour scale (matplotlib's viridis, as pyvista draws it) as an inline SVG bar."""
+    from matplotlib import colormaps
+
+    from .images import colour_bar
+
+    stops = [tuple(colormaps["viridis"](k / 8)[:3]) for k in range(9)]
+    middle = float(np.sqrt(low * top))
+    return colour_bar(stops, [(0.0, f"{low:.2g}"), (0.5, f"{middle:.2g}"), (1.0, f"{top:.2g}")], label)
+
+
 #: Sections of each readable mesh, in page order.
 MESH_SECTIONS = (
-    findings_section, renders_section, overlay_section, error_heatmaps_section, score_histograms_section,
-    overview_section,
+    findings_section, closeups_section, uv_layout_section, renders_section, overlay_section, error_heatmaps_section,
+    score_histograms_section, stability_section, overview_section,
 )
 #: Sections after the meshes, about the whole product.
-CLOSING_SECTIONS = (study_section, stability_section)
+CLOSING_SECTIONS = (study_section,)

@@ -1,0 +1,151 @@
+"""Close-ups: a camera on a few faces of a mesh and the neighbourhood it needs to draw.
+
+A close-up looks at a place (one or more neighbouring faces) along its mean
+normal, tilted a little, from the distance that fits the place and its ring of
+neighbouring faces in the picture. Only the faces near the place are drawn
+(within a few radii, and nothing more than a radius in front of it), so the place
+shows whether or not the rest of the mesh hides it from the overview's camera.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..mesh import Mesh
+
+#: Vertical field of view of a close-up, degrees.
+CLOSEUP_FOV = 30.0
+#: The view direction leans this far (degrees) off the mean normal, so relief and folds show.
+TILT_DEGREES = 20.0
+#: The ring of neighbours fills this fraction of the picture's half-height.
+FILL = 0.85
+#: Faces whose centroid is within this many ring radii of the place are drawn.
+DRAWN_RADII = 2.5
+#: A ring reaching farther than this many place radii (long neighbours, a pole) is framed at that distance.
+RING_RADII = 3.0
+
+
+@dataclass(frozen=True)
+class CloseupView:
+    """Where a close-up's camera stands.
+
+    camera : ``(eye, target, fov)`` as ``RenderOptions.camera`` takes it
+    up : the world axis name (``"x"``, ``"y"``, ``"z"``) least aligned with the view direction
+    drawn : (D,) int64, the mesh faces to draw (the place, its ring and what lies around them)
+    ring : (N,) int64, the place's faces and every face sharing a vertex with them
+    """
+
+    camera: tuple
+    up: str
+    drawn: np.ndarray
+    ring: np.ndarray
+
+
+def face_vertices(mesh: Mesh, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The corners' vertices of ``faces``: (C,) int64 vertex per corner and (C,) int64 its face (from ``faces``)."""
+    sizes = mesh.face_sizes[faces]
+    owner = np.repeat(faces, sizes)
+    starts = np.repeat(mesh.face_start[faces], sizes)
+    offsets = np.arange(len(owner)) - np.repeat(np.cumsum(sizes) - sizes, sizes)
+    return mesh.corner_vertex[starts + offsets], owner
+
+
+def ring_of(mesh: Mesh, faces: np.ndarray) -> np.ndarray:
+    """(N,) int64 sorted: ``faces`` and every face that shares a vertex with one of them."""
+    touched = np.zeros(len(mesh.positions), dtype=bool)
+    touched[face_vertices(mesh, faces)[0]] = True
+    every_vertex, owner = face_vertices(mesh, np.arange(mesh.n_faces))
+    return np.unique(np.concatenate([faces, owner[touched[every_vertex]]]))
+
+
+def face_centroids(mesh: Mesh) -> np.ndarray:
+    """(F, 3) float64: the mean of each face's corner positions."""
+    vertices, owner = face_vertices(mesh, np.arange(mesh.n_faces))
+    total = np.zeros((mesh.n_faces, 3))
+    np.add.at(total, owner, mesh.positions[vertices])
+    return total / mesh.face_sizes[:, None]
+
+
+def mean_normal(mesh: Mesh, faces: np.ndarray) -> np.ndarray:
+    """(3,) unit area-weighted normal of ``faces`` (Newell's vector area of each polygon), or +z if they cancel."""
+    vertices, _ = face_vertices(mesh, faces)
+    p = mesh.positions[vertices]
+    sizes = mesh.face_sizes[faces]
+    first = np.repeat(np.cumsum(sizes) - sizes, sizes)
+    following = np.arange(len(p)) + 1
+    following = np.where(following - first >= np.repeat(sizes, sizes), first, following)  # wrap within the face
+    area = np.cross(p, p[following]).sum(axis=0)
+    length = np.linalg.norm(area)
+    return area / length if length > 0 else np.array([0.0, 0.0, 1.0])
+
+
+def closeup_view(mesh: Mesh, place: np.ndarray, aspect: float = 1.0) -> CloseupView:
+    """Frame a camera on ``place`` (P,) int64 mesh faces: along their mean normal, tilted by ``TILT_DEGREES``.
+
+    The distance fits the bounding sphere of the place's ring (:func:`ring_of`),
+    at most ``RING_RADII`` times the place's own, into ``FILL`` of the narrower
+    half field of view.
+    """
+    ring = ring_of(mesh, place)
+    ring_points = mesh.positions[face_vertices(mesh, ring)[0]]
+    place_points = mesh.positions[face_vertices(mesh, place)[0]]
+    target = place_points.mean(axis=0)
+    own = float(np.linalg.norm(place_points - target, axis=1).max())
+    radius = min(float(np.linalg.norm(ring_points - target, axis=1).max()), RING_RADII * own)
+    radius = radius if radius > 0 else 1.0
+    normal = mean_normal(mesh, place)
+    # Tilt toward the world axis least aligned with the normal: a fixed, reproducible side.
+    side_axis = int(np.argmin(np.abs(normal)))
+    side = np.eye(3)[side_axis] - normal * normal[side_axis]
+    side /= np.linalg.norm(side)
+    tilt = np.radians(TILT_DEGREES)
+    direction = np.cos(tilt) * normal + np.sin(tilt) * side
+    half = np.radians(CLOSEUP_FOV) / 2
+    narrow = min(half, np.arctan(np.tan(half) * aspect))
+    distance = radius / (FILL * np.sin(narrow))
+    eye = target + distance * direction
+    up = "xyz"[int(np.argmin(np.abs(direction)))]
+    # Draw what lies around the place, but nothing more than a radius in front of it: an occluder (an eyelid,
+    # a helper cube inside the body, the other side of a thin part) would hide the place.
+    offset = face_centroids(mesh) - target
+    drawn = np.flatnonzero((np.linalg.norm(offset, axis=1) <= DRAWN_RADII * radius) & (offset @ direction <= radius))
+    drawn = np.union1d(drawn, ring)
+    return CloseupView((tuple(eye.tolist()), tuple(target.tolist()), CLOSEUP_FOV), up, drawn, ring)
+
+
+def face_subset(mesh: Mesh, faces: np.ndarray) -> Mesh:
+    """A mesh of ``faces`` (D,) int64 sorted, in that order, with the same vertex and attribute tables.
+
+    Positions, uv, normals and colours keep their indices (unused entries stay),
+    so attributes, seams and scores are unchanged; face ``i`` of the result is
+    face ``faces[i]`` of ``mesh``.
+    """
+    from dataclasses import replace
+
+    sizes = mesh.face_sizes[faces]
+    corners = np.repeat(mesh.face_start[faces], sizes) + (np.arange(sizes.sum()) - np.repeat(np.cumsum(sizes) - sizes, sizes))
+
+    def take(array):
+        return None if array is None else array[corners]
+
+    return replace(
+        mesh, face_start=np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64),
+        corner_vertex=mesh.corner_vertex[corners], face_line=mesh.face_line[faces],
+        corner_texcoord=take(mesh.corner_texcoord), corner_normal=take(mesh.corner_normal),
+        face_group=mesh.face_group[faces], face_material=mesh.face_material[faces], prim_face_start=None,
+    )
+
+
+def outline(mask: np.ndarray, width: int = 2) -> np.ndarray:
+    """(H, W) bool: the pixels of ``mask`` (H, W) bool within ``width`` pixels of its border.
+
+    A pixel is on the border when one of its 4-neighbours (or the image edge) is
+    outside the mask; the border then grows ``width - 1`` pixels inward.
+    """
+    inside = mask.copy()
+    for _ in range(width):
+        padded = np.pad(inside, 1, constant_values=False)
+        inside = (inside & padded[:-2, 1:-1] & padded[2:, 1:-1] & padded[1:-1, :-2] & padded[1:-1, 2:])
+    return mask & ~inside

@@ -1,0 +1,132 @@
+"""Close-ups of the flagged places: split | hybrid | exact on the place, outlined, and the split's error map.
+
+For each place chosen by :func:`affinity.report.places.choose_places`, a camera
+is framed on it (:func:`affinity.draw.closeup.closeup_view`) and only the faces
+around it are drawn, so a place the overview cannot see still gets its picture.
+The texture is the mesh's own ``map_Kd`` when it can be read; otherwise a
+procedural UV grid of about eight cells across the worst quad's uv extent
+(:func:`affinity.draw.texture.grid_colours`), so the split's crease shows at
+the scale of the quad whatever the atlas.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..mesh import Mesh
+from ..rules import RULES
+from ..settings import Settings
+from .places import Place
+
+#: Methods of a close-up, left to right.
+CLOSEUP_METHODS = ("split", "hybrid", "exact")
+#: A place with more faces than this is framed on its worst face and that face's ring.
+FRAMED_FACES = 12
+PLAIN = np.ones((1, 1, 3), dtype=np.float32)
+#: Attribute shown for each scored rule; the geometric rules show uv when the mesh has it.
+SHOW_FOR = {"texcoords": "uv", "colors": "color", "normals": "normal"}
+
+
+@dataclass
+class Closeup:
+    """One close-up: the place, what is shown, the images and the split's error against exact.
+
+    images : method -> (S, S, 3) float RGB, the place outlined in the flag colour
+    error : (S, S) float64 split error against exact in ``unit`` (None without an attribute or exact)
+    covered : (S, S) bool, the pixels where split and exact show the same face
+    """
+
+    place: Place
+    show: str
+    texture: str
+    framed: str
+    images: dict = field(default_factory=dict)
+    error: np.ndarray | None = None
+    covered: np.ndarray | None = None
+    unit: str = ""
+    missing: dict = field(default_factory=dict)
+
+
+def _show_for(mesh: Mesh, code: str) -> str:
+    attribute = RULES[code].attribute if RULES[code].scored else None
+    if attribute is not None:
+        return SHOW_FOR[attribute]
+    if mesh.texcoords is not None:
+        return "uv"
+    return "color" if mesh.colors is not None else "shaded"
+
+
+def _map_kd(mesh: Mesh) -> str | None:
+    """The mesh's map_Kd path when it is a readable image, else None."""
+    from ..loaders.imagesize import image_size
+
+    path = mesh.texture_path()
+    return path if path and image_size(path) else None
+
+
+def _face_uv(mesh: Mesh, face: int) -> np.ndarray:
+    corners = np.arange(mesh.face_start[face], mesh.face_start[face + 1])[None]
+    return np.nan_to_num(mesh.corner_attribute("texcoords", corners)[0])
+
+
+def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_tolerance: float,
+            texture: str | None = None) -> Closeup:
+    """Draw one place (see the module docstring); ``texture`` is ``--texture``, overriding map_Kd."""
+    import os
+
+    from ..draw.closeup import closeup_view, face_subset, outline
+    from ..draw.drawing import RenderOptions, render_mesh
+    from ..draw.shading import OVERLAY_TINT
+    from ..draw.texture import grid_cell, grid_colours
+    from ..loaders.imagesize import image_size
+    from ..measures import pixel_error
+
+    framed_faces = place.faces if len(place.faces) <= FRAMED_FACES else np.array([place.worst])
+    view = closeup_view(mesh, framed_faces)
+    sub = face_subset(mesh, view.drawn)
+    show = _show_for(mesh, place.code)
+    image_file = texture or _map_kd(mesh)
+    cell = None
+    if show == "uv" and image_file:
+        label = f"texture {os.path.basename(image_file)}" + ("" if texture else " (map_Kd)")
+    elif show == "uv":
+        cell = grid_cell(_face_uv(mesh, place.worst))
+        label = f"UV grid, 8 cells across face {place.worst}'s uv extent (cell {cell:.3g} uv)"
+    else:
+        label = {"color": "vertex colours", "normal": "normals as RGB", "shaded": "shading"}[show]
+    framed = (f"the {len(place.faces)} flagged faces and their neighbours" if len(framed_faces) > 1
+              else f"face {place.worst} and its neighbours" + (f" (of a place of {len(place.faces)} flagged faces)"
+                                                              if len(place.faces) > 1 else ""))
+    result = Closeup(place, show, label, framed)
+    in_place = np.isin(view.drawn, place.faces)
+    frames = {}
+    for method in CLOSEUP_METHODS:
+        # With the grid, the render's own texture is replaced pixel by pixel: a 1-texel one costs nothing to sample.
+        options = RenderOptions(method=method, show=show, width=size, height=size, camera=view.camera, up=view.up,
+                                texture=image_file if cell is None else PLAIN, pixel_tolerance=pixel_tolerance)
+        try:
+            drawn = render_mesh(sub, options)
+        except NotImplementedError as err:
+            result.missing[method] = str(err)
+            continue
+        image = drawn.image.copy()
+        face = drawn.frame.face
+        covered = face >= 0
+        sub_face = np.where(covered, drawn.faces[np.maximum(face, 0)], -1)
+        if cell is not None:
+            image[covered] = grid_colours(drawn.frame.attrs[covered], cell)
+        image[outline(covered & in_place[np.maximum(sub_face, 0)])] = OVERLAY_TINT
+        result.images[method] = image
+        frames[method] = (drawn.frame, sub_face)
+    if show != "shaded" and {"split", "exact"} <= frames.keys():
+        (split, split_face), (exact, exact_face) = frames["split"], frames["exact"]
+        covered = (split_face >= 0) & (split_face == exact_face)
+        attribute = next(name for name, shown in SHOW_FOR.items() if shown == show)
+        texture_size = (image_size(image_file) if image_file else None) or (settings.texture_size,) * 2
+        error = np.zeros(covered.shape)
+        error[covered] = pixel_error(split.attrs[covered], exact.attrs[covered], attribute, texture_size)
+        code = next(code for code, rule in RULES.items() if rule.scored and rule.attribute == attribute)
+        result.error, result.covered, result.unit = error, covered, RULES[code].unit_for(settings.measure)
+    return result

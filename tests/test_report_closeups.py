@@ -1,0 +1,288 @@
+"""Close-ups of flagged places, the UV layout and the overview's framing, against independent truth."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from affinity.loaders.objwriter import write_obj
+from affinity.mesh import mesh_from_polygons
+
+MESHES = Path(__file__).resolve().parents[2] / "shared" / "meshes"
+needs_meshes = pytest.mark.skipif(not MESHES.is_dir(), reason="../shared/meshes is absent")
+
+
+def grid_mesh(n: int = 10, bent: tuple = ()) -> object:
+    """An n x n grid of unit quads in the z = 0 plane with uv = position / n, except the quads in ``bent``
+    ((row, col) pairs), whose top-right corner's uv is pushed (a disaffine quad needs its own uv corners)."""
+    xs, ys = np.meshgrid(np.arange(n + 1.0), np.arange(n + 1.0))
+    positions = np.stack([xs.ravel(), ys.ravel(), np.zeros(xs.size)], axis=1)
+    row, col = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
+    first = (row * (n + 1) + col).ravel()
+    faces = np.stack([first, first + 1, first + n + 2, first + n + 1], axis=1)
+    # One uv per corner: corners are numbered 4 * face + k.
+    corner_positions = positions[faces].reshape(-1, 3)
+    uv = corner_positions[:, :2] / n
+    for r, c in bent:
+        uv[4 * (r * n + c) + 2] += 0.3 / n
+    mesh = mesh_from_polygons("grid", corner_positions, np.arange(4 * n * n).reshape(-1, 4), texcoords=uv)
+    return mesh
+
+
+def welded_grid(n: int = 10, bent: tuple = ()) -> object:
+    """:func:`grid_mesh` with its corners welded: neighbouring quads share vertices (uv stays per corner)."""
+    from affinity.mesh import Mesh
+
+    xs, ys = np.meshgrid(np.arange(n + 1.0), np.arange(n + 1.0))
+    positions = np.stack([xs.ravel(), ys.ravel(), np.zeros(xs.size)], axis=1)
+    row, col = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
+    first = (row * (n + 1) + col).ravel()
+    faces = np.stack([first, first + 1, first + n + 2, first + n + 1], axis=1)
+    return Mesh(**{**grid_mesh(n, bent).__dict__, "corner_vertex": faces.ravel(), "positions": positions})
+
+
+def test_connected_components_agree_with_a_breadth_first_search():
+    from affinity.report.places import connected_components
+
+    rng = np.random.default_rng(7)
+    n = 300
+    a, b = rng.integers(0, n, 200), rng.integers(0, n, 200)
+    label = connected_components(n, a, b)
+    neighbours = [[] for _ in range(n)]
+    for x, y in zip(a.tolist(), b.tolist()):
+        neighbours[x].append(y)
+        neighbours[y].append(x)
+    truth = np.full(n, -1)
+    for start in range(n):  # plain BFS, components named by their smallest node
+        if truth[start] >= 0:
+            continue
+        truth[start], queue = start, [start]
+        while queue:
+            for other in neighbours[queue.pop()]:
+                if truth[other] < 0:
+                    truth[other] = start
+                    queue.append(other)
+    np.testing.assert_array_equal(label, truth)
+
+
+def test_faces_sharing_a_vertex_are_one_place_and_separated_patches_are_two():
+    from affinity.lint import lint_mesh
+    from affinity.report.places import places_of
+    from affinity.settings import Settings
+
+    # Faces (2,2) and (3,3) touch at one corner; (7,7) is apart.
+    welded = welded_grid(10, bent=[(2, 2), (3, 3), (7, 7)])
+    (hits,) = lint_mesh(welded, Settings(select=["Q101"]))
+    assert sorted(hits.faces.tolist()) == [22, 33, 77]
+    places = places_of(welded, hits)
+    assert sorted(sorted(p.faces.tolist()) for p in places) == [[22, 33], [77]]
+
+
+def test_places_take_turns_between_rules_worst_first():
+    from affinity.report.places import Place, choose_places
+
+    def place(code, beyond, face):
+        return Place(code, np.array([face]), np.array([beyond]), face, beyond, beyond)
+
+    by_rule = {"Q101": [place("Q101", 9.0, 1), place("Q101", 5.0, 2), place("Q101", 4.0, 3)],
+               "Q202": [place("Q202", 2.0, 4)], "Q204": [place("Q204", 1.5, 5)]}  # Q204 is an error
+    chosen = choose_places(by_rule, 4)
+    assert [(p.code, p.worst) for p in chosen] == [("Q204", 5), ("Q101", 1), ("Q202", 4), ("Q101", 2)]
+    assert choose_places(by_rule, 0) == []
+
+
+def test_closeup_camera_looks_at_the_place_along_its_normal_and_fits_its_ring():
+    from affinity.draw.closeup import TILT_DEGREES, closeup_view, face_subset
+    from affinity.draw.framing import camera_for
+    from render import to_clip
+
+    mesh = welded_grid(10)
+    view = closeup_view(mesh, np.array([55]))
+    eye, target, _ = view.camera
+    np.testing.assert_allclose(target, [5.5, 5.5, 0.0])
+    direction = np.subtract(eye, target) / np.linalg.norm(np.subtract(eye, target))
+    assert np.degrees(np.arccos(direction[2])) == pytest.approx(TILT_DEGREES)  # the normal is +z
+    # Every corner of the place's ring projects inside the picture, and the place near its centre.
+    camera = camera_for(mesh, 240, 240, view.camera, view.up)
+    clip = to_clip(mesh.positions, camera.matrix)
+    ndc = clip[:, :2] / clip[:, 3:]
+    ring_corners = face_subset(mesh, view.ring).corner_vertex
+    assert np.abs(ndc[ring_corners]).max() < 1.0
+    assert np.abs(ndc[face_subset(mesh, np.array([55])).corner_vertex].mean(axis=0)).max() < 0.05
+    assert view.ring.tolist() == [44, 45, 46, 54, 55, 56, 64, 65, 66]  # the quad and its eight neighbours
+
+
+def test_grid_cell_puts_eight_cells_across_the_quad_and_the_grid_is_a_checker():
+    from affinity.draw.texture import grid_cell, grid_colours
+
+    uv = np.array([[0.1, 0.2], [0.1016, 0.2], [0.1016, 0.2008], [0.1, 0.2008]])
+    assert grid_cell(uv) == pytest.approx(0.0016 / 8)
+    cell = 0.5
+    centres = np.array([[0.25, 0.25], [0.75, 0.25], [0.75, 0.75], [0.01, 0.25]])
+    colours = grid_colours(centres, cell)
+    assert np.allclose(colours[0], colours[2]) and not np.allclose(colours[0], colours[1])
+    assert np.allclose(colours[3], [0.85, 0.25, 0.15], atol=1e-6)  # on a cell edge: the line
+
+
+def test_outline_is_the_border_of_the_mask():
+    from affinity.draw.closeup import outline
+
+    mask = np.zeros((10, 10), dtype=bool)
+    mask[2:8, 3:9] = True
+    ring = outline(mask, width=1)
+    assert ring.sum() == 2 * 6 + 2 * 4 and not ring[3:7, 4:8].any() and (ring <= mask).all()
+
+
+def test_two_separated_flagged_patches_give_two_closeups_each_outlined(tmp_path):
+    from html.parser import HTMLParser
+
+    write_obj(grid_mesh(12, bent=[(2, 2), (9, 9)]), tmp_path / "two.obj")
+    result = subprocess.run([sys.executable, "-m", "affinity.cli", "report", "-q", "two.obj", "-o", "out.html"],
+                            capture_output=True, text=True, cwd=tmp_path, timeout=300)
+    assert result.returncode == 0, result.stderr
+
+    class Figures(HTMLParser):
+        def __init__(self):
+            super().__init__()
+            self.figures, self.current, self.views = [], None, []
+
+        def handle_starttag(self, tag, attrs):
+            attrs = dict(attrs)
+            if tag == "figure" and "data-face" in attrs:
+                self.current = {"face": int(attrs["data-face"]), "rule": attrs["data-rule"], "images": []}
+                self.figures.append(self.current)
+            if tag == "figure" and "data-view" in attrs:
+                self.views.append(attrs["data-view"])
+            if tag == "img" and self.current is not None:
+                self.current["images"].append(attrs["src"])
+
+        def handle_endtag(self, tag):
+            if tag == "figure":
+                self.current = None
+
+    parser = Figures()
+    parser.feed((tmp_path / "out.html").read_text(encoding="utf-8"))
+    assert sorted((f["face"], f["rule"]) for f in parser.figures) == [(2 * 12 + 2, "Q101"), (9 * 12 + 9, "Q101")]
+    assert parser.views == ["uv-layout"]
+    for figure in parser.figures:
+        assert has_outline_colour(figure["images"][0])
+
+
+def has_outline_colour(data_uri: str) -> bool:
+    """Whether a PNG data URI has pixels of exactly the flag colour."""
+    import base64
+    import io
+
+    from PIL import Image
+
+    from affinity.draw.shading import FLAG_COLOUR
+
+    flag = [int(FLAG_COLOUR[i:i + 2], 16) for i in (1, 3, 5)]
+    pixels = np.asarray(Image.open(io.BytesIO(base64.b64decode(data_uri.split(",", 1)[1]))).convert("RGB"))
+    return bool((pixels.reshape(-1, 3) == flag).all(axis=1).sum() >= 20)
+
+
+def test_uv_layout_fills_the_flagged_faces_in_the_flag_colour():
+    from affinity.draw.shading import OVERLAY_TINT
+    from affinity.report.uvlayout import layout_image
+
+    mesh = grid_mesh(4)
+    flagged = np.zeros(mesh.n_faces, dtype=bool)
+    flagged[5] = True  # row 1, col 1: uv [0.25, 0.5]^2
+    image, low, side = layout_image(mesh, flagged, 64)
+    assert side == 1.0 and tuple(low) == (0.0, 0.0)
+    tinted = np.all(np.isclose(image, OVERLAY_TINT, atol=1e-6), axis=2)
+    rows, cols = np.nonzero(tinted)
+    # uv (0.25..0.5, 0.25..0.5) is columns 16..32 and rows 32..48 (v up, row 0 at the top), less the edge pixels.
+    assert 16 <= cols.min() and cols.max() < 32 and 32 <= rows.min() and rows.max() < 48
+    assert tinted.sum() > 0.7 * 16 * 16
+
+
+def test_surfaces_of_revolution_stand_on_their_axis_and_everything_else_is_y_up():
+    from affinity.draw.framing import guess_up_axis
+    from affinity.scenes import latlong_sphere
+
+    vase = latlong_sphere(16, 8)  # z axis of revolution, but a sphere: all extents equal -> the y convention
+    assert guess_up_axis(vase) == "y"
+    stretched = mesh_from_polygons("pillar", vase.positions * [1.0, 1.0, 3.0], vase.corner_vertex.reshape(-1, 4))
+    assert guess_up_axis(stretched) == "z"
+    lying = mesh_from_polygons("lying", stretched.positions[:, [2, 0, 1]], stretched.corner_vertex.reshape(-1, 4))
+    assert guess_up_axis(lying) == "x"
+    tile = grid_mesh(3)  # a square tile in the z = 0 plane lies flat: z up, seen from above
+    assert guess_up_axis(tile) == "z"
+    wall = mesh_from_polygons("wall", tile.positions * [1.0, 2.0, 1.0], tile.corner_vertex.reshape(-1, 4))
+    assert guess_up_axis(wall) == "y"  # no two equal extents: the OBJ convention
+
+
+@needs_meshes
+def test_the_car_with_up_z_is_seen_from_the_side():
+    pytest.importorskip("pyvista")
+    from affinity.report.build import ReportOptions, collect_mesh
+    from affinity.report.demo import MeshInput
+    from affinity.settings import Settings
+
+    car = MeshInput(str(MESHES / "osd_catmark_car.obj"), "car")
+    aspects = {}
+    for up in ("z", "y"):
+        result = collect_mesh(car, Settings(), options=ReportOptions(up=up, max_views=0))
+        mask = np.abs(result.overview.astype(int) - 255).max(axis=2) > 10
+        rows, cols = np.nonzero(mask)
+        aspects[up] = np.ptp(cols) / np.ptp(rows)
+    # The car is 1.0 long (y), 0.43 wide (x) and 0.2 high (z): from the side its silhouette is about five times
+    # as wide as high, less the elevation and the turn; seen with the wrong up axis it stands on its nose.
+    assert aspects["z"] > 2.5 and aspects["y"] < 1.0
+
+
+@needs_meshes
+def test_every_shared_mesh_with_flags_gets_closeups():
+    from affinity.pipeline.check import load_and_check
+    from affinity.report.build import ReportOptions, collect_mesh
+    from affinity.report.demo import MeshInput
+    from affinity.settings import Settings
+
+    for path in sorted(MESHES.glob("*.obj")):
+        file, _ = load_and_check(str(path), Settings())
+        result = collect_mesh(MeshInput(str(path), path.name), Settings(), options=ReportOptions(max_views=2))
+        flagged_rules = {hits.code for hits in file.hits if (hits.faces >= 0).any()}
+        assert bool(result.closeups) == bool(flagged_rules), path.name
+        for closeup in result.closeups:
+            hits = next(h for h in file.hits if h.code == closeup.place.code)
+            assert closeup.place.worst in hits.faces
+            assert (np.all(np.isclose(closeup.images["split"], [1.0, 0.1, 0.6], atol=1e-6), axis=2)).sum() >= 10
+
+
+def test_a_pixel_is_stiff_where_the_catalogue_says_the_coordinates_are_ill_conditioned():
+    from affinity.report.stiffness import STIFF_CONDITION, _check
+    from affinity.stability.cases import catalogue
+
+    cases = {case.name: case for case in catalogue()}
+    inside, far = cases["inside"], cases["far-1e4"]  # far outside a quad: weights grow, the condition with them
+    calm = _check(np.asarray(inside.points[0]), np.asarray(inside.quad), np.ones(4), 0, (0, 0))
+    stiff = _check(np.asarray(far.points[0]), np.asarray(far.quad), np.ones(4), 0, (0, 0))
+    assert calm.condition < 10 and not calm.stiff
+    assert calm.error64 <= calm.tolerance64 and calm.error32 <= calm.tolerance32
+    assert stiff.condition > STIFF_CONDITION and stiff.stiff
+
+
+def test_report_options_max_views_and_a_bad_texture(tmp_path):
+    write_obj(grid_mesh(6, bent=[(1, 1), (4, 4)]), tmp_path / "two.obj")
+
+    def report(*args):
+        return subprocess.run([sys.executable, "-m", "affinity.cli", "report", "-q", "two.obj", "-o", "out.html", *args],
+                              capture_output=True, text=True, cwd=tmp_path, timeout=300)
+
+    done = report("--max-views", "1", "--size", "200x150", "--up", "z")
+    assert done.returncode == 0, done.stderr
+    html = (tmp_path / "out.html").read_text(encoding="utf-8")
+    assert html.count("<figure class=\"closeup\"") == 1 and "1 more flagged places not drawn" in html
+    done = report("--max-views", "0")
+    assert done.returncode == 0 and "data-face" not in (tmp_path / "out.html").read_text(encoding="utf-8")
+    (tmp_path / "out.html").unlink()
+    (tmp_path / "not-an-image.png").write_text("hello")
+    failed = report("--texture", "not-an-image.png")
+    assert failed.returncode == 2 and "not-an-image.png: not a readable image" in failed.stderr
+    assert "Traceback" not in failed.stderr and not (tmp_path / "out.html").exists()
