@@ -68,3 +68,45 @@ class FileReport:
     @property
     def n_findings(self) -> int:
         return sum(len(h) for h in self.hits)
+
+
+def report_to_bytes(report: FileReport) -> bytes:
+    """``report`` as a self-contained ``.npz`` blob: arrays stored as they are, the rest as JSON.
+
+    :func:`report_from_bytes` gives back an equal report (same dtypes, same
+    values bit for bit), without pickle, so a damaged blob can only fail to load.
+    """
+    import io
+    import json
+    from dataclasses import fields
+
+    arrays: dict[str, np.ndarray] = {}
+    meta = {f.name: getattr(report, f.name) for f in fields(report) if f.name not in ("hits", "prim_face_start")}
+    meta["hits"] = [{"code": h.code, "threshold": h.threshold} for h in report.hits]
+    for k, hits in enumerate(report.hits):
+        for name in _HIT_ARRAYS:
+            arrays[f"hits{k}_{name}"] = getattr(hits, name)
+    if report.prim_face_start is not None:
+        arrays["prim_face_start"] = report.prim_face_start
+    arrays["meta"] = np.frombuffer(json.dumps(meta).encode("utf-8"), dtype=np.uint8)
+    buffer = io.BytesIO()
+    np.savez_compressed(buffer, **arrays)
+    return buffer.getvalue()
+
+
+def report_from_bytes(data: bytes) -> FileReport:
+    """The report :func:`report_to_bytes` stored; raises ValueError (or KeyError, OSError) on a damaged blob."""
+    import io
+    import json
+
+    with np.load(io.BytesIO(data), allow_pickle=False) as blob:
+        meta = json.loads(blob["meta"].tobytes().decode("utf-8"))
+        hits = [
+            RuleHits(h["code"], threshold=h["threshold"], **{name: blob[f"hits{k}_{name}"] for name in _HIT_ARRAYS})
+            for k, h in enumerate(meta.pop("hits"))
+        ]
+        prim_face_start = blob["prim_face_start"] if "prim_face_start" in blob.files else None
+    return FileReport(**meta, hits=hits, prim_face_start=prim_face_start)
+
+
+_HIT_ARRAYS = ("faces", "lines", "values", "groups")
