@@ -95,18 +95,23 @@ def report_to_bytes(report: FileReport) -> bytes:
 
 
 def report_from_bytes(data: bytes) -> FileReport:
-    """The report :func:`report_to_bytes` stored; raises ValueError (or KeyError, OSError) on a damaged blob."""
+    """The report :func:`report_to_bytes` stored; a damaged blob raises ValueError."""
     import io
     import json
+    import zipfile
+    import zlib
 
-    with np.load(io.BytesIO(data), allow_pickle=False) as blob:
-        meta = json.loads(blob["meta"].tobytes().decode("utf-8"))
-        hits = [
-            RuleHits(h["code"], threshold=h["threshold"], **{name: blob[f"hits{k}_{name}"] for name in _HIT_ARRAYS})
-            for k, h in enumerate(meta.pop("hits"))
-        ]
-        prim_face_start = blob["prim_face_start"] if "prim_face_start" in blob.files else None
-    return FileReport(**meta, hits=hits, prim_face_start=prim_face_start)
+    try:
+        with np.load(io.BytesIO(data), allow_pickle=False) as blob:
+            meta = json.loads(blob["meta"].tobytes().decode("utf-8"))
+            hits = [
+                RuleHits(h["code"], threshold=h["threshold"], **{name: blob[f"hits{k}_{name}"] for name in _HIT_ARRAYS})
+                for k, h in enumerate(meta.pop("hits"))
+            ]
+            prim_face_start = blob["prim_face_start"] if "prim_face_start" in blob.files else None
+            return FileReport(**meta, hits=hits, prim_face_start=prim_face_start)
+    except (zipfile.BadZipFile, zlib.error, EOFError, KeyError, TypeError, OSError) as err:
+        raise ValueError(f"not a stored report: {type(err).__name__}: {err}") from None
 
 
 _HIT_ARRAYS = ("faces", "lines", "values", "groups")

@@ -105,6 +105,7 @@ class ResultCache:
         self.tool = tool_fingerprint() if tool is None else tool
         self._db: sqlite3.Connection | None = None
         self._pending = 0
+        self._damaged_entries = 0
         self._now = time.time()
         path = os.path.join(folder, DB_NAME)
         try:
@@ -216,8 +217,10 @@ class ResultCache:
             return None
         try:
             report = report_from_bytes(row[0])
-        except (ValueError, KeyError, TypeError, OSError) as err:
-            self._warn(f"damaged entry ({type(err).__name__}); checking that file again", off=False)
+        except ValueError as err:
+            if not self._damaged_entries:
+                self._warn(f"damaged entry ({err}); checking such files again", off=False)
+            self._damaged_entries += 1
             self._write("DELETE FROM results WHERE key = ?", (key,))
             return None
         if row[1] < self._now - _DAY:
