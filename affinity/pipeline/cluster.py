@@ -60,13 +60,13 @@ def connect(spec: str) -> Iterator:
     """
     import logging
 
+    address = scheduler_address(spec)
+    workers = _local_workers(address) if address.startswith(LOCAL_PREFIX) else None
     import dask
     from dask.utils import parse_timedelta
     from distributed import Client, LocalCluster
 
-    address = scheduler_address(spec)
-    if address.startswith(LOCAL_PREFIX):
-        workers = _local_workers(address)
+    if workers is not None:
         with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
                           dashboard_address="127.0.0.1:0", silence_logs=logging.ERROR) as cluster:
             with Client(cluster) as client:
