@@ -5,6 +5,8 @@ from __future__ import annotations
 import os
 import sqlite3
 import struct
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -221,9 +223,6 @@ def write_assets_dir(tmp_path: Path) -> Path:
 
 def check_with_cache(folder: Path, cache_dir: Path | str, *extra: str):
     env = {**os.environ, "AFFINITY_CACHE_DIR": str(cache_dir)}
-    import subprocess
-    import sys
-
     return subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--verbose", *extra, "."],
                           capture_output=True, text=True, cwd=folder, env=env, timeout=120)
 
@@ -307,3 +306,13 @@ def test_usd_sublayer_edits_invalidate_the_stage(tmp_path, tmp_path_factory, cou
     age(sub)
     second = cached_run(folder, [(str(tmp_path / "shot.usda"), Settings())])
     assert counting.paths == ["shot.usda", "shot.usda"] and second[0].counts["triangles"] == 1
+
+
+def test_a_stage_read_without_usd_core_is_not_served_to_a_run_with_it(tmp_path, monkeypatch):
+    stage = tmp_path / "stage.usda"
+    stage.write_text("#usda 1.0\n")
+    cache = ResultCache(str(tmp_path / "cache"), tool="t")
+    with_reader = cache.key(str(stage), Settings())
+    monkeypatch.setitem(sys.modules, "pxr", None)
+    assert cache.key(str(stage), Settings()) != with_reader
+    cache.close()

@@ -71,16 +71,18 @@ def cache_folder() -> str:
 
 
 def tool_fingerprint() -> str:
-    """The version and a hash of every ``.py`` file of the installed ``affinity`` and ``render`` packages.
+    """The version, NumPy's version and a hash of every ``.py`` file of the ``affinity`` and ``render`` packages.
 
     ``render`` is found, not imported: ``affinity check`` never loads the renderer.
     """
     from importlib.util import find_spec
     from pathlib import Path
 
+    import numpy as np
+
     from .. import __version__
 
-    digest = hashlib.blake2b(__version__.encode(), digest_size=20)
+    digest = hashlib.blake2b(f"{__version__} numpy {np.__version__}".encode(), digest_size=20)
     for package in ("affinity", "render"):
         for root in map(Path, find_spec(package).submodule_search_locations):
             for source in sorted(root.rglob("*.py")):
@@ -166,7 +168,9 @@ class ResultCache:
             return None
         if tree is None:
             return None
-        usd_key = None if usd is None else dataclasses.asdict(usd)
+        usd_key = None
+        if os.path.splitext(path)[1].lower() in _USD_SUFFIXES:
+            usd_key = [_usd_reader(), None if usd is None else dataclasses.asdict(usd)]
         payload = _json([SCHEMA, self.tool, path, tree, dataclasses.asdict(settings), usd_key])
         return hashlib.blake2b(payload.encode(), digest_size=20).hexdigest()
 
@@ -291,6 +295,21 @@ def _hash_file(path: str) -> tuple[str, list[str]]:
     else:
         deps = []
     return digest.hexdigest(), [os.path.abspath(dep) for dep in deps]
+
+
+def _usd_reader() -> str | None:
+    """The usd-core version that would read a stage, None without one (found, not imported: that is slow)."""
+    from importlib.metadata import PackageNotFoundError, version
+    from importlib.util import find_spec
+
+    if "pxr" in sys.modules and sys.modules["pxr"] is None:  # blocked, as a test does
+        return None
+    if find_spec("pxr") is None:
+        return None
+    try:
+        return version("usd-core")
+    except PackageNotFoundError:  # pxr from a USD build rather than the wheel
+        return "pxr"
 
 
 def _usd_dependencies(path: str) -> list[str]:

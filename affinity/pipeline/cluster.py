@@ -67,10 +67,10 @@ def connect(spec: str) -> Iterator:
     from distributed import Client, LocalCluster
 
     if workers is not None:
-        with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
-                          dashboard_address="127.0.0.1:0", silence_logs=logging.ERROR) as cluster:
-            with Client(cluster) as client:
-                yield client
+        with (LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
+                           dashboard_address="127.0.0.1:0", silence_logs=logging.ERROR) as cluster,
+              Client(cluster) as client):
+            yield client
         return
     timeout = parse_timedelta(dask.config.get("distributed.comm.timeouts.connect"), default="s")
     try:
