@@ -111,6 +111,7 @@ def check_files(
 
 
 def _chain(known: dict, todo: list[int], fresh) -> Iterator[tuple[int, FileReport]]:
+    """The cached reports first, then the fresh ones (numbered within ``todo``) as task indices."""
     yield from known.items()
     for j, report in fresh:
         yield todo[j], report
