@@ -164,3 +164,11 @@ def test_check_without_scheduler_never_imports_dask(assets):
                             capture_output=True, text=True, env=env, timeout=120)
     assert result.stdout.strip().endswith("[]"), result.stdout + result.stderr
     assert run("check", str(assets / "clean.obj")).returncode == 0
+
+
+def test_the_progress_bar_passes_every_result_through(capsys):
+    from affinity.commands.check import _progress_bar
+    from affinity.findings import FileReport
+
+    results = [(2, FileReport("a.obj")), (0, FileReport("b.obj")), (1, FileReport("c.obj", error="x"))]
+    assert list(_progress_bar("http://127.0.0.1:8787/status")(iter(results), 3)) == results
