@@ -71,47 +71,55 @@ class FileReport:
 
 
 def report_to_bytes(report: FileReport) -> bytes:
-    """``report`` as a self-contained ``.npz`` blob: arrays stored as they are, the rest as JSON.
+    """``report`` as a compact blob: a JSON header (fields, then each array's dtype and shape) and the
+    arrays' raw bytes, zlib-compressed.
 
     :func:`report_from_bytes` gives back an equal report (same dtypes, same
     values bit for bit), without pickle, so a damaged blob can only fail to load.
     """
-    import io
     import json
+    import zlib
     from dataclasses import fields
 
-    arrays: dict[str, np.ndarray] = {}
     meta = {f.name: getattr(report, f.name) for f in fields(report) if f.name not in ("hits", "prim_face_start")}
     meta["hits"] = [{"code": h.code, "threshold": h.threshold} for h in report.hits]
-    for k, hits in enumerate(report.hits):
-        for name in _HIT_ARRAYS:
-            arrays[f"hits{k}_{name}"] = getattr(hits, name)
+    arrays = [getattr(hits, name) for hits in report.hits for name in _HIT_ARRAYS]
     if report.prim_face_start is not None:
-        arrays["prim_face_start"] = report.prim_face_start
-    arrays["meta"] = np.frombuffer(json.dumps(meta).encode("utf-8"), dtype=np.uint8)
-    buffer = io.BytesIO()
-    np.savez_compressed(buffer, **arrays)
-    return buffer.getvalue()
+        arrays.append(report.prim_face_start)
+    arrays = [np.ascontiguousarray(a) for a in arrays]
+    meta["arrays"] = [[a.dtype.str, list(a.shape)] for a in arrays]
+    header = json.dumps(meta).encode("utf-8")
+    body = b"".join([len(header).to_bytes(4, "little"), header, *(a.tobytes() for a in arrays)])
+    return _BLOB_MAGIC + zlib.compress(body, 1)
 
 
 def report_from_bytes(data: bytes) -> FileReport:
     """The report :func:`report_to_bytes` stored; a damaged blob raises ValueError."""
-    import io
     import json
-    import zipfile
     import zlib
 
     try:
-        with np.load(io.BytesIO(data), allow_pickle=False) as blob:
-            meta = json.loads(blob["meta"].tobytes().decode("utf-8"))
-            hits = [
-                RuleHits(h["code"], threshold=h["threshold"], **{name: blob[f"hits{k}_{name}"] for name in _HIT_ARRAYS})
-                for k, h in enumerate(meta.pop("hits"))
-            ]
-            prim_face_start = blob["prim_face_start"] if "prim_face_start" in blob.files else None
-            return FileReport(**meta, hits=hits, prim_face_start=prim_face_start)
-    except (zipfile.BadZipFile, zlib.error, EOFError, KeyError, TypeError, OSError) as err:
+        if not data.startswith(_BLOB_MAGIC):
+            raise ValueError("no report header")
+        body = bytearray(zlib.decompress(data[len(_BLOB_MAGIC):]))  # writable, so the arrays are
+        size = int.from_bytes(body[:4], "little")
+        meta = json.loads(body[4 : 4 + size].decode("utf-8"))
+        arrays, offset = [], 4 + size
+        for dtype, shape in meta.pop("arrays"):
+            count = int(np.prod(shape, dtype=np.int64))
+            arrays.append(np.frombuffer(body, dtype=dtype, count=count, offset=offset).reshape(shape))
+            offset += arrays[-1].nbytes
+        if offset != len(body):
+            raise ValueError("arrays and header disagree")
+        hits = [
+            RuleHits(h["code"], threshold=h["threshold"], **dict(zip(_HIT_ARRAYS, arrays[4 * k : 4 * k + 4])))
+            for k, h in enumerate(meta.pop("hits"))
+        ]
+        prim_face_start = arrays[4 * len(hits)] if len(arrays) > 4 * len(hits) else None
+        return FileReport(**meta, hits=hits, prim_face_start=prim_face_start)
+    except (zlib.error, KeyError, TypeError, IndexError, UnicodeDecodeError) as err:
         raise ValueError(f"not a stored report: {type(err).__name__}: {err}") from None
 
 
 _HIT_ARRAYS = ("faces", "lines", "values", "groups")
+_BLOB_MAGIC = b"QAR1"

@@ -261,7 +261,7 @@ def test_damaged_cache_warns_is_replaced_and_still_checks(tmp_path):
     assert damaged.stdout == fresh.stdout and damaged.returncode == 2
     assert damaged.stderr.count("result cache") == 1 and "damaged" in damaged.stderr
     db = sqlite3.connect(cache_dir / DB_NAME)
-    db.execute("UPDATE results SET report = x'504b0304'")  # every entry now a broken zip
+    db.execute("UPDATE results SET report = x'51415231ff'")  # every entry now a broken blob
     db.commit()
     broken_entries = check_with_cache(folder, cache_dir)
     assert broken_entries.stdout == fresh.stdout and broken_entries.stderr.count("damaged entry") == 1
