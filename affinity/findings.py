@@ -96,6 +96,7 @@ def report_to_bytes(report: FileReport) -> bytes:
 def report_from_bytes(data: bytes) -> FileReport:
     """The report :func:`report_to_bytes` stored; a damaged blob raises ValueError."""
     import json
+    import math
     import zlib
 
     try:
@@ -106,7 +107,7 @@ def report_from_bytes(data: bytes) -> FileReport:
         meta = json.loads(body[4 : 4 + size].decode("utf-8"))
         arrays, offset = [], 4 + size
         for dtype, shape in meta.pop("arrays"):
-            count = int(np.prod(shape, dtype=np.int64))
+            count = math.prod(shape)
             arrays.append(np.frombuffer(body, dtype=dtype, count=count, offset=offset).reshape(shape))
             offset += arrays[-1].nbytes
         if offset != len(body):

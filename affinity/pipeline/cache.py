@@ -108,6 +108,7 @@ class ResultCache:
         self._db: sqlite3.Connection | None = None
         self._pending = 0
         self._damaged_entries = 0
+        self._settings: dict[int, tuple[Settings, dict]] = {}  # id -> (the object, kept alive; its fields)
         self._now = time.time()
         path = os.path.join(folder, DB_NAME)
         try:
@@ -171,7 +172,9 @@ class ResultCache:
         usd_key = None
         if os.path.splitext(path)[1].lower() in _USD_SUFFIXES:
             usd_key = [_usd_reader(), None if usd is None else dataclasses.asdict(usd)]
-        payload = _json([SCHEMA, self.tool, path, tree, dataclasses.asdict(settings), usd_key])
+        if id(settings) not in self._settings:  # files share a few Settings objects: describe each once
+            self._settings[id(settings)] = (settings, dataclasses.asdict(settings))
+        payload = _json([SCHEMA, self.tool, path, tree, self._settings[id(settings)][1], usd_key])
         return hashlib.blake2b(payload.encode(), digest_size=20).hexdigest()
 
     def _tree(self, path: str, seen: set[str]) -> list | None:
