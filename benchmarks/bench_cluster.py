@@ -77,7 +77,7 @@ class Remote:
     def __init__(self, tmp: str):
         dask = [sys.executable, "-m", "distributed.cli.dask_scheduler"]
         scheduler_file = os.path.join(tmp, "scheduler.json")
-        log = open(os.path.join(tmp, "dask.log"), "w")
+        log = subprocess.DEVNULL
         self.processes = [subprocess.Popen([*dask, "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
                                             "--scheduler-file", scheduler_file], stdout=log, stderr=log)]
         while not os.path.exists(scheduler_file):
