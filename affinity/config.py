@@ -27,6 +27,12 @@ Keys (kebab-case, as in ruff)::
 Thresholds must be finite numbers and ``select`` must name at least one rule
 (``ignore`` switches rules off): nothing here switches a check off silently.
 
+Run-level keys, read only from the configuration of the current directory
+(:meth:`Resolver.run_options`), never per file::
+
+    scheduler = "tcp://scheduler:8786"   # or "env", "local:4": check on a Dask cluster
+    cache = false                        # turn the result cache off
+
 Globs are relative to the configuration file's folder (see
 :func:`affinity.settings.glob_matches`).
 """
@@ -192,6 +198,22 @@ _KEYS = {
 }
 
 
+def _scheduler(value, where: str) -> str:
+    if not isinstance(value, str) or not value.strip():
+        raise ConfigError(f"{where}: expected a scheduler address, \"env\" or \"local:N\"")
+    return value.strip()
+
+
+def _flag(value, where: str) -> bool:
+    if not isinstance(value, bool):
+        raise ConfigError(f"{where}: expected true or false")
+    return value
+
+
+#: Run-level TOML keys -> validator; they apply to a whole run, so they are not Settings.
+_RUN_KEYS = {"scheduler": _scheduler, "cache": _flag}
+
+
 def read_config(path: Path) -> dict:
     """The validated options of a configuration file as Settings field names -> values.
 
@@ -203,12 +225,14 @@ def read_config(path: Path) -> dict:
     prefix = f"{path}: " + ("[tool.affinity] " if path.name == "pyproject.toml" else "")
     options: dict = {"root": os.path.abspath(path.parent)}
     for key, value in table.items():
-        if key == "threshold":
+        if key == "threshold" or key in _RUN_KEYS:
             continue
         if key not in _KEYS:
-            raise ConfigError(f"{prefix}unknown key {key!r} (known: threshold, {', '.join(_KEYS)})")
+            raise ConfigError(f"{prefix}unknown key {key!r} (known: threshold, {', '.join([*_KEYS, *_RUN_KEYS])})")
         name, validate = _KEYS[key]
         options[name] = validate(value, prefix + key)
+    for key in _RUN_KEYS.keys() & table.keys():
+        _RUN_KEYS[key](table[key], prefix + key)
     if "threshold" in table:
         if "Q101" in options.get("thresholds", {}):
             raise ConfigError(f"{prefix}threshold and thresholds.Q101 both set the Q101 threshold")
@@ -255,3 +279,12 @@ class Resolver:
             settings = Settings() if source is None else Settings().updated(read_config(source))
             self._by_source[source] = Resolved(settings.updated(self._overrides), source)
         return self._by_source[source]
+
+    def run_options(self) -> dict:
+        """The run-level keys (``scheduler``, ``cache``) of the configuration governing the current directory."""
+        source = self._source(Path(os.path.abspath(os.curdir)))
+        if source is None:
+            return {}
+        table = _table(source) or {}
+        prefix = f"{source}: " + ("[tool.affinity] " if source.name == "pyproject.toml" else "")
+        return {key: _RUN_KEYS[key](table[key], prefix + key) for key in _RUN_KEYS.keys() & table.keys()}

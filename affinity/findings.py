@@ -118,3 +118,61 @@ def settle(hits: list[RuleHits], settings, group_names: list[str], inline=()) ->
         if len(h):
             settled.append(h)
     return settled
+
+
+def report_to_bytes(report: FileReport) -> bytes:
+    """``report`` as a compact blob: a JSON header (fields, then each array's dtype and shape) and the
+    arrays' raw bytes, zlib-compressed.
+
+    :func:`report_from_bytes` gives back an equal report (same dtypes, same
+    values bit for bit), without pickle, so a damaged blob can only fail to load.
+    """
+    import json
+    import zlib
+    from dataclasses import fields
+
+    meta = {f.name: getattr(report, f.name) for f in fields(report) if f.name not in ("hits", "prim_face_start")}
+    meta["hits"] = [{"code": h.code, "threshold": h.threshold, "level": h.level, "unit": h.unit,
+                     "details": h.details} for h in report.hits]
+    arrays = [getattr(hits, name) for hits in report.hits for name in _HIT_ARRAYS]
+    if report.prim_face_start is not None:
+        arrays.append(report.prim_face_start)
+    arrays = [np.ascontiguousarray(a) for a in arrays]
+    meta["arrays"] = [[a.dtype.str, list(a.shape)] for a in arrays]
+    header = json.dumps(meta).encode("utf-8")
+    body = b"".join([len(header).to_bytes(4, "little"), header, *(a.tobytes() for a in arrays)])
+    return _BLOB_MAGIC + zlib.compress(body, 1)
+
+
+def report_from_bytes(data: bytes) -> FileReport:
+    """The report :func:`report_to_bytes` stored; a damaged blob raises ValueError."""
+    import json
+    import math
+    import zlib
+
+    try:
+        if not data.startswith(_BLOB_MAGIC):
+            raise ValueError("no report header")
+        body = bytearray(zlib.decompress(data[len(_BLOB_MAGIC):]))  # writable, so the arrays are
+        size = int.from_bytes(body[:4], "little")
+        meta = json.loads(body[4 : 4 + size].decode("utf-8"))
+        arrays, offset = [], 4 + size
+        for dtype, shape in meta.pop("arrays"):
+            count = math.prod(shape)
+            arrays.append(np.frombuffer(body, dtype=dtype, count=count, offset=offset).reshape(shape))
+            offset += arrays[-1].nbytes
+        if offset != len(body):
+            raise ValueError("arrays and header disagree")
+        hits = [
+            RuleHits(h["code"], threshold=h["threshold"], level=h["level"], unit=h["unit"], details=h["details"],
+                     **dict(zip(_HIT_ARRAYS, arrays[4 * k : 4 * k + 4])))
+            for k, h in enumerate(meta.pop("hits"))
+        ]
+        prim_face_start = arrays[4 * len(hits)] if len(arrays) > 4 * len(hits) else None
+        return FileReport(**meta, hits=hits, prim_face_start=prim_face_start)
+    except (zlib.error, KeyError, TypeError, IndexError, UnicodeDecodeError) as err:
+        raise ValueError(f"not a stored report: {type(err).__name__}: {err}") from None
+
+
+_HIT_ARRAYS = ("faces", "lines", "values", "groups")
+_BLOB_MAGIC = b"QAR1"

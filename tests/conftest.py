@@ -1,4 +1,4 @@
-"""What the whole suite shares: the real meshes of ../shared/meshes.
+"""What the whole suite shares: the real meshes of ../shared/meshes, and a temporary result cache.
 
 Tests take the ``shared_meshes`` fixture (the folder) or a ``manifest_entry``
 argument (parametrized over MANIFEST.json). Without the folder those tests skip,
@@ -41,3 +41,11 @@ def pytest_generate_tests(metafunc):
 def pytest_terminal_summary(terminalreporter):
     if not MANIFEST.is_file():
         terminalreporter.write_line(ABSENT)
+
+
+@pytest.fixture(autouse=True, scope="session")
+def result_cache_folder(tmp_path_factory):
+    """The result cache lives in a temporary folder, never in the user's cache."""
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("AFFINITY_CACHE_DIR", str(tmp_path_factory.mktemp("result-cache")))
+        yield

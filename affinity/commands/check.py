@@ -9,6 +9,7 @@ every flag given on the command line replaces the configured value of its key
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import os
 import sys
@@ -133,6 +134,12 @@ def add_parser(sub) -> None:
                    help="json/sarif: keep the worst N findings per file and rule, and say what was truncated")
     p.add_argument("--show-files", action="store_true", help="list the files that would be checked and exit")
     p.add_argument("-o", "--output-file", metavar="PATH", help="write the output to PATH (whole or not at all)")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="check the files on a Dask cluster: a scheduler address, env (DASK_SCHEDULER_ADDRESS) "
+                        "or local:N (N local worker processes); needs the distributed extra")
+    p.add_argument("--no-cache", action="store_true",
+                   help="check every file again instead of reusing the results of unchanged files "
+                        "(cache folder: AFFINITY_CACHE_DIR, else the user cache folder)")
     p.add_argument("--statistics", action="store_true",
                    help="text: counts per rule instead of findings; json/sarif/github/junit: counts added")
     p.add_argument("--verbose", action="store_true", help="show every finding in text output")
@@ -169,14 +176,50 @@ def _report_problems(reports, quiet: bool, skips_fail: bool = False) -> None:
             sys.stderr.write(f"{report.path}: note: {note}\n")
 
 
-def _progress_bar():
-    """A tqdm wrapper for the stream of reports; imported only when stderr is a terminal."""
+def _progress_bar(dashboard: str | None = None):
+    """A tqdm bar over the stream of ``(index, report)`` pairs: files, findings so far, files per second.
+
+    Imported only when stderr is a terminal; ``dashboard`` (a Dask dashboard link) goes in front.
+    """
     from tqdm import tqdm
 
-    def progress(reports, total):
-        return tqdm(reports, total=total, unit="file", delay=1.0, leave=False, file=sys.stderr)
+    def progress(results, total):
+        findings = 0
+        with tqdm(total=total, unit="file", delay=1.0, leave=False, file=sys.stderr,
+                  desc=f"dashboard {dashboard}" if dashboard else None) as bar:
+            for result in results:
+                findings += result[1].n_findings
+                bar.set_postfix_str(f"{findings} findings", refresh=False)
+                bar.update()
+                yield result
 
     return progress
+
+
+@contextlib.contextmanager
+def _run_on(args, run_options: dict):
+    """``(client, cache, dashboard link)``: the Dask client of ``--scheduler`` (or of the configured
+    ``scheduler``) and its dashboard, else None; the result cache, else None."""
+    from ..pipeline.cache import ResultCache, cache_folder
+
+    cache = None
+    if not args.no_cache and run_options.get("cache", True):
+        cache = ResultCache(cache_folder())
+    scheduler = args.scheduler or run_options.get("scheduler")
+    try:
+        if scheduler is None:
+            yield None, cache, None
+            return
+        from . import require
+
+        require(("distributed",), "distributed")
+        from ..pipeline.cluster import connect, dashboard_link
+
+        with connect(scheduler) as client:
+            yield client, cache, dashboard_link(client)
+    finally:
+        if cache is not None:
+            cache.close()
 
 
 def _tasks(resolver, paths: list[str]) -> list:
@@ -231,8 +274,10 @@ def run(args) -> int:
     if args.show_files:
         _write_output_file(args.output_file, lambda out: out.writelines(path + "\n" for path, _ in tasks))
         return EXIT_CLEAN
-    progress = _progress_bar() if len(tasks) > 1 and sys.stderr.isatty() else None
-    reports = check_files(tasks, args.jobs, progress, usd=UsdOptions(args.time, args.uv_primvar))
+    with _run_on(args, resolver.run_options()) as (client, cache, dashboard):
+        progress = _progress_bar(dashboard) if len(tasks) > 1 and sys.stderr.isatty() else None
+        reports = check_files(tasks, args.jobs, progress, usd=UsdOptions(args.time, args.uv_primvar),
+                              cache=cache, client=client)
     _report_problems(reports, args.quiet, args.fail_on_skip)
     failed = any(r.error is not None or (args.fail_on_skip and r.skipped is not None) for r in reports)
     if args.write_baseline:

@@ -89,22 +89,55 @@ def auto_jobs(paths: list[str]) -> int:
 def check_files(
     tasks: list[tuple[str, Settings]],
     jobs: int | None = None,
-    progress: Callable[[Iterable[FileReport], int], Iterator[FileReport]] | None = None,
+    progress: Callable[[Iterable[tuple[int, FileReport]], int], Iterator[tuple[int, FileReport]]] | None = None,
     usd=None,
+    cache=None,
+    client=None,
 ) -> list[FileReport]:
     """Check ``(path, settings)`` pairs with up to ``jobs`` processes; reports in task order.
 
     ``jobs`` None picks :func:`auto_jobs`. One file or one job stays in this
     process (no pool start-up). ``progress``, when given, wraps the stream of
-    finished reports (e.g. a progress bar) and receives the number of tasks.
-    ``usd`` is passed on to :func:`check_file`.
+    ``(task index, report)`` pairs as they finish (e.g. a progress bar) and
+    receives the number of tasks. ``usd`` is passed on to :func:`check_file`.
+    ``cache`` (:class:`affinity.pipeline.cache.ResultCache`) answers for the
+    unchanged files before anything is checked, and keeps the new reports.
+    ``client`` (a ``dask.distributed.Client``) checks the files on its cluster
+    instead of ``jobs`` local processes (:mod:`affinity.pipeline.cluster`).
     """
+    keys = [None] * len(tasks) if cache is None else [cache.key(path, s, usd) for path, s in tasks]
+    known = {} if cache is None else {i: hit for i, key in enumerate(keys) if (hit := cache.get(key)) is not None}
+    todo = [i for i in range(len(tasks)) if i not in known]
+    if client is not None:
+        from .cluster import check_on_cluster
+
+        fresh = check_on_cluster(client, [tasks[i] for i in todo], usd)
+    else:
+        fresh = enumerate(_check_here([tasks[i] for i in todo], jobs, usd))
+    reports: list[FileReport | None] = [None] * len(tasks)
+    for i, report in _tracked(_chain(known, todo, fresh), len(tasks), progress):
+        reports[i] = report
+        if cache is not None and i not in known:
+            cache.put(keys[i], report)
+    return reports
+
+
+def _chain(known: dict, todo: list[int], fresh) -> Iterator[tuple[int, FileReport]]:
+    """The cached reports first, then the fresh ones (numbered within ``todo``) as task indices."""
+    yield from known.items()
+    for j, report in fresh:
+        yield todo[j], report
+
+
+def _check_here(tasks: list[tuple[str, Settings]], jobs: int | None, usd) -> Iterator[FileReport]:
+    """The reports of ``tasks`` in order, checked in this process or a local process pool."""
     paths = [path for path, _ in tasks]
     settings = [s for _, s in tasks]
     check = partial(check_file, usd=usd)
     workers = min(auto_jobs(paths) if jobs is None else jobs, len(tasks))
     if workers <= 1:
-        return list(_tracked(map(check, paths, settings), len(tasks), progress))
+        yield from map(check, paths, settings)
+        return
 
     from concurrent.futures import ProcessPoolExecutor
 
@@ -113,9 +146,8 @@ def check_files(
     # Small chunks balance uneven file sizes; a few per worker keep the pickling overhead low.
     chunksize = max(1, len(tasks) // (workers * 8))
     with ProcessPoolExecutor(max_workers=workers) as pool:
-        reports = pool.map(check, paths, settings, chunksize=chunksize)
-        return list(_tracked(reports, len(tasks), progress))
+        yield from pool.map(check, paths, settings, chunksize=chunksize)
 
 
-def _tracked(reports: Iterator[FileReport], total: int, progress) -> Iterator[FileReport]:
-    return reports if progress is None else progress(reports, total)
+def _tracked(results: Iterator, total: int, progress) -> Iterator:
+    return results if progress is None else progress(results, total)

@@ -1,0 +1,330 @@
+"""The result cache: an unchanged file's report comes back without reading the file again.
+
+A report is stored under a key made of
+
+- the content hash of the file and of everything it pulls in: an OBJ's
+  ``mtllib`` files and their ``map_Kd`` textures, a USD layer's sublayers,
+  references and payloads (recursively; ``pxr``'s ``GetCompositionAssetDependencies``);
+- the path as given (reports name it) and the resolved settings of the file,
+  and the USD reading options;
+- the tool: its version and a hash of the installed package's source files,
+  since the version string does not change between commits.
+
+Content hashes are remembered per file under a pre-key (path, size, mtime_ns,
+inode), so an unchanged file costs one ``stat`` and is not read. A file
+modified in the last :data:`RACY_SECONDS` gets no pre-key (its mtime may not
+yet tell two versions apart, as in git's "racy" index entries): it is hashed
+again next time.
+
+The cache is one SQLite file in the user cache folder (``platformdirs``), or in
+``AFFINITY_CACHE_DIR``. It is an optimisation only: a folder that cannot be
+written or a damaged database gives one warning line on stderr and the run goes
+on (a damaged database is replaced by a new one). Reports whose error starts
+with ``"internal error"`` are never stored. Entries unused for
+:data:`MAX_AGE_DAYS` days go, and the oldest go first when the entries exceed
+:data:`MAX_BYTES`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import os
+import re
+import sqlite3
+import sys
+import time
+
+from ..findings import FileReport, report_from_bytes, report_to_bytes
+from ..settings import Settings
+
+#: Bump when the key or the stored report changes meaning.
+SCHEMA = 1
+DB_NAME = f"results-v{SCHEMA}.sqlite"
+MAX_AGE_DAYS = 30
+MAX_BYTES = 200_000_000
+RACY_SECONDS = 2.0
+#: Rows written between commits (one transaction per row would cost an fsync each).
+COMMIT_EVERY = 200
+
+_DAY = 86_400.0
+_MTLLIB = re.compile(rb"^[ \t]*mtllib[ \t]+([^\r\n#]*)", re.MULTILINE)
+_USD_SUFFIXES = (".usd", ".usda", ".usdc", ".usdz")
+_CHUNK = 1 << 20
+
+_TABLES = """
+CREATE TABLE IF NOT EXISTS files (path TEXT PRIMARY KEY, size INTEGER, mtime_ns INTEGER, inode INTEGER,
+                                  digest TEXT, deps TEXT, used REAL);
+CREATE TABLE IF NOT EXISTS results (key TEXT PRIMARY KEY, report BLOB, used REAL);
+"""
+
+
+def cache_folder() -> str:
+    """``AFFINITY_CACHE_DIR``, else the user cache folder of quad-affinity."""
+    folder = os.environ.get("AFFINITY_CACHE_DIR")
+    if folder:
+        return folder
+    import platformdirs
+
+    return platformdirs.user_cache_dir("quad-affinity", appauthor=False)
+
+
+def tool_fingerprint() -> str:
+    """The version, NumPy's version and a hash of every ``.py`` file of the ``affinity`` and ``render`` packages.
+
+    ``render`` is found, not imported: ``affinity check`` never loads the renderer.
+    """
+    from importlib.util import find_spec
+    from pathlib import Path
+
+    import numpy as np
+
+    from .. import __version__
+
+    digest = hashlib.blake2b(f"{__version__} numpy {np.__version__}".encode(), digest_size=20)
+    for package in ("affinity", "render"):
+        for root in map(Path, find_spec(package).submodule_search_locations):
+            for source in sorted(root.rglob("*.py")):
+                digest.update(f"{package}/{source.relative_to(root).as_posix()}".encode() + b"\0")
+                digest.update(source.read_bytes())
+    return digest.hexdigest()
+
+
+def _json(value) -> str:
+    return json.dumps(value, sort_keys=True, separators=(",", ":"))
+
+
+class ResultCache:
+    """Reports by key in ``folder``; every failure is one warning line, then the cache is off.
+
+    Use :meth:`key` then :meth:`get` before checking a file, :meth:`put` after,
+    and :meth:`close` at the end of the run (commits and prunes).
+    """
+
+    def __init__(self, folder: str, tool: str | None = None):
+        self.folder = folder
+        self.tool = tool_fingerprint() if tool is None else tool
+        self._db: sqlite3.Connection | None = None
+        self._pending = 0
+        self._damaged_entries = 0
+        self._settings: dict[int, tuple[Settings, dict]] = {}  # id -> (the object, kept alive; its fields)
+        self._now = time.time()
+        path = os.path.join(folder, DB_NAME)
+        try:
+            self._db = self._open(path)
+        except sqlite3.DatabaseError as err:  # not a database, or a damaged one
+            if isinstance(err, sqlite3.OperationalError) and not os.path.isfile(path):
+                self._warn(f"cannot open it ({err})")
+                return
+            self._warn(f"damaged ({err}); starting a new one", off=False)
+            try:
+                for suffix in ("", "-wal", "-shm"):
+                    if os.path.exists(path + suffix):
+                        os.remove(path + suffix)
+                self._db = self._open(path)
+            except (OSError, sqlite3.Error) as again:
+                self._warn(f"cannot replace it ({again})")
+        except OSError as err:
+            self._warn(f"cannot create it ({err.strerror or err})")
+
+    @staticmethod
+    def _open(path: str) -> sqlite3.Connection:
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        db = sqlite3.connect(path, timeout=10)
+        try:
+            db.execute("PRAGMA journal_mode=WAL")
+            db.execute("PRAGMA synchronous=NORMAL")
+            db.executescript(_TABLES)
+            db.execute("SELECT count(*) FROM results").fetchone()
+        except BaseException:
+            db.close()
+            raise
+        return db
+
+    def _warn(self, reason: str, off: bool = True) -> None:
+        action = "; checking without it" if off else ""
+        sys.stderr.write(f"affinity: warning: result cache {self.folder}: {reason}{action}\n")
+        if off and self._db is not None:
+            try:
+                self._db.close()
+            except sqlite3.Error:
+                pass
+            self._db = None
+
+    @property
+    def enabled(self) -> bool:
+        return self._db is not None
+
+    # -- keys -------------------------------------------------------------------------------------
+
+    def key(self, path: str, settings: Settings, usd=None) -> str | None:
+        """The key of ``path`` checked with ``settings``; None when the file cannot be hashed (no caching)."""
+        if self._db is None:
+            return None
+        try:
+            tree = self._tree(os.path.abspath(path), set())
+        except sqlite3.Error as err:
+            self._warn(f"cannot read it ({err})")
+            return None
+        if tree is None:
+            return None
+        usd_key = None
+        if os.path.splitext(path)[1].lower() in _USD_SUFFIXES:
+            usd_key = [_usd_reader(), None if usd is None else dataclasses.asdict(usd)]
+        if id(settings) not in self._settings:  # files share a few Settings objects: describe each once
+            self._settings[id(settings)] = (settings, dataclasses.asdict(settings))
+        payload = _json([SCHEMA, self.tool, path, tree, self._settings[id(settings)][1], usd_key])
+        return hashlib.blake2b(payload.encode(), digest_size=20).hexdigest()
+
+    def _tree(self, path: str, seen: set[str]) -> list | None:
+        """``[path, digest, dependency trees...]``; None when ``path`` is not a readable file."""
+        found = self._digest(path)
+        if found is None:
+            return None
+        digest, deps = found
+        seen.add(path)
+        trees = [[dep, "cycle"] if dep in seen else self._tree(dep, seen) or [dep, "missing"] for dep in deps]
+        return [path, digest, *trees]
+
+    def _digest(self, path: str) -> tuple[str, list[str]] | None:
+        """A file's content hash and the files it pulls in, from its pre-key when it is unchanged."""
+        try:
+            st = os.stat(path)
+        except OSError:
+            return None
+        if not os.path.isfile(path):
+            return None
+        prekey = (st.st_size, st.st_mtime_ns, st.st_ino)
+        row = self._db.execute("SELECT size, mtime_ns, inode, digest, deps FROM files WHERE path = ?",
+                               (path,)).fetchone()
+        if row is not None and tuple(row[:3]) == prekey:
+            return row[3], json.loads(row[4])
+        try:
+            digest, deps = _hash_file(path)
+        except OSError:
+            return None
+        if st.st_mtime_ns < (self._now - RACY_SECONDS) * 1e9:
+            self._write("INSERT OR REPLACE INTO files VALUES (?, ?, ?, ?, ?, ?, ?)",
+                        (path, *prekey, digest, _json(deps), self._now))
+        return digest, deps
+
+    # -- entries ----------------------------------------------------------------------------------
+
+    def get(self, key: str | None) -> FileReport | None:
+        """The stored report for ``key``, or None."""
+        if key is None or self._db is None:
+            return None
+        try:
+            row = self._db.execute("SELECT report, used FROM results WHERE key = ?", (key,)).fetchone()
+        except sqlite3.Error as err:
+            self._warn(f"cannot read it ({err})")
+            return None
+        if row is None:
+            return None
+        try:
+            report = report_from_bytes(row[0])
+        except ValueError as err:
+            if not self._damaged_entries:
+                self._warn(f"damaged entry ({err}); checking such files again", off=False)
+            self._damaged_entries += 1
+            self._write("DELETE FROM results WHERE key = ?", (key,))
+            return None
+        if row[1] < self._now - _DAY:
+            self._write("UPDATE results SET used = ? WHERE key = ?", (self._now, key))
+        return report
+
+    def put(self, key: str | None, report: FileReport) -> None:
+        """Store ``report`` under ``key``; internal errors are not stored."""
+        if key is None or self._db is None or (report.error or "").startswith("internal error"):
+            return
+        self._write("INSERT OR REPLACE INTO results VALUES (?, ?, ?)", (key, report_to_bytes(report), self._now))
+
+    def _write(self, sql: str, values: tuple) -> None:
+        if self._db is None:
+            return
+        try:
+            self._db.execute(sql, values)
+            self._pending += 1
+            if self._pending >= COMMIT_EVERY:
+                self._db.commit()
+                self._pending = 0
+        except sqlite3.Error as err:
+            self._warn(f"cannot write it ({err})")
+
+    def close(self) -> None:
+        """Commit, drop entries unused for :data:`MAX_AGE_DAYS` and the oldest beyond :data:`MAX_BYTES`."""
+        if self._db is None:
+            return
+        old = self._now - MAX_AGE_DAYS * _DAY
+        try:
+            self._db.execute("DELETE FROM results WHERE used < ?", (old,))
+            self._db.execute("DELETE FROM files WHERE used < ?", (old,))
+            self._db.execute(
+                "DELETE FROM results WHERE key IN (SELECT key FROM (SELECT key, SUM(LENGTH(report)) "
+                "OVER (ORDER BY used DESC, key) AS running FROM results) WHERE running > ?)", (MAX_BYTES,))
+            self._db.commit()
+            self._db.close()
+        except sqlite3.Error as err:
+            self._warn(f"cannot write it ({err})")
+        self._db = None
+
+
+def _hash_file(path: str) -> tuple[str, list[str]]:
+    """The content hash of ``path`` and the absolute paths of the files it pulls in."""
+    suffix = os.path.splitext(path)[1].lower()
+    digest = hashlib.blake2b(digest_size=20)
+    libraries: list[bytes] = []
+    tail = b""
+    with open(path, "rb") as fh:
+        while chunk := fh.read(_CHUNK):
+            digest.update(chunk)
+            if suffix == ".obj":  # mtllib lines, scanned whole: a chunk may end inside a line
+                block = tail + chunk
+                cut = block.rfind(b"\n") + 1
+                libraries += _MTLLIB.findall(block, 0, cut)
+                tail = block[cut:]
+    libraries += _MTLLIB.findall(tail)
+    folder = os.path.dirname(path)
+    if suffix == ".obj":
+        names = (" ".join(name.decode("utf-8", "replace").split()) for name in libraries)
+        deps = [os.path.join(folder, name) for name in names if name]
+    elif suffix == ".mtl":
+        from ..loaders.mtl import read_material_textures
+
+        deps = list(dict.fromkeys(read_material_textures(path).values()))
+    elif suffix in _USD_SUFFIXES:
+        deps = _usd_dependencies(path)
+    else:
+        deps = []
+    return digest.hexdigest(), [os.path.abspath(dep) for dep in deps]
+
+
+def _usd_reader() -> str | None:
+    """The usd-core version that would read a stage, None without one (found, not imported: that is slow)."""
+    from importlib.metadata import PackageNotFoundError, version
+    from importlib.util import find_spec
+
+    if "pxr" in sys.modules and sys.modules["pxr"] is None:  # blocked, as a test does
+        return None
+    if find_spec("pxr") is None:
+        return None
+    try:
+        return version("usd-core")
+    except PackageNotFoundError:  # pxr from a USD build rather than the wheel
+        return "pxr"
+
+
+def _usd_dependencies(path: str) -> list[str]:
+    """The sublayers, references and payloads a USD layer names, as paths (none without ``pxr``)."""
+    try:
+        from pxr import Sdf, Tf
+    except ImportError:
+        return []
+    try:
+        layer = Sdf.Layer.FindOrOpen(path)
+    except Tf.ErrorException:
+        return []
+    if layer is None:
+        return []
+    return [layer.ComputeAbsolutePath(asset) for asset in sorted(layer.GetCompositionAssetDependencies())]

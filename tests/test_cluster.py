@@ -1,0 +1,174 @@
+"""``affinity check --scheduler``: a real LocalCluster (2 worker processes on 127.0.0.1) gives a local run's output."""
+
+from __future__ import annotations
+
+import os
+import signal
+import socket
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from test_cli_check import run
+from test_formats import SQUARE, UNIT_UV, quad_obj, trapezoid
+
+from affinity.pipeline import cluster as cluster_module
+from affinity.pipeline.check import check_files
+from affinity.settings import Settings
+
+pytest.importorskip("distributed")
+
+
+@pytest.fixture(scope="module")
+def client():
+    """One cluster for the module, started the way ``--scheduler local:2`` starts it."""
+    with cluster_module.connect("local:2") as dask_client:
+        assert len(dask_client.scheduler_info()["workers"]) == 2
+        assert dask_client.scheduler.address.startswith("tcp://127.0.0.1:")
+        yield dask_client
+
+
+@pytest.fixture(scope="module")
+def assets(tmp_path_factory) -> Path:
+    """Meshes of different sizes with known findings, a clean one, a broken one and one in a subfolder."""
+    folder = tmp_path_factory.mktemp("assets")
+    for i in range(10):
+        quads = [(trapezoid(0.2 + 0.1 * k, 3 * k), UNIT_UV) for k in range(1 + 30 * (i % 3))]
+        (folder / f"mesh_{i:02d}.obj").write_text(quad_obj(quads + [(SQUARE, UNIT_UV)] * (400 * i)))
+    (folder / "clean.obj").write_text(quad_obj([(SQUARE, UNIT_UV)]))
+    (folder / "broken.obj").write_text("v 0 0 0\nv 1 0 0\nf 1 2 7\n")
+    (folder / "props").mkdir()
+    (folder / "props" / "lid.obj").write_text(quad_obj([(trapezoid(0.5), UNIT_UV)]))
+    return folder
+
+
+def check(folder: Path, *extra: str, env: dict | None = None) -> subprocess.CompletedProcess:
+    """``affinity check --no-cache ... .`` in ``folder``; the local runs are remembered (they do not change)."""
+    key = (folder, extra, tuple(sorted((env or {}).items())))
+    if "--scheduler" not in extra and key in _LOCAL_RUNS:
+        return _LOCAL_RUNS[key]
+    result = subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--no-cache", *extra, "."],
+                          capture_output=True, text=True, cwd=folder, timeout=120, env={**os.environ, **(env or {})})
+    if "--scheduler" not in extra:
+        _LOCAL_RUNS[key] = result
+    return result
+
+
+_LOCAL_RUNS: dict = {}
+
+
+@pytest.mark.parametrize("fmt", ["text", "json"])
+def test_cluster_output_is_the_local_output(client, assets, fmt):
+    local = check(assets, "--verbose", "--format", fmt)
+    remote = check(assets, "--verbose", "--format", fmt, "--scheduler", client.scheduler.address)
+    assert local.returncode == remote.returncode == 2, local.stderr
+    assert (remote.stdout, remote.stderr) == (local.stdout, local.stderr)
+    assert "broken.obj:3: Q901 unreadable" in local.stderr and local.stdout.count("Q101") > 30
+
+
+def test_scheduler_from_the_environment_and_from_the_config(client, assets, tmp_path):
+    local = check(assets, "--verbose", "--format", "text")
+    address = {"DASK_SCHEDULER_ADDRESS": client.scheduler.address}
+    assert check(assets, "--verbose", "--format", "text", "--scheduler", "env", env=address).stdout == local.stdout
+    (tmp_path / "affinity.toml").write_text('scheduler = "tcp://127.0.0.1:1"\n')
+    configured = subprocess.run(
+        [sys.executable, "-m", "affinity.cli", "check", "--no-cache", str(assets)], capture_output=True, text=True,
+        cwd=tmp_path, timeout=120, env={**os.environ, "DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT": "1s"})
+    assert configured.returncode == 2 and "--scheduler tcp://127.0.0.1:1: no Dask scheduler" in configured.stderr
+
+
+def test_a_lost_worker_costs_only_its_tasks(client, assets):
+    tasks = [(str(p), Settings()) for p in sorted(assets.rglob("*.obj"))]
+    expected = [r.n_findings for r in check_files(tasks, jobs=1)]
+    seen, killed = [], []
+
+    def kill_a_busy_worker(results, total):
+        for index, report in results:
+            if not seen:  # the first file is back: the others are still queued or running on the workers
+                busy = [w for w, keys in client.processing().items() if keys]
+                killed.append(client.run(os.getpid, workers=busy[:1])[busy[0]])
+                os.kill(killed[0], signal.SIGKILL)
+            seen.append(index)
+            yield index, report
+
+    reports = check_files(tasks, progress=kill_a_busy_worker, client=client)
+    assert sorted(seen) == list(range(len(tasks)))
+    assert [r.n_findings for r in reports] == expected and [r.path for r in reports] == [p for p, _ in tasks]
+    assert not any((r.error or "").startswith("internal error") for r in reports)
+    client.wait_for_workers(2, timeout=60)
+    assert killed[0] not in client.run(os.getpid).values()  # the nanny started a new worker process
+
+
+def test_a_path_the_worker_cannot_see_is_unreadable_with_the_reason(client, tmp_path):
+    missing = tmp_path / "only-on-the-client" / "crate.obj"
+    [(index, report)] = list(cluster_module.check_on_cluster(client, [(str(missing), Settings())]))
+    assert index == 0 and report.path == str(missing)
+    assert "not found on the Dask worker" in report.error and "shared storage" in report.error
+
+
+def test_cached_files_are_not_submitted(client, assets, tmp_path, monkeypatch):
+    from affinity.pipeline.cache import ResultCache
+
+    tasks = [(str(p), Settings()) for p in sorted(assets.glob("mesh_*.obj"))]
+    for path, _ in tasks:  # out of the racy window, so the pre-keys are kept
+        os.utime(path, (os.stat(path).st_atime - 3600, os.stat(path).st_mtime - 3600))
+    submitted = []
+    real = cluster_module.check_on_cluster
+
+    def counting(dask_client, todo, usd=None):
+        submitted.append(len(todo))
+        return real(dask_client, todo, usd)
+
+    monkeypatch.setattr(cluster_module, "check_on_cluster", counting)
+    runs = []
+    for _ in range(2):
+        cache = ResultCache(str(tmp_path), tool="t")
+        runs.append([r.n_findings for r in check_files(tasks, cache=cache, client=client)])
+        cache.close()
+    assert submitted == [len(tasks), 0] and runs[0] == runs[1]
+
+
+def test_a_scheduler_that_does_not_answer_is_one_line_and_exit_2(assets):
+    with socket.socket() as probe:  # a port nothing listens on
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    result = check(assets, "--scheduler", f"tcp://127.0.0.1:{port}",
+                   env={"DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT": "1s"})
+    assert result.returncode == 2 and result.stdout == ""
+    assert result.stderr.strip().count("\n") == 0 and "Traceback" not in result.stderr
+    assert f"tcp://127.0.0.1:{port}: no Dask scheduler answered within 1 s" in result.stderr
+
+
+@pytest.mark.parametrize("spec, message", [("env", "DASK_SCHEDULER_ADDRESS is not set"),
+                                           ("local:0", "expected local:N")])
+def test_bad_scheduler_specs_are_usage_errors(assets, spec, message):
+    env = {k: v for k, v in os.environ.items() if k != "DASK_SCHEDULER_ADDRESS"}
+    result = subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--scheduler", spec, "."],
+                            capture_output=True, text=True, cwd=assets, timeout=120, env=env)
+    assert result.returncode == 2 and message in result.stderr and "Traceback" not in result.stderr
+
+
+def test_check_without_scheduler_never_imports_dask(assets):
+    probe = (
+        "import sys, runpy\n"
+        "sys.argv = ['affinity', 'check', sys.argv[1]]\n"
+        "try:\n"
+        "    runpy.run_module('affinity.cli', run_name='__main__')\n"
+        "except SystemExit:\n"
+        "    pass\n"
+        "print(sorted(m for m in sys.modules if m.split('.')[0] in ('dask', 'distributed')))\n"
+    )
+    env = {**os.environ, "DASK_SCHEDULER_ADDRESS": "tcp://127.0.0.1:1"}  # the variable alone changes nothing
+    result = subprocess.run([sys.executable, "-c", probe, str(assets / "clean.obj")],
+                            capture_output=True, text=True, env=env, timeout=120)
+    assert result.stdout.strip().endswith("[]"), result.stdout + result.stderr
+    assert run("check", str(assets / "clean.obj")).returncode == 0
+
+
+def test_the_progress_bar_passes_every_result_through(capsys):
+    from affinity.commands.check import _progress_bar
+    from affinity.findings import FileReport
+
+    results = [(2, FileReport("a.obj")), (0, FileReport("b.obj")), (1, FileReport("c.obj", error="x"))]
+    assert list(_progress_bar("http://127.0.0.1:8787/status")(iter(results), 3)) == results
