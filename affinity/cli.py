@@ -10,7 +10,6 @@ import argparse
 import functools
 import sys
 
-from .errors import UsageError
 from .commands import EXIT_CLEAN, EXIT_ERROR
 from .commands import bench as bench_command
 from .commands import check as check_command
@@ -19,6 +18,7 @@ from .commands import report as report_command
 from .commands import rules as rules_command
 from .commands import stability as stability_command
 from .commands import view as view_command
+from .errors import UsageError
 
 SUBCOMMANDS = [check_command, render_command, rules_command, report_command, view_command, stability_command,
                bench_command]

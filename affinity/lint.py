@@ -26,7 +26,6 @@ from .mesh import ATTRIBUTE_NAMES, Mesh
 from .rules import RULES, resolve_codes
 from .settings import Settings
 
-
 #: Quads measured together. Whole-mesh temporaries of a million quads spill out
 #: of the caches; batches of this size keep them in, and let the batches run on
 #: parallel threads.

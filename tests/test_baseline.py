@@ -8,8 +8,8 @@ from pathlib import Path
 from test_cli_check import run
 from test_formats import SQUARE, UNIT_UV, hits, quad_obj, trapezoid
 
-from affinity.pipeline import baseline
 from affinity.findings import FileReport
+from affinity.pipeline import baseline
 
 # Three trapezoids of different shapes (different Q101 values) in two groups, and a clean square.
 QUADS = [(trapezoid(1.0, 0), UNIT_UV), (SQUARE, UNIT_UV), (trapezoid(0.5, 3), UNIT_UV), (trapezoid(1.5, 6), UNIT_UV)]

@@ -2,8 +2,8 @@
 
 import pytest
 
-from affinity.errors import UsageError
 from affinity.commands import require
+from affinity.errors import UsageError
 
 
 def test_require_names_the_missing_module_and_the_extra():

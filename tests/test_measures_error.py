@@ -109,9 +109,9 @@ MESHES = Path(__file__).resolve().parents[2] / "shared" / "meshes"
 def test_never_above_the_corner_extent_on_the_shared_meshes():
     """Every Q101-Q103 value of every quad (linted at threshold -inf) against the largest
     distance between two of its corner values, in the rule's unit."""
-    from affinity.loaders.imagesize import image_size
     from affinity.lint import lint_mesh
     from affinity.loaders import load
+    from affinity.loaders.imagesize import image_size
     from affinity.settings import Settings
 
     checked = 0

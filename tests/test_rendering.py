@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from affinity.mesh import Mesh, mesh_from_polygons
 from affinity.draw.quads import render_corners
 from affinity.draw.shading import shading_inputs
+from affinity.mesh import Mesh, mesh_from_polygons
 from affinity.scenes import color_squares, latlong_sphere
 
 

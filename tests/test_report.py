@@ -15,8 +15,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from affinity.mesh import mesh_from_polygons
 from affinity.loaders.objwriter import write_obj
+from affinity.mesh import mesh_from_polygons
 from affinity.scenes import color_squares
 
 TRAPEZOID = "v -1 0 0\nv 1 0 0\nv 0.5 1 0\nv -0.5 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n"

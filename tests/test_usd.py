@@ -25,12 +25,12 @@ from test_cli_check import run
 from test_sarif import assert_valid
 
 import affinity.loaders.usd
+from affinity.errors import MeshError
+from affinity.loaders import load
+from affinity.loaders.objwriter import write_obj
+from affinity.loaders.usd import UsdOptions, _Primvar, colors_per_vertex, corner_index
 from affinity.pipeline.check import check_file, check_files
 from affinity.pipeline.files import MESH_SUFFIXES, collect_paths
-from affinity.loaders import load
-from affinity.loaders.usd import UsdOptions, _Primvar, colors_per_vertex, corner_index
-from affinity.errors import MeshError
-from affinity.loaders.objwriter import write_obj
 from affinity.rules import RULES
 from affinity.settings import Settings
 

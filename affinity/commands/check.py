@@ -109,18 +109,21 @@ def add_parser(sub) -> None:
                    help="which split diagonal the affinity test measures (default: both)")
     p.add_argument("--texture-size", type=int, metavar="PX",
                    help="texture size for texel units when the mesh names no readable map_Kd (default 1024)")
-    p.add_argument("--time", type=_time, metavar="T",
-                   help="USD: read the stage at time code T (default: the earliest time sample)")
-    p.add_argument("--uv-primvar", metavar="NAME",
-                   help="USD: texture coordinates from primvar NAME (default: st, else the first texCoord2f primvar)")
-    p.add_argument("--config", metavar="FILE",
-                   help="use this affinity.toml/pyproject.toml for every file instead of searching")
-    p.add_argument("--isolated", action="store_true", help="ignore configuration files")
-    p.add_argument("--show-settings", action="store_true",
-                   help="print the resolved settings (and the file they came from) and exit")
-    p.add_argument("--baseline", metavar="FILE", help="report only findings not recorded in this baseline")
-    p.add_argument("--write-baseline", metavar="FILE",
-                   help="record every current finding in FILE (counts per file, group and rule) and exit")
+    usd = p.add_argument_group("USD stages")
+    usd.add_argument("--time", type=_time, metavar="T",
+                     help="read the stage at time code T (default: the earliest time sample)")
+    usd.add_argument("--uv-primvar", metavar="NAME",
+                     help="texture coordinates from primvar NAME (default: st, else the first texCoord2f primvar)")
+    config = p.add_argument_group("configuration")
+    config.add_argument("--config", metavar="FILE",
+                        help="use this affinity.toml/pyproject.toml for every file instead of searching")
+    config.add_argument("--isolated", action="store_true", help="ignore configuration files")
+    config.add_argument("--show-settings", action="store_true",
+                        help="print the resolved settings (and the file they came from) and exit")
+    known = p.add_argument_group("baseline")
+    known.add_argument("--baseline", metavar="FILE", help="report only findings not recorded in this baseline")
+    known.add_argument("--write-baseline", metavar="FILE",
+                       help="record every current finding in FILE (counts per file, group and rule) and exit")
     p.add_argument("-j", "--jobs", type=_jobs, metavar="N",
                    help="check files in N processes (default: all CPUs, fewer when the files are small)")
     p.add_argument("--fail-on", choices=LEVELS, default="warning",
@@ -248,9 +251,9 @@ def _write_baseline(reports, path: str, quiet: bool) -> None:
 
 def run(args) -> int:
     from ..config import Resolver
-    from ..pipeline.check import check_files
     from ..loaders.usd import UsdOptions
     from ..output import CheckRun
+    from ..pipeline.check import check_files
 
     if args.baseline and args.write_baseline:
         raise UsageError("--baseline and --write-baseline exclude each other")

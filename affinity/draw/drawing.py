@@ -21,6 +21,7 @@ from .quads import render_corners
 from .routing import MVC, SPLIT, route_by_view
 from .shading import OVERLAY_TINT, shade, shading_inputs
 
+
 @dataclass
 class RenderOptions:
     """How to render: see ``affinity render --help`` for each option's meaning."""

@@ -397,13 +397,11 @@ def _concatenate(path: str, parts: list[Mesh], prim_paths: list[str]) -> Mesh:
         face_start=_stacked([np.zeros(1, dtype=np.int64)]
                             + [p.face_start[1:] + offset for p, offset in zip(parts, corner_offsets)]),
         corner_vertex=corner_vertex,
-        face_line=np.zeros(sum(faces), dtype=np.int64),
-        texcoords=texcoords,
-        corner_texcoord=corner_texcoord,
-        normals=normals,
-        corner_normal=corner_normal,
-        colors=colors,
-        group_names=prim_paths,
+        face_line=np.zeros(sum(faces), dtype=np.int64),  # a stage has no source lines
+        group_names=prim_paths,  # one group per mesh prim, its faces from prim_face_start on
         face_group=np.repeat(np.arange(len(parts), dtype=np.int32), faces),
         prim_face_start=np.cumsum([0] + faces, dtype=np.int64),
+        colors=colors,
+        texcoords=texcoords, corner_texcoord=corner_texcoord,
+        normals=normals, corner_normal=corner_normal,
     )

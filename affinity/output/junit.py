@@ -17,7 +17,6 @@ from ..findings import FileReport
 from ..rules import UNREADABLE
 from . import CheckRun, Finding, describe, face_label, file_findings, statistics, text_line
 
-
 # Characters XML 1.0 cannot carry at all (control characters, lone surrogates from undecodable file names).
 _NOT_XML = re.compile("[^\t\n\r\x20-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
 

@@ -77,7 +77,8 @@ def _check(p: np.ndarray, quad: np.ndarray, w: np.ndarray, face: int, pixel) -> 
     """mpmath reference and condition at one pixel; None where the weights are undefined there."""
     from render.coords import mean_value
 
-    from ..stability.condition import UNIT_ROUNDOFF, condition, tolerance
+    from ..stability.condition import condition, tolerance
+    from ..stability.rows import UNIT_ROUNDOFF
     from ..stability.reference import Undefined, homogeneous, mean_value_exact, offsets
 
     results = {}

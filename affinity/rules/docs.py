@@ -40,7 +40,7 @@ def _example(rule: Rule, markdown: bool) -> str:
     if markdown:
         text = f"```\n{obj}\n```"
         return text + (f"\n\n`affinity check example.obj` prints:\n\n```\n{output}\n```" if output else "")
-    indent = lambda block: textwrap.indent(block, "        ")  # noqa: E731
+    indent = lambda block: textwrap.indent(block, "        ")
     return indent(obj) + (f"\n\n    affinity check example.obj prints:\n\n{indent(output)}" if output else "")
 
 
@@ -60,7 +60,7 @@ def rule_page(rule: Rule, markdown: bool = False) -> str:
                 for part in ("", f"### {title}", "", _example(rule, True) if title == "Example" else text)]
     else:
         head = [f"{rule.code} {rule.name}: {rule.summary}", facts]
-        fill = lambda text: textwrap.fill(text, 79, initial_indent="    ", subsequent_indent="    ")  # noqa: E731
+        fill = lambda text: textwrap.fill(text, 79, initial_indent="    ", subsequent_indent="    ")
         body = [part for title, text in sections
                 for part in ("", title, _example(rule, False) if title == "Example" else fill(text))]
     return "\n".join(head + body) + "\n"

@@ -24,8 +24,7 @@ from __future__ import annotations
 import mpmath
 
 from .reference import DIGITS
-from .rows import TOLERANCE_FACTOR, TOLERANCE_FLOOR, UNIT_ROUNDOFF
-
+from .rows import TOLERANCE_FACTOR, TOLERANCE_FLOOR
 
 
 def condition(exact, s, w, u, relative=False) -> float:
