@@ -137,6 +137,17 @@ def test_outline_is_the_border_of_the_mask():
     assert ring.sum() == 2 * 6 + 2 * 4 and not ring[3:7, 4:8].any() and (ring <= mask).all()
 
 
+def test_a_sliver_place_gets_a_halo_outside_it():
+    from affinity.draw.closeup import SLIVER_PIXELS, outline
+
+    mask = np.zeros((9, 9), dtype=bool)
+    mask[4, 2:7] = True  # 5 pixels: a folded quad seen nearly edge-on
+    ring = outline(mask, width=2)
+    assert mask.sum() < SLIVER_PIXELS and (ring >= mask).all()
+    distance = np.abs(np.arange(9)[:, None] - 4) + np.maximum(np.maximum(2 - np.arange(9), np.arange(9) - 6), 0)[None]
+    np.testing.assert_array_equal(ring, distance <= 2)  # every pixel within 2 steps of the sliver
+
+
 def test_two_separated_flagged_patches_give_two_closeups_each_outlined(tmp_path):
     from html.parser import HTMLParser
 

@@ -138,14 +138,36 @@ def face_subset(mesh: Mesh, faces: np.ndarray) -> Mesh:
     )
 
 
+#: A place covering fewer pixels than this (about a 6 x 6 square) is a sliver (a folded or nearly collapsed quad):
+#: its outline also grows outward, as a halo, so it can still be seen.
+SLIVER_PIXELS = 32
+
+
+def _shrunk(mask: np.ndarray, steps: int) -> np.ndarray:
+    """``mask`` (H, W) bool eroded by ``steps`` pixels (4-neighbours; the image edge counts as outside)."""
+    inside = mask.copy()
+    for _ in range(steps):
+        padded = np.pad(inside, 1, constant_values=False)
+        inside = (inside & padded[:-2, 1:-1] & padded[2:, 1:-1] & padded[1:-1, :-2] & padded[1:-1, 2:])
+    return inside
+
+
 def outline(mask: np.ndarray, width: int = 2) -> np.ndarray:
     """(H, W) bool: the pixels of ``mask`` (H, W) bool within ``width`` pixels of its border.
 
     A pixel is on the border when one of its 4-neighbours (or the image edge) is
-    outside the mask; the border then grows ``width - 1`` pixels inward.
+    outside the mask; the border then grows ``width - 1`` pixels inward. A mask
+    of fewer than ``SLIVER_PIXELS`` pixels also gets a ``width``-pixel halo outside it.
+
+    >>> mask = np.zeros((7, 7), bool); mask[3, 1:6] = True  # a 5-pixel sliver
+    >>> int(outline(mask).sum()), int(mask.sum())
+    (31, 5)
     """
-    inside = mask.copy()
+    ring = mask & ~_shrunk(mask, width)
+    if mask.sum() >= SLIVER_PIXELS:
+        return ring
+    grown = mask.copy()
     for _ in range(width):
-        padded = np.pad(inside, 1, constant_values=False)
-        inside = (inside & padded[:-2, 1:-1] & padded[2:, 1:-1] & padded[1:-1, :-2] & padded[1:-1, 2:])
-    return mask & ~inside
+        padded = np.pad(grown, 1, constant_values=False)
+        grown = grown | padded[:-2, 1:-1] | padded[2:, 1:-1] | padded[1:-1, :-2] | padded[1:-1, 2:]
+    return ring | grown
