@@ -56,6 +56,7 @@ def check_object(obj, **options) -> ObjectCheck:
     size of the active material's Base Color image (packed or generated), the
     default of :class:`~affinity.settings.Settings`.
     """
+    from ..findings import settle
     from ..lint import lint_mesh
     from ..rules import resolve_codes
     from ..settings import Settings
@@ -72,7 +73,7 @@ def check_object(obj, **options) -> ObjectCheck:
             notes.append(f"texture {texture.image} is not square and not a file: "
                          f"texels counted at {max(texture.size)} px both ways")
     settings = Settings(**options)
-    hits = lint_mesh(mesh, settings)
+    hits = settle(lint_mesh(mesh, settings), settings, list(mesh.group_names))  # levels and units, as check does
     rows = _finding_dicts(mesh, hits, settings, conversion.original_face if convert.get("evaluated") else None)
     return ObjectCheck(conversion, settings, hits, rows, notes)
 
@@ -80,17 +81,15 @@ def check_object(obj, **options) -> ObjectCheck:
 def _finding_dicts(mesh, hits, settings, original_face) -> list[dict]:
     from ..findings import FileReport
     from ..output import file_findings
-    from ..rules import RULES
 
     report = FileReport(path=mesh.path, counts=mesh.counts(), hits=hits, group_names=mesh.group_names)
     rows = []
     for finding in file_findings(report)[0]:
         row = dataclasses.asdict(finding)
         del row["prim"]
-        rule = RULES[finding.code]
-        barycentric = settings.measure == "barycentric" and finding.code == "Q101"
-        row.setdefault("unit", "" if barycentric else rule.unit)
-        row.setdefault("level", rule.level)
+        measure = settings.measure_of(finding.code)
+        if measure is not None:  # as in affinity check --format json
+            row["measure"] = measure
         if original_face is not None:
             row["original_face"] = int(original_face[finding.face]) if finding.face >= 0 else -1
         rows.append(row)
