@@ -7,6 +7,8 @@ import signal
 import socket
 import subprocess
 import sys
+import time
+from contextlib import nullcontext
 from pathlib import Path
 
 import pytest
@@ -92,7 +94,7 @@ def test_a_lost_worker_costs_only_its_tasks(client, assets):
             seen.append(index)
             yield index, report
 
-    reports = check_files(tasks, progress=kill_a_busy_worker, client=client)
+    reports = check_files(tasks, progress=kill_a_busy_worker, cluster=lambda: nullcontext(client))
     assert sorted(seen) == list(range(len(tasks)))
     assert [r.n_findings for r in reports] == expected and [r.path for r in reports] == [p for p, _ in tasks]
     assert not any((r.error or "").startswith("internal error") for r in reports)
@@ -121,19 +123,30 @@ def test_cached_files_are_not_submitted(client, assets, tmp_path, monkeypatch):
         return real(dask_client, todo, usd)
 
     monkeypatch.setattr(cluster_module, "check_on_cluster", counting)
-    runs = []
+    runs, connections = [], []
+
+    def reach_the_cluster():
+        connections.append(1)
+        return nullcontext(client)
+
     for _ in range(2):
         cache = ResultCache(str(tmp_path), tool="t")
-        runs.append([r.n_findings for r in check_files(tasks, cache=cache, client=client)])
+        runs.append([r.n_findings for r in check_files(tasks, cache=cache, cluster=reach_the_cluster)])
         cache.close()
-    assert submitted == [len(tasks), 0] and runs[0] == runs[1]
+    assert submitted == [len(tasks)] and connections == [1] and runs[0] == runs[1]
+
+
+def dead_address() -> str:
+    """A scheduler address nothing listens on."""
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return f"tcp://127.0.0.1:{probe.getsockname()[1]}"
 
 
 def test_a_scheduler_that_does_not_answer_is_one_line_and_exit_2(assets):
-    with socket.socket() as probe:  # a port nothing listens on
-        probe.bind(("127.0.0.1", 0))
-        port = probe.getsockname()[1]
-    result = check(assets, "--scheduler", f"tcp://127.0.0.1:{port}",
+    address = dead_address()
+    port = address.rsplit(":", 1)[1]
+    result = check(assets, "--scheduler", address,
                    env={"DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT": "1s"})
     assert result.returncode == 2 and result.stdout == ""
     assert result.stderr.strip().count("\n") == 0 and "Traceback" not in result.stderr
@@ -171,4 +184,41 @@ def test_the_progress_bar_passes_every_result_through(capsys):
     from affinity.findings import FileReport
 
     results = [(2, FileReport("a.obj")), (0, FileReport("b.obj")), (1, FileReport("c.obj", error="x"))]
-    assert list(_progress_bar("http://127.0.0.1:8787/status")(iter(results), 3)) == results
+    assert list(_progress_bar()(iter(results), 3)) == results
+
+
+def test_with_every_file_cached_the_scheduler_is_not_reached(assets, tmp_path):
+    """The client consults the cache first: nothing to submit, no connection (a dead address passes)."""
+    library = tmp_path / "library"
+    library.mkdir()
+    for source in sorted(assets.glob("mesh_0[0-4].obj")):
+        target = library / source.name
+        target.write_bytes(source.read_bytes())
+        old = time.time() - 3600  # out of the racy window, so the pre-keys are kept
+        os.utime(target, (old, old))
+    env = {**os.environ, "AFFINITY_CACHE_DIR": str(tmp_path / "cache"),
+           "DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT": "1s"}
+
+    def cached_check(*extra):
+        return subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--verbose", *extra, "."],
+                              capture_output=True, text=True, cwd=library, timeout=120, env=env)
+
+    first = cached_check()
+    again = cached_check("--scheduler", dead_address(), "--jobs", "2")
+    assert first.returncode == again.returncode == 1 and first.stdout.count("Q101") > 30
+    assert again.stdout == first.stdout
+    assert again.stderr == "affinity: warning: --jobs 2 is ignored with --scheduler: the cluster's workers check the files\n"
+    (library / "mesh_00.obj").write_text(quad_obj([(SQUARE, UNIT_UV)]))  # one file to check: now it connects
+    changed = cached_check("--scheduler", dead_address())
+    assert changed.returncode == 2 and "no Dask scheduler answered within 1 s" in changed.stderr
+
+
+def test_scheduler_none_checks_here_whatever_the_config_says(assets, tmp_path):
+    (tmp_path / "affinity.toml").write_text(f'scheduler = "{dead_address()}"\n')
+    here = subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--no-cache", "--verbose",
+                           "--scheduler", "none", str(assets)], capture_output=True, text=True, cwd=tmp_path,
+                          timeout=120)
+    local = subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--no-cache", "--verbose", "--isolated",
+                            str(assets)], capture_output=True, text=True, cwd=tmp_path, timeout=120)
+    assert here.returncode == local.returncode == 2 and (here.stdout, here.stderr) == (local.stdout, local.stderr)
+    assert here.stdout.count("Q101") > 30

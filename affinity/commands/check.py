@@ -139,7 +139,8 @@ def add_parser(sub) -> None:
     p.add_argument("-o", "--output-file", metavar="PATH", help="write the output to PATH (whole or not at all)")
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="check the files on a Dask cluster: a scheduler address, env (DASK_SCHEDULER_ADDRESS) "
-                        "or local:N (N local worker processes); needs the distributed extra")
+                        "or local:N (N local worker processes); needs the distributed extra. "
+                        "none checks on this machine whatever the configuration says")
     p.add_argument("--no-cache", action="store_true",
                    help="check every file again instead of reusing the results of unchanged files "
                         "(cache folder: AFFINITY_CACHE_DIR, else the user cache folder)")
@@ -179,17 +180,16 @@ def _report_problems(reports, quiet: bool, skips_fail: bool = False) -> None:
             sys.stderr.write(f"{report.path}: note: {note}\n")
 
 
-def _progress_bar(dashboard: str | None = None):
+def _progress_bar():
     """A tqdm bar over the stream of ``(index, report)`` pairs: files, findings so far, files per second.
 
-    Imported only when stderr is a terminal; ``dashboard`` (a Dask dashboard link) goes in front.
+    Imported only when stderr is a terminal.
     """
     from tqdm import tqdm
 
     def progress(results, total):
         findings = 0
-        with tqdm(total=total, unit="file", delay=1.0, leave=False, file=sys.stderr,
-                  desc=f"dashboard {dashboard}" if dashboard else None) as bar:
+        with tqdm(total=total, unit="file", delay=1.0, leave=False, file=sys.stderr) as bar:
             for result in results:
                 findings += result[1].n_findings
                 bar.set_postfix_str(f"{findings} findings", refresh=False)
@@ -200,29 +200,50 @@ def _progress_bar(dashboard: str | None = None):
 
 
 @contextlib.contextmanager
-def _run_on(args, run_options: dict):
-    """``(client, cache, dashboard link)``: the Dask client of ``--scheduler`` (or of the configured
-    ``scheduler``) and its dashboard, else None; the result cache, else None."""
+def _result_cache(args, run_options: dict):
+    """The result cache, committed and closed at the end; None with ``--no-cache`` or ``cache = false``."""
+    if args.no_cache or not run_options.get("cache", True):
+        yield None
+        return
     from ..pipeline.cache import ResultCache, cache_folder
 
-    cache = None
-    if not args.no_cache and run_options.get("cache", True):
-        cache = ResultCache(cache_folder())
-    scheduler = args.scheduler or run_options.get("scheduler")
+    cache = ResultCache(cache_folder())
     try:
-        if scheduler is None:
-            yield None, cache, None
-            return
-        from . import require
-
-        require(("distributed",), "distributed")
-        from ..pipeline.cluster import connect, dashboard_link
-
-        with connect(scheduler) as client:
-            yield client, cache, dashboard_link(client)
+        yield cache
     finally:
-        if cache is not None:
-            cache.close()
+        cache.close()
+
+
+def _cluster(args, run_options: dict, show_dashboard: bool):
+    """What :func:`~affinity.pipeline.check.check_files` calls to reach the Dask cluster of ``--scheduler``
+    (or of the configured ``scheduler``); None for a run on this machine (no scheduler, or ``none``).
+
+    A bad scheduler spec or a missing ``distributed`` extra fails now; the
+    cluster itself is reached only when some file is not in the cache. With
+    ``show_dashboard`` its dashboard link goes to stderr once connected.
+    """
+    spec = args.scheduler or run_options.get("scheduler")
+    if spec is None or spec == "none":
+        return None
+    from ..pipeline.cluster import connect, dashboard_link, scheduler_address
+
+    address = scheduler_address(spec)
+    from . import require
+
+    require(("distributed",), "distributed")
+    if args.jobs is not None:
+        sys.stderr.write(f"affinity: warning: --jobs {args.jobs} is ignored with --scheduler: "
+                         "the cluster's workers check the files\n")
+
+    @contextlib.contextmanager
+    def on_cluster():
+        with connect(address) as client:
+            link = dashboard_link(client) if show_dashboard else None
+            if link:
+                sys.stderr.write(f"Dask dashboard: {link}\n")
+            yield client
+
+    return on_cluster
 
 
 def _tasks(resolver, paths: list[str]) -> list:
@@ -277,10 +298,12 @@ def run(args) -> int:
     if args.show_files:
         _write_output_file(args.output_file, lambda out: out.writelines(path + "\n" for path, _ in tasks))
         return EXIT_CLEAN
-    with _run_on(args, resolver.run_options()) as (client, cache, dashboard):
-        progress = _progress_bar(dashboard) if len(tasks) > 1 and sys.stderr.isatty() else None
-        reports = check_files(tasks, args.jobs, progress, usd=UsdOptions(args.time, args.uv_primvar),
-                              cache=cache, client=client)
+    run_options = resolver.run_options()
+    show_progress = len(tasks) > 1 and sys.stderr.isatty()
+    cluster = _cluster(args, run_options, show_progress)
+    with _result_cache(args, run_options) as cache:
+        reports = check_files(tasks, args.jobs, _progress_bar() if show_progress else None,
+                              usd=UsdOptions(args.time, args.uv_primvar), cache=cache, cluster=cluster)
     _report_problems(reports, args.quiet, args.fail_on_skip)
     failed = any(r.error is not None or (args.fail_on_skip and r.skipped is not None) for r in reports)
     if args.write_baseline:

@@ -56,7 +56,7 @@ class CheckRun:
         return file_findings(report, self.max_findings, worst=True)[0]
 
 
-@dataclass(frozen=True)
+@dataclass(slots=True)
 class Finding:
     """One finding, as every structured format carries it (design.md, "Rule codes").
 

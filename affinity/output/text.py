@@ -28,10 +28,10 @@ def write_findings(run: CheckRun, out: TextIO, verbose: bool = False) -> None:
     """Every finding of every checked file, capped per file and rule unless verbose."""
     for report in run.reports:
         findings, omitted = file_findings(report, None if verbose else TEXT_LIMIT)
-        for f in findings:
-            out.write(text_line(f) + "\n")
-        for code, n in omitted.items():
-            out.write(f"{report.path}: ... and {n} more {code} (use --verbose or --format json for all)\n")
+        lines = [text_line(f) + "\n" for f in findings]
+        lines += [f"{report.path}: ... and {n} more {code} (use --verbose or --format json for all)\n"
+                  for code, n in omitted.items()]
+        out.write("".join(lines))
 
 
 def write_statistics(run: CheckRun, out: TextIO) -> None:

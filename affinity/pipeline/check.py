@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable, Iterable, Iterator
+from contextlib import AbstractContextManager, nullcontext
 from functools import partial
 
 from ..errors import MeshError, SkippedFile
@@ -92,7 +93,7 @@ def check_files(
     progress: Callable[[Iterable[tuple[int, FileReport]], int], Iterator[tuple[int, FileReport]]] | None = None,
     usd=None,
     cache=None,
-    client=None,
+    cluster: Callable[[], AbstractContextManager] | None = None,
 ) -> list[FileReport]:
     """Check ``(path, settings)`` pairs with up to ``jobs`` processes; reports in task order.
 
@@ -102,23 +103,26 @@ def check_files(
     receives the number of tasks. ``usd`` is passed on to :func:`check_file`.
     ``cache`` (:class:`affinity.pipeline.cache.ResultCache`) answers for the
     unchanged files before anything is checked, and keeps the new reports.
-    ``client`` (a ``dask.distributed.Client``) checks the files on its cluster
-    instead of ``jobs`` local processes (:mod:`affinity.pipeline.cluster`).
+    ``cluster``, when given, checks the files on a Dask cluster instead of
+    ``jobs`` local processes (:mod:`affinity.pipeline.cluster`): called only
+    when some file is not in the cache, it returns a context manager giving a
+    ``dask.distributed.Client``, e.g. ``lambda: cluster.connect("local:2")``.
     """
     keys = [None] * len(tasks) if cache is None else [cache.key(path, s, usd) for path, s in tasks]
     known = {} if cache is None else {i: hit for i, key in enumerate(keys) if (hit := cache.get(key)) is not None}
     todo = [i for i in range(len(tasks)) if i not in known]
-    if client is not None:
-        from .cluster import check_on_cluster
+    with cluster() if cluster is not None and todo else nullcontext() as client:
+        if client is not None:
+            from .cluster import check_on_cluster
 
-        fresh = check_on_cluster(client, [tasks[i] for i in todo], usd)
-    else:
-        fresh = enumerate(_check_here([tasks[i] for i in todo], jobs, usd))
-    reports: list[FileReport | None] = [None] * len(tasks)
-    for i, report in _tracked(_chain(known, todo, fresh), len(tasks), progress):
-        reports[i] = report
-        if cache is not None and i not in known:
-            cache.put(keys[i], report)
+            fresh = check_on_cluster(client, [tasks[i] for i in todo], usd)
+        else:
+            fresh = enumerate(_check_here([tasks[i] for i in todo], jobs, usd))
+        reports: list[FileReport | None] = [None] * len(tasks)
+        for i, report in _tracked(_chain(known, todo, fresh), len(tasks), progress):
+            reports[i] = report
+            if cache is not None and i not in known:
+                cache.put(keys[i], report)
     return reports
 
 

@@ -34,12 +34,18 @@ LOCAL_PREFIX = "local:"
 
 
 def scheduler_address(spec: str) -> str:
-    """The scheduler to use for ``--scheduler spec``: ``env`` reads ``DASK_SCHEDULER_ADDRESS``."""
-    if spec != "env":
-        return spec
-    address = os.environ.get(ENV_ADDRESS, "").strip()
-    if not address:
-        raise UsageError(f"--scheduler env: {ENV_ADDRESS} is not set")
+    """The scheduler to use for ``--scheduler spec``: ``env`` reads ``DASK_SCHEDULER_ADDRESS``.
+
+    A spec that names no scheduler (``env`` with the variable unset, ``local:0``)
+    is a :class:`UsageError`; whether an address answers is :func:`connect`'s business.
+    """
+    address = spec
+    if spec == "env":
+        address = os.environ.get(ENV_ADDRESS, "").strip()
+        if not address:
+            raise UsageError(f"--scheduler env: {ENV_ADDRESS} is not set")
+    if address.startswith(LOCAL_PREFIX):
+        _local_workers(address)
     return address
 
 
