@@ -11,6 +11,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 from test_cli_check import run
 from test_formats import SQUARE, UNIT_UV, quad_obj, sample_run, trapezoid
 
@@ -316,3 +318,44 @@ def test_a_stage_read_without_usd_core_is_not_served_to_a_run_with_it(tmp_path, 
     monkeypatch.setitem(sys.modules, "pxr", None)
     assert cache.key(str(stage), Settings()) != with_reader
     cache.close()
+
+
+# -- the mtllib scan of the content hash ------------------------------------------------------------
+
+_LINES = [b"mtllib a.mtl", b"  mtllib b c.mtl", b"\tmtllib d.mtl # the look", b"mtllib e#f.mtl", b"# mtllib g.mtl",
+          b"usemtl mtllib", b"xmtllib h.mtl", b"mtllibi.mtl", b"mtllib", b"mtllib # nothing", b"mtllib j.mtl mtllib",
+          b"v 0 0 0", b"vt 0.5 0.5", b"f 1 2 3", b"g mtllib k.mtl", b"mtllib l.mtl\r", b"mtllib caf\xe9.mtl", b""]
+
+
+def named_libraries(text: bytes) -> list[str]:
+    """The OBJ rule, line by line: a line whose first word is ``mtllib`` names the words after it up to a comment."""
+    names = []
+    for line in text.split(b"\n"):
+        words = line.split()
+        if words and words[0] == b"mtllib":
+            comment = next((k for k, word in enumerate(words) if word.startswith(b"#")), len(words))
+            names += [os.fsdecode(b" ".join(words[1:comment]))] if comment > 1 else []
+    return names
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(lines=st.lists(st.sampled_from(_LINES), max_size=30), chunk=st.integers(1, 64), newline=st.booleans())
+def test_the_mtllib_scan_reads_what_the_loader_reads_at_any_chunk_size(tmp_path, monkeypatch, lines, chunk, newline):
+    text = b"\n".join(lines) + b"\n" * newline
+    path = tmp_path / "mesh.obj"
+    path.write_bytes(text)
+    monkeypatch.setattr(cache_module, "_CHUNK", chunk)
+    _, deps = cache_module._hash_file(str(path))
+    assert deps == [os.path.abspath(tmp_path / name) for name in named_libraries(text)]
+
+
+def test_a_file_without_line_breaks_is_scanned_in_bounded_blocks(tmp_path, monkeypatch):
+    path = tmp_path / "one-line.obj"
+    path.write_bytes(b"mtllib a.mtl #" + b"x" * 200_000)
+    blocks = []
+    real = cache_module._mtllib_names
+    monkeypatch.setattr(cache_module, "_CHUNK", 1000)
+    monkeypatch.setattr(cache_module, "_LINE_START", 100)
+    monkeypatch.setattr(cache_module, "_mtllib_names", lambda block, end: blocks.append(len(block)) or real(block, end))
+    _, deps = cache_module._hash_file(str(path))
+    assert deps == [str(tmp_path / "a.mtl")] and max(blocks) <= 1100

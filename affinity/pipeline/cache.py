@@ -49,7 +49,10 @@ RACY_SECONDS = 2.0
 COMMIT_EVERY = 200
 
 _DAY = 86_400.0
-_MTLLIB = re.compile(rb"^[ \t]*mtllib[ \t]+([^\r\n#]*)", re.MULTILINE)
+#: Starts with its literal, so ``re`` skips ahead to each "mtllib" (a ``^`` anchor made it try every byte).
+_MTLLIB = re.compile(rb"mtllib[^\n]*")
+#: The bytes of an unfinished line kept for the next chunk: far longer than any library name.
+_LINE_START = 1 << 16
 _USD_SUFFIXES = (".usd", ".usda", ".usdc", ".usdz")
 _CHUNK = 1 << 20
 
@@ -274,21 +277,20 @@ def _hash_file(path: str) -> tuple[str, list[str]]:
     """The content hash of ``path`` and the absolute paths of the files it pulls in."""
     suffix = os.path.splitext(path)[1].lower()
     digest = hashlib.blake2b(digest_size=20)
-    libraries: list[bytes] = []
-    tail = b""
+    libraries: list[str] = []
+    tail = b""  # the start of the line a chunk ended in
     with open(path, "rb") as fh:
         while chunk := fh.read(_CHUNK):
             digest.update(chunk)
             if suffix == ".obj":  # mtllib lines, scanned whole: a chunk may end inside a line
                 block = tail + chunk
                 cut = block.rfind(b"\n") + 1
-                libraries += _MTLLIB.findall(block, 0, cut)
-                tail = block[cut:]
-    libraries += _MTLLIB.findall(tail)
+                libraries += _mtllib_names(block, cut)
+                tail = block[cut : cut + _LINE_START]  # a line's start names its library; no quadratic copies
+    libraries += _mtllib_names(tail, len(tail))
     folder = os.path.dirname(path)
     if suffix == ".obj":
-        names = (" ".join(name.decode("utf-8", "replace").split()) for name in libraries)
-        deps = [os.path.join(folder, name) for name in names if name]
+        deps = [os.path.join(folder, name) for name in libraries]
     elif suffix == ".mtl":
         from ..loaders.mtl import read_material_textures
 
@@ -298,6 +300,22 @@ def _hash_file(path: str) -> tuple[str, list[str]]:
     else:
         deps = []
     return digest.hexdigest(), [os.path.abspath(dep) for dep in deps]
+
+
+def _mtllib_names(block: bytes, end: int) -> list[str]:
+    """The library names of the ``mtllib`` statements in ``block[:end]``, read as the OBJ loader reads them:
+    the words after the keyword, up to a word that starts a comment, as the file system spells them."""
+    names, last_line = [], -1
+    for match in _MTLLIB.finditer(block, 0, end):
+        line_start = block.rfind(b"\n", 0, match.start()) + 1
+        words = block[line_start : match.end()].split()
+        if line_start == last_line or words[0] != b"mtllib":  # said again on its line, or another statement
+            continue
+        last_line = line_start
+        comment = next((k for k, word in enumerate(words) if word.startswith(b"#")), len(words))
+        if comment > 1:
+            names.append(os.fsdecode(b" ".join(words[1:comment])))
+    return names
 
 
 def _usd_reader() -> str | None:
