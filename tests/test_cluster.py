@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import argparse
 import os
 import signal
 import socket
 import subprocess
 import sys
 import time
+import urllib.request
 from contextlib import nullcontext
 from pathlib import Path
 
@@ -207,7 +209,8 @@ def test_with_every_file_cached_the_scheduler_is_not_reached(assets, tmp_path):
     again = cached_check("--scheduler", dead_address(), "--jobs", "2")
     assert first.returncode == again.returncode == 1 and first.stdout.count("Q101") > 30
     assert again.stdout == first.stdout
-    assert again.stderr == "affinity: warning: --jobs 2 is ignored with --scheduler: the cluster's workers check the files\n"
+    assert again.stderr == ("affinity: warning: --jobs 2 is ignored with --scheduler: "
+                            "the cluster's workers check the files\n")
     (library / "mesh_00.obj").write_text(quad_obj([(SQUARE, UNIT_UV)]))  # one file to check: now it connects
     changed = cached_check("--scheduler", dead_address())
     assert changed.returncode == 2 and "no Dask scheduler answered within 1 s" in changed.stderr
@@ -222,3 +225,15 @@ def test_scheduler_none_checks_here_whatever_the_config_says(assets, tmp_path):
                             str(assets)], capture_output=True, text=True, cwd=tmp_path, timeout=120)
     assert here.returncode == local.returncode == 2 and (here.stdout, here.stderr) == (local.stdout, local.stderr)
     assert here.stdout.count("Q101") > 30
+
+
+def test_the_dashboard_link_is_said_once_connected_and_answers(capsys):
+    from affinity.commands.check import _cluster
+
+    reach = _cluster(argparse.Namespace(scheduler="local:1", jobs=None), {}, show_dashboard=True)
+    assert capsys.readouterr().err == ""  # nothing is started before there is a file to check
+    with reach():
+        said = capsys.readouterr().err
+        assert said.startswith("Dask dashboard: http://127.0.0.1:") and said.count("\n") == 1
+        with urllib.request.urlopen(said.split(": ", 1)[1].strip(), timeout=60) as page:
+            assert page.status == 200
