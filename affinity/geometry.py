@@ -253,7 +253,8 @@ class PlanarQuads:
         if isinstance(rows, slice) and rows == slice(None):
             return self
         normals = None if self.normals is None else self.normals[:, rows]
-        return PlanarQuads(self.areas.T[:, rows].T, self.size[rows], self.diagonals[rows], self.components[:, :, rows], normals)
+        return PlanarQuads(self.areas.T[:, rows].T, self.size[rows], self.diagonals[rows], self.components[:, :, rows],
+                           normals)
 
     def __len__(self) -> int:
         return len(self.size)

@@ -57,7 +57,8 @@ class CornerTables:
         self.tables[name] = np.asarray(values, dtype=np.float64)
         self.has_nan[name] = name != "positions" and bool(np.isnan(self.tables[name]).any())
 
-    def gather(self, name: str, corners: np.ndarray, complete: bool = True) -> tuple[np.ndarray | slice, np.ndarray] | None:
+    def gather(self, name: str, corners: np.ndarray,
+               complete: bool = True) -> tuple[np.ndarray | slice, np.ndarray] | None:
         """Attribute ``name`` at the (4, Q) corners: ``rows`` of the quads that have
         it at all four corners (a slice when all do, or without ``complete``) and
         their values laid out by component, (D, 4, n); normals scaled to unit

@@ -198,7 +198,8 @@ class Mesh:
             if shaped(name, table, None, "iu"):
                 require(len(table) == n_faces, f"{name} has {len(table)} entries for {n_faces} faces")
         require(len(self.face_line) == 0 or self.face_line.min() >= 0, "face_line has a negative line")
-        require(len(self.face_group) == 0 or (self.face_group.min() >= 0 and self.face_group.max() < len(self.group_names)),
+        require(len(self.face_group) == 0 or (self.face_group.min() >= 0
+                                              and self.face_group.max() < len(self.group_names)),
                 "face_group has an entry outside group_names")
         require(len(self.face_material) == 0 or (self.face_material.min() >= -1
                                                  and self.face_material.max() < len(self.material_names)),

@@ -143,7 +143,8 @@ def main(argv=None) -> None:
         if phases:
             best = [min(p[i] for p in phases) for i in range(6)]
             print("\nInside one `affinity check` process (best of the rounds; wall s / CPU s):")
-            print(f"load {best[0]:.2f} / {best[1]:.2f}, lint {best[2]:.2f} / {best[3]:.2f}, JSON output {best[4]:.3f} / {best[5]:.3f}")
+            print(f"load {best[0]:.2f} / {best[1]:.2f}, lint {best[2]:.2f} / {best[3]:.2f}, "
+                  f"JSON output {best[4]:.3f} / {best[5]:.3f}")
         print(f"\nload average after: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
 
 

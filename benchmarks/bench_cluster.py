@@ -60,7 +60,7 @@ def generate(folder: str, files: int, sizes: dict[int, float]) -> int:
     counts[max(sizes, key=sizes.get)] += files - sum(counts.values())
     names = [(quads, k) for quads, count in counts.items() for k in range(count)]
     total = 0
-    for i, (quads, k) in enumerate(names):
+    for i, (quads, _) in enumerate(names):
         target = os.path.join(folder, f"asset_{i:05d}_{quads}q.obj")
         if not os.path.exists(target):
             shutil.copyfile(templates[quads], target)

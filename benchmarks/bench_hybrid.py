@@ -60,9 +60,12 @@ def main() -> None:
     parser.add_argument("--no-demo", action="store_true", help="leave out the demo sphere")
     args = parser.parse_args()
     paths = args.meshes or (sorted(str(p) for p in SHARED.glob("*.obj")) if SHARED.exists() else [])
-    scenes = ([] if args.no_demo else [("demo sphere 16x8", demo_sphere(), "z")]) + [(Path(p).name, load(p), up_axis(Path(p).name)) for p in paths]
+    scenes = ([] if args.no_demo else [("demo sphere 16x8", demo_sphere(), "z")]) + [
+        (Path(p).name, load(p), up_axis(Path(p).name)) for p in paths
+    ]
 
-    print(f"| mesh ({args.size}x{args.size}) | quads | to mvc | fragments | split s | hybrid s | mvc s | hybrid / split |")
+    print(f"| mesh ({args.size}x{args.size}) | quads | to mvc | fragments | split s | hybrid s | mvc s "
+          "| hybrid / split |")
     print("|---|---:|---:|---:|---:|---:|---:|---:|")
     for name, mesh, up in scenes:
         options = {method: RenderOptions(method=method, width=args.size, height=args.size, up=up, show="shaded",

@@ -99,7 +99,8 @@ def main(argv=None) -> None:
 
     with tempfile.TemporaryDirectory() as folder:
         path = generated_input(args.path or os.path.join(folder, f"grid_{args.quads}.obj"), args.quads, write_grid_obj)
-        cases = [(name, lambda m=module, s=setup: measure_reader(m, s, path)) for name, (module, setup) in READERS.items()]
+        cases = [(name, lambda m=module, s=setup: measure_reader(m, s, path))
+                 for name, (module, setup) in READERS.items()]
         cases.insert(1, ("affinity check --format json", lambda: measure_check(path)))
         print("| case | call s | process s | peak RSS MiB |")
         print("|---|---:|---:|---:|")

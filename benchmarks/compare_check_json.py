@@ -52,7 +52,8 @@ def main() -> int:
     with tempfile.TemporaryDirectory() as scratch:
         for label, revision in (("before", args.before), ("after", args.after)):
             tree = Path(scratch) / label
-            subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", "-q", str(tree), revision], check=True)
+            subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", "-q", str(tree), revision],
+                           check=True)
             try:
                 results[label] = by_file(check_json(tree, meshes, args.arg))
             finally:

@@ -19,9 +19,9 @@ import pytest
 
 bpy = pytest.importorskip("bpy")
 
-from affinity.blender import addon, findings, mesh_from_object
-from affinity.blender.check import check_object
-from affinity.blender.convert import ERROR_ATTRIBUTE, ERROR_COLOR, ORIGINAL_FACE
+from affinity.blender import addon, findings, mesh_from_object  # noqa: E402
+from affinity.blender.check import check_object  # noqa: E402
+from affinity.blender.convert import ERROR_ATTRIBUTE, ERROR_COLOR, ORIGINAL_FACE  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 

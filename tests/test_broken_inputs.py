@@ -47,7 +47,8 @@ def broken_folder(tmp_path):
 
 def test_broken_files_are_one_q901_line_each_and_the_others_are_checked(tmp_path):
     folder = broken_folder(tmp_path)
-    broken = ["junk.usda", "liar.ply", "truncated.ply"] if importlib.util.find_spec("pxr") else ["liar.ply", "truncated.ply"]
+    broken = (["junk.usda", "liar.ply", "truncated.ply"] if importlib.util.find_spec("pxr")
+              else ["liar.ply", "truncated.ply"])
     result = run("check", str(folder), "--format", "json")
     assert result.returncode == 2, result.stderr
     assert "Traceback" not in result.stderr
@@ -151,7 +152,8 @@ def test_render_of_a_skipped_file_is_one_line_and_writes_nothing(tmp_path):
     out = tmp_path / "out.png"
     result = run("render", str(pointer), "-o", str(out))
     assert result.returncode == 2
-    assert result.stderr.splitlines() == [f"affinity render: error: {pointer}: skipped (lfs-pointer): nothing to render"]
+    assert result.stderr.splitlines() == [f"affinity render: error: {pointer}: "
+                                          "skipped (lfs-pointer): nothing to render"]
     assert not out.exists()
 
 
@@ -160,7 +162,8 @@ def test_report_of_skipped_files(tmp_path):
     out = tmp_path / "report.html"
     single = run("report", "-q", str(pointer), "-o", str(out))
     assert single.returncode == 2
-    assert single.stderr.splitlines() == [f"affinity report: error: {pointer}: skipped (lfs-pointer): nothing to report"]
+    assert single.stderr.splitlines() == [f"affinity report: error: {pointer}: "
+                                          "skipped (lfs-pointer): nothing to report"]
     assert not out.exists()
     several = run("report", "-q", str(pointer), str(write(tmp_path, "clean.obj", SQUARE)), "-o", str(out))
     assert several.returncode == 2, several.stderr

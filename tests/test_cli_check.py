@@ -118,7 +118,8 @@ BAD_INPUTS = {
     "truncated.obj": b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nf 1 2 3 5",
     "wrong.stl": b"solid x\nendsolid x\n",
     "truncated.ply": b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-                     b"property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n",
+                     b"property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                     b"0 0 0\n1 0 0\n",
     "truncated.off": b"OFF\n4 1 0\n0 0 0\n1 0 0\n",
 }
 

@@ -78,7 +78,8 @@ def generated_ply(rng: random.Random, fmt: str) -> bytes:
     n = rng.randrange(2, 6)
     vertices = [(float(x), float(y), rng.uniform(-0.1, 0.1), x / n, y / n, rng.randrange(256)) for y in range(n)
                 for x in range(n)]
-    faces = [[y * n + x, y * n + x + 1, (y + 1) * n + x + 1, (y + 1) * n + x] for y in range(n - 1) for x in range(n - 1)]
+    faces = [[y * n + x, y * n + x + 1, (y + 1) * n + x + 1, (y + 1) * n + x] for y in range(n - 1)
+             for x in range(n - 1)]
     strips = rng.random() < 0.2
     header = ["ply", f"format {fmt} 1.0", f"element vertex {len(vertices)}", "property float x", "property float y",
               "property float z", "property float s", "property float t", "property uchar red"]

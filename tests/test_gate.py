@@ -32,7 +32,8 @@ def spot(shared_meshes):
     return shared_meshes / "gen_spot_cc4.obj"
 
 #: The unit square with corner 2 lifted by ``h``: the split along 0-2 folds by
-#: acos(1 / (1 + h^2)), the split along 1-3 by acos(1 / sqrt(1 + 2 h^2)) (normals (0,-h,1), (-h,0,1); (-h,-h,1), (0,0,1)).
+#: acos(1 / (1 + h^2)), the split along 1-3 by acos(1 / sqrt(1 + 2 h^2)) (normals (0,-h,1), (-h,0,1);
+#: (-h,-h,1), (0,0,1)).
 LIFTED = "v 0 0 0\nv 1 0 0\nv 1 1 {h}\nv 0 1 0\nf 1 2 3 4\n"
 #: A mirrored UV island: Q302 (info by default) and nothing else.
 MIRRORED = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 1 0\nvt 0 0\nvt 0 1\nvt 1 1\nf 1/1 2/2 3/3 4/4\n"
@@ -208,7 +209,8 @@ def test_configuration_that_would_switch_checks_off_is_a_usage_error(tmp_path, c
 
 def test_show_settings_is_toml_that_reads_back(tmp_path):
     write(tmp_path, "affinity.toml", 'ignore = ["Q3"]\nextend-exclude = ["wip"]\n[thresholds]\nQ102 = 3\n'
-                                     '[levels]\nQ203 = "warning"\n[per-file-ignores]\n"caf\u00e9 \U0001F600/*.obj::helper-*" = ["Q101"]\n')
+                                     '[levels]\nQ203 = "warning"\n[per-file-ignores]\n'
+                                     '"caf\u00e9 \U0001F600/*.obj::helper-*" = ["Q101"]\n')
     result = run("check", "--show-settings", "--threshold", "Q201=1e-12", str(tmp_path))
     assert result.returncode == 0
     settings = tomllib.loads(result.stdout)
@@ -304,13 +306,15 @@ def test_missing_mtllib_is_an_info_finding(tmp_path):
     result = run("check", "--format", "json", "--select", "Q9", path)
     assert result.returncode == 0, "a checkout without textures does not fail the gate"
     (finding,) = findings(result)
-    assert (finding["code"], finding["name"], finding["level"], finding["line"]) == ("Q902", "missing-resource", "info", 1)
+    assert (finding["code"], finding["name"], finding["level"], finding["line"]) == ("Q902", "missing-resource",
+                                                                                      "info", 1)
     assert "mtllib crate.mtl not found; texels use texture-size 1024" in finding["message"]
     assert run("check", "--select", "Q9", "--fail-on", "info", path).returncode == 1
 
 
 def test_missing_and_lfs_textures_are_reported_once_each(tmp_path):
-    write(tmp_path, "crate.mtl", "newmtl wood\nmap_Kd wood.png\nnewmtl oak\nmap_Kd wood.png\nnewmtl lid\nmap_Kd lid.png\n")
+    write(tmp_path, "crate.mtl", "newmtl wood\nmap_Kd wood.png\nnewmtl oak\nmap_Kd wood.png\n"
+                                 "newmtl lid\nmap_Kd lid.png\n")
     write(tmp_path, "lid.png", "version https://git-lfs.github.com/spec/v1\noid sha256:00\nsize 9\n")
     path = str(write(tmp_path, "crate.obj", "mtllib crate.mtl\nusemtl wood\n" + MIRRORED))
     result = run("check", "--select", "Q902", "--texture-size", "512", path)

@@ -257,7 +257,7 @@ def test_corpus_makehuman_paper_score_flags_most_quads_but_few_move_a_texel(load
 def test_corpus_sphere_pole_quads_are_degenerate_and_scored_finitely(load_corpus_mesh):
     mesh = load_corpus_mesh("gen_uv_sphere_64x32.obj")
     assert len(found(mesh, select=["Q201"])["Q201"][0]) == 128
-    faces, m = quad_uv_error(mesh, diagonal="both")
+    _faces, m = quad_uv_error(mesh, diagonal="both")
     # The split's worst error on a pole quad is its whole u width, 1/64 (a quarter of it at the centre).
     assert np.isfinite(m).all() and m.max() == pytest.approx(1 / 64)
 

@@ -11,7 +11,8 @@ from affinity.loaders import load
 
 SQUARE = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"  # lines 1-4
 
-PLY_HEADER = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"  # 9 lines
+PLY_HEADER = ("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+              "element face 1\nproperty list uchar int vertex_indices\nend_header\n")  # 9 lines
 
 
 def error_of(tmp_path, content, name="mesh.obj") -> MeshError:
@@ -187,7 +188,8 @@ def test_binary_ply_errors_have_line_zero(tmp_path, faces, words):
 
 
 def test_binary_ply_nan_and_count_mismatch(tmp_path):
-    content = binary_ply(3, struct.pack("<B3i", 3, 0, 1, 2)).replace(struct.pack("<f", 1), struct.pack("<f", float("nan")), 1)
+    content = binary_ply(3, struct.pack("<B3i", 3, 0, 1, 2)).replace(struct.pack("<f", 1),
+                                                                     struct.pack("<f", float("nan")), 1)
     assert "finite" in error_of(tmp_path, content, name="mesh.ply").reason
     # a vertex count one too high shifts the face data: still a clean error, line 0
     assert error_of(tmp_path, binary_ply(4, struct.pack("<B3i", 3, 0, 1, 2)), name="mesh.ply").line == 0

@@ -46,7 +46,8 @@ def generate_obj(rng: random.Random) -> str:
     plan = []
     for kind, n in runs:
         if kind == "elements":
-            counts = {"v": n, "vt": rng.randrange(0, n + 1) * rng.randrange(2), "vn": rng.randrange(0, n + 1) * rng.randrange(2)}
+            counts = {"v": n, "vt": rng.randrange(0, n + 1) * rng.randrange(2),
+                      "vn": rng.randrange(0, n + 1) * rng.randrange(2)}
             for key in totals:
                 totals[key] += counts[key]
             plan.append((kind, counts))

@@ -245,7 +245,10 @@ def test_empty_trailing_slots(tmp_path):
 def test_empty_slots_in_uniform_lines_are_read_per_line(tmp_path):
     """'1/  2' (one empty slot, two spaces) and '1// 2' have gaps of one length: each line is read as written."""
     body = SQUARE + "vt 0 0\nf 1/1/  2/1/  3/1/\nf 1/1// 2/1// 3/1//\n"
-    error = pytest.raises(MeshError, load, write(tmp_path, body)).value
+    path = write(tmp_path, body)
+    with pytest.raises(MeshError) as info:
+        load(path)
+    error = info.value
     assert error.line == 7 and "malformed" in error.reason
 
 

@@ -59,7 +59,8 @@ def test_stoff_texcoords(tmp_path):
 
 
 def test_stcnoff_order_of_vertex_fields(tmp_path):
-    mesh = load_text(tmp_path, "STCNOFF\n3 1 0\n0 0 0 0 0 1 255 0 0 0.5 0.5\n1 0 0 0 0 1 0 0 255 1 0\n0 1 0 0 0 1 0 255 0 0 1\n3 0 1 2\n")
+    mesh = load_text(tmp_path, "STCNOFF\n3 1 0\n0 0 0 0 0 1 255 0 0 0.5 0.5\n1 0 0 0 0 1 0 0 255 1 0\n"
+                               "0 1 0 0 0 1 0 255 0 0 1\n3 0 1 2\n")
     np.testing.assert_array_equal(mesh.normals[0], [0, 0, 1])
     np.testing.assert_array_equal(mesh.colors[1], [0, 0, 1])
     np.testing.assert_array_equal(mesh.texcoords[0], [0.5, 0.5])

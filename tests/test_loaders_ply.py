@@ -25,7 +25,8 @@ def write_ply(path, fmt, elements):
     header.append("end_header")
     body = bytearray()
     order = ">" if fmt == "binary_big_endian" else "<"
-    codes = {"char": "i1", "uchar": "u1", "short": "i2", "ushort": "u2", "int": "i4", "uint": "u4", "float": "f4", "double": "f8"}
+    codes = {"char": "i1", "uchar": "u1", "short": "i2", "ushort": "u2", "int": "i4", "uint": "u4", "float": "f4",
+             "double": "f8"}
     text_rows = []
     for _, properties, rows in elements:
         for row in rows:
@@ -46,7 +47,8 @@ def write_ply(path, fmt, elements):
 
 
 VERTEX = [("float", "x"), ("float", "y"), ("float", "z"), ("float", "nx"), ("float", "ny"), ("float", "nz"),
-          ("uchar", "red"), ("uchar", "green"), ("uchar", "blue"), ("uchar", "alpha"), ("float", "s"), ("float", "t")]  # fmt: skip
+          ("uchar", "red"), ("uchar", "green"), ("uchar", "blue"), ("uchar", "alpha"),
+          ("float", "s"), ("float", "t")]  # fmt: skip
 VERTEX_ROWS = [
     (0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 255, 0, 0, 255, 0.0, 0.0),
     (1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0, 255, 0, 255, 1.0, 0.0),
@@ -120,7 +122,8 @@ def test_vertex_texcoord_names(tmp_path, fmt, names):
 def test_float_colours_are_kept(tmp_path):
     vertex = [("float", "x"), ("float", "y"), ("float", "z"), ("float", "red"), ("float", "green"), ("float", "blue")]
     rows = [(0.0, 0.0, 0.0, 0.25, 0.5, 1.0), (1.0, 0.0, 0.0, 0.0, 0.0, 0.0), (0.0, 1.0, 0.0, 1.0, 1.0, 1.0)]
-    mesh = load(write_ply(tmp_path / "c.ply", "binary_little_endian", [("vertex", vertex, rows), ("face", FACE[:1], [([0, 1, 2],)])]))
+    mesh = load(write_ply(tmp_path / "c.ply", "binary_little_endian",
+                          [("vertex", vertex, rows), ("face", FACE[:1], [([0, 1, 2],)])]))
     np.testing.assert_array_equal(mesh.colors, [r[3:] for r in rows])
 
 
@@ -129,7 +132,8 @@ def test_binary_runs_of_mixed_face_sizes(tmp_path, fmt):
     rng = np.random.default_rng(7)
     sizes = np.concatenate([np.full(3000, 4), rng.integers(3, 7, 500), np.full(2000, 3), [5, 4, 3] * 100])
     faces = [(list(rng.integers(0, 5, s)),) for s in sizes]
-    mesh = load(write_ply(tmp_path / "runs.ply", fmt, [("vertex", VERTEX[:3], [r[:3] for r in VERTEX_ROWS]), ("face", FACE[:1], faces)]))
+    mesh = load(write_ply(tmp_path / "runs.ply", fmt,
+                          [("vertex", VERTEX[:3], [r[:3] for r in VERTEX_ROWS]), ("face", FACE[:1], faces)]))
     assert mesh.face_sizes.tolist() == sizes.tolist()
     assert mesh.corner_vertex.tolist() == [i for (f,) in faces for i in f]
 
@@ -161,7 +165,8 @@ def test_tristrips_read_as_triangles(tmp_path, fmt):
     mesh.validate()
     pieces = [[0, 1, 2, 3, 4, 5], [6, 7, 8, 8, 9, 10, 11], [2, 3, 6], [5, 6, 7, 1]]
     expected = triangle_strips_to_faces([np.array(p) for p in pieces])
-    expected = expected[(expected[:, 0] != expected[:, 1]) & (expected[:, 1] != expected[:, 2]) & (expected[:, 0] != expected[:, 2])]
+    expected = expected[(expected[:, 0] != expected[:, 1]) & (expected[:, 1] != expected[:, 2])
+                        & (expected[:, 0] != expected[:, 2])]
     got = mesh.corner_vertex.reshape(-1, 3)
     assert mesh.counts() == {"faces": len(expected), "quads": 0, "triangles": len(expected), "ngons": 0}
 

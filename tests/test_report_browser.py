@@ -243,7 +243,8 @@ def test_makehuman_closeups_name_flagged_faces_and_outline_them(makehuman_report
 def test_makehuman_has_a_uv_layout(makehuman_report):
     browser, session, _ = makehuman_report
     layout = _evaluate(browser, session, """Array.from(document.querySelectorAll('figure[data-view="uv-layout"]'))
-        .map(f => [f.querySelector("svg image").getBoundingClientRect().width, f.querySelectorAll("svg text").length])""")
+        .map(f => [f.querySelector("svg image").getBoundingClientRect().width, """
+                       """f.querySelectorAll("svg text").length])""")
     assert len(layout) == 1
     width, labels = layout[0]
     assert width >= 400 and labels >= 5

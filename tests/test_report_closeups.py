@@ -283,7 +283,8 @@ def test_report_options_max_views_and_a_bad_texture(tmp_path):
     write_obj(grid_mesh(6, bent=[(1, 1), (4, 4)]), tmp_path / "two.obj")
 
     def report(*args):
-        return subprocess.run([sys.executable, "-m", "affinity.cli", "report", "-q", "two.obj", "-o", "out.html", *args],
+        return subprocess.run([sys.executable, "-m", "affinity.cli", "report", "-q", "two.obj", "-o", "out.html",
+                               *args],
                               capture_output=True, text=True, cwd=tmp_path, timeout=300)
 
     done = report("--max-views", "1", "--size", "200x150", "--up", "z")

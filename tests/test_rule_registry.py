@@ -27,7 +27,8 @@ def test_each_rules_example_triggers_that_rule_and_only_it(code, tmp_path, monke
     assert 4 <= len(rule.example.splitlines()) <= 10, "the example is a tiny OBJ"
     (tmp_path / "example.obj").write_text(rule.example)
     monkeypatch.chdir(tmp_path)
-    status, out, err = check(["check", "--select", "ALL", "--fail-on", "info", "--format", "json", "example.obj"], capsys)
+    status, out, err = check(["check", "--select", "ALL", "--fail-on", "info", "--format", "json", "example.obj"],
+                             capsys)
     assert status == 1, err
     findings = json.loads(out)["findings"]
     assert {f["code"] for f in findings} == {code}

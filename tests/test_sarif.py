@@ -99,7 +99,8 @@ def test_file_outside_the_working_directory_gets_an_absolute_uri(tmp_path, monke
 
 
 def fingerprints(report: FileReport) -> list[str]:
-    return [r["partialFingerprints"]["quadAffinity/v1"] for r in sarif_log(CheckRun([report], Settings()))["runs"][0]["results"]]
+    return [r["partialFingerprints"]["quadAffinity/v1"]
+            for r in sarif_log(CheckRun([report], Settings()))["runs"][0]["results"]]
 
 
 def test_fingerprints_survive_face_reordering_but_not_a_changed_quad():

@@ -1,9 +1,9 @@
 """``affinity bench [MESH...] [--quick] -o DIR``: error against run time, every method and hybrid setting.
 
 Without MESH it studies the built-in scenes (the paper's figures and a
-nonplanar quad strip); MESH may name files or folders of meshes. ``--quick`` keeps three small built-in scenes at a small size and
-finishes in seconds (for CI). Writes ``study.csv``, ``summary.md`` and PNG
-charts into DIR.
+nonplanar quad strip); MESH may name files or folders of meshes. ``--quick``
+keeps three small built-in scenes at a small size and finishes in seconds (for
+CI). Writes ``study.csv``, ``summary.md`` and PNG charts into DIR.
 """
 
 from __future__ import annotations

@@ -44,7 +44,8 @@ def _threshold(text: str) -> tuple[str, float]:
     except ValueError:
         number = math.nan
     if not math.isfinite(number):
-        raise argparse.ArgumentTypeError(f"not a finite threshold: {text!r} (use 0.8 or Q102=3; --ignore switches a rule off)")
+        raise argparse.ArgumentTypeError(f"not a finite threshold: {text!r} "
+                                         "(use 0.8 or Q102=3; --ignore switches a rule off)")
     return (code.strip().upper() or "Q101"), number
 
 

@@ -29,7 +29,8 @@ def add_parser(sub) -> None:
                    help="route a quad to mvc when the split moves its texture by more than PX pixels")
     p.add_argument("--size", type=image_size, default=(800, 600), metavar="WxH")
     p.add_argument("--camera", type=camera, metavar="EX,EY,EZ,TX,TY,TZ,FOV")
-    p.add_argument("--up", choices=["x", "y", "z"], default=None, help="world up axis (default: the stage's upAxis for USD, else y; z for the demo)")
+    p.add_argument("--up", choices=["x", "y", "z"], default=None,
+                   help="world up axis (default: the stage's upAxis for USD, else y; z for the demo)")
     p.add_argument("--show", choices=SHOW_MODES, type=spelling,
                    help="what to draw (default: uv when the mesh has it, else color, else shaded)")
     p.add_argument("--texture", metavar="IMAGE", help="texture image for uv (default: map_Kd, else a checker)")
@@ -51,7 +52,8 @@ def run(args) -> int:
             width=args.size[0], height=args.size[1], camera=args.camera, up=args.up,
             show=args.show, texture=args.texture, overlay=args.overlay == "flags", cull=args.cull,
         )
-        result = render_mesh(args.mesh, options, warn=lambda line: sys.stderr.write(f"affinity render: warning: {line}\n"))
+        result = render_mesh(args.mesh, options,
+                             warn=lambda line: sys.stderr.write(f"affinity render: warning: {line}\n"))
     except MeshError as err:
         raise UsageError(f"{err.path}:{err.line}: {err.reason}") from None
     except SkippedFile as skip:

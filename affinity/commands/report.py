@@ -134,6 +134,7 @@ def run(args) -> int:
     if not args.quiet:
         unreadable = f", {len(failed)} unreadable" if failed else ""
         unreadable += f", {len(skipped)} skipped" if skipped else ""
-        sys.stderr.write(f"affinity report: wrote {args.output} ({len(inputs)} file{'s' * (len(inputs) != 1)}{unreadable}, "
+        sys.stderr.write(f"affinity report: wrote {args.output} "
+                         f"({len(inputs)} file{'s' * (len(inputs) != 1)}{unreadable}, "
                          f"{len(html.encode()) / 1e6:.1f} MB, {report.seconds:.1f} s)\n")
     return EXIT_ERROR if failed or skipped else EXIT_CLEAN

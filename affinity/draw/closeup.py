@@ -125,7 +125,8 @@ def face_subset(mesh: Mesh, faces: np.ndarray) -> Mesh:
     from dataclasses import replace
 
     sizes = mesh.face_sizes[faces]
-    corners = np.repeat(mesh.face_start[faces], sizes) + (np.arange(sizes.sum()) - np.repeat(np.cumsum(sizes) - sizes, sizes))
+    corners = np.repeat(mesh.face_start[faces], sizes) + (np.arange(sizes.sum())
+                                                           - np.repeat(np.cumsum(sizes) - sizes, sizes))
 
     def take(array):
         return None if array is None else array[corners]

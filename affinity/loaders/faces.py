@@ -25,7 +25,8 @@ def ragged_positions(starts: np.ndarray, sizes: np.ndarray, stride: int = 1) -> 
     return np.repeat(starts - stride * before, sizes) + stride * np.arange(before[-1] + sizes[-1] if len(sizes) else 0)
 
 
-def check_indices(path, index: np.ndarray, total: int, face_start, face_line, name: str, absent: int | None = None) -> None:
+def check_indices(path, index: np.ndarray, total: int, face_start, face_line, name: str,
+                  absent: int | None = None) -> None:
     """MeshError at the face line of the first corner whose ``index`` is outside [0, total).
 
     index : (C,) int64 per corner (``absent`` marks a corner without one);
@@ -67,7 +68,8 @@ def color_note(count: int, vertex: int, line: int) -> str:
     return f"{count} vertex colour{'s' * (count != 1)} NaN (first at {where}): colours not checked"
 
 
-def polygon_mesh(path, positions, sizes, corners, face_line, texcoords=None, corner_texcoord=None, normals=None, colors=None) -> Mesh:
+def polygon_mesh(path, positions, sizes, corners, face_line, texcoords=None, corner_texcoord=None, normals=None,
+                 colors=None) -> Mesh:
     """A :class:`Mesh` from per-vertex attributes and face lists as OFF and PLY store them.
 
     positions : (V, 3); sizes : (F,) int64 corners per face; corners : (C,) vertex
@@ -78,7 +80,8 @@ def polygon_mesh(path, positions, sizes, corners, face_line, texcoords=None, cor
     """
     small = sizes < 3
     if small.any():
-        raise MeshError(path, int(face_line[np.argmax(small)]), f"face with {sizes[small][0]} corners (at least 3 needed)")
+        raise MeshError(path, int(face_line[np.argmax(small)]),
+                        f"face with {sizes[small][0]} corners (at least 3 needed)")
     face_start = np.concatenate(([0], np.cumsum(sizes)))
     whole = (corners == np.round(corners)) & (np.abs(corners) < 2**62)  # NaN, inf and 1e30 are no index
     corner_vertex = np.where(whole, corners, -1).astype(np.int64)

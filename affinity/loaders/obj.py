@@ -202,7 +202,8 @@ def _elements(tokens: Tokens, path, lines, which, nan_colors: list) -> np.ndarra
         wrong = ~_ALLOWED[which][np.minimum(width, _MAX_WIDTH)]
         if wrong.any():
             line = lines[np.argmax(wrong)]
-            raise MeshError(path, tokens.number[line], f"{tokens.text(tokens.first[line])} line with {width[wrong][0]} numbers")
+            raise MeshError(path, tokens.number[line],
+                            f"{tokens.text(tokens.first[line])} line with {width[wrong][0]} numbers")
         values, bad = parse_floats(tokens.buf, tokens.starts[numbers], tokens.ends[numbers], finite=True)
         if len(bad):
             line = np.repeat(np.arange(len(width)), width)[bad]

@@ -29,7 +29,8 @@ def load_off(path) -> Mesh:
     n_vertices, n_faces = counts
     if len(rows.number) < n_vertices + n_faces:
         last = int(rows.number[-1]) if len(rows.number) else line
-        raise MeshError(path, last, f"truncated: {len(rows.number)} data lines for {n_vertices} vertices and {n_faces} faces")
+        raise MeshError(path, last,
+                        f"truncated: {len(rows.number)} data lines for {n_vertices} vertices and {n_faces} faces")
 
     width = rows.counts[:n_vertices]
     fixed = 3 + 3 * has_normal + 2 * has_st
@@ -45,7 +46,8 @@ def load_off(path) -> Mesh:
         column = np.flatnonzero(infinite) - first[row]
         colour = 3 + 3 * has_normal
         # a NaN colour drops the colours (unit_colors says so); anything else must be finite
-        allowed = has_color & (column >= colour) & (column < width[row] - 2 * has_st) & np.isnan(vertex_values[infinite])
+        allowed = (has_color & (column >= colour) & (column < width[row] - 2 * has_st)
+                   & np.isnan(vertex_values[infinite]))
         if not allowed.all():
             raise MeshError(path, int(rows.number[row[np.argmax(~allowed)]]), "coordinate is not finite")
 
@@ -125,7 +127,8 @@ def _header(fh, path):
         if prefix is None:
             prefix = _KEYWORD.fullmatch(words[0])
             if prefix is None:
-                raise MeshError(path, line, f"not an OFF file: header {words[0][:20]!r} (supported: OFF, COFF, NOFF, STOFF and combinations)")
+                raise MeshError(path, line, f"not an OFF file: header {words[0][:20]!r} "
+                                            "(supported: OFF, COFF, NOFF, STOFF and combinations)")
             words = words[1:]
         numbers += words
     try:

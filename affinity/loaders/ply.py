@@ -152,10 +152,12 @@ def _read_ascii(path, fh, elements, header_lines):
     for element in elements:
         span = slice(done, done + element.count)
         first, limit = rows.first[span], rows.first[done + 1 : done + element.count + 1]
-        found, end, bad = _walk(element, first, lambda at, dtype: _as_declared(rows.values[at], dtype), lambda _: 1, limit)
+        found, end, bad = _walk(element, first, lambda at, dtype: _as_declared(rows.values[at], dtype), lambda _: 1,
+                                limit)
         wrong = [bad] if bad is not None else np.flatnonzero(end != limit)
         if len(wrong):
-            raise MeshError(path, int(rows.number[span][wrong[0]]), f"{element.name} line does not match the header's properties")
+            raise MeshError(path, int(rows.number[span][wrong[0]]),
+                            f"{element.name} line does not match the header's properties")
         columns[element.name] = found
         columns[element.name + ":lines"] = rows.number[span]
         done += element.count
@@ -300,7 +302,8 @@ def _mesh(path, elements, columns) -> Mesh:
         strip_lines = columns.get("tristrips:lines", np.zeros(len(strips[0]), np.int64))
         sizes, corner_vertex, face_line, dropped = strip_triangles(*strips, strip_lines)
         notes.append(f"{len(sizes)} triangles read from {len(strips[0])} triangle strip list"
-                     f"{'s' * (len(strips[0]) != 1)}" + (f" ({dropped} degenerate joining triangles left out)" if dropped else ""))
+                     f"{'s' * (len(strips[0]) != 1)}"
+                     + (f" ({dropped} degenerate joining triangles left out)" if dropped else ""))
     texcoords = corner_texcoord = normals = colors = None
     if all(k in vertex for k in ("nx", "ny", "nz")):
         normals = np.stack([vertex[k] for k in ("nx", "ny", "nz")], axis=1).astype(np.float64)
@@ -313,7 +316,8 @@ def _mesh(path, elements, columns) -> Mesh:
     if "texcoord" in face:
         counts, uv = face["texcoord"]
         if (counts != 2 * sizes).any():
-            raise MeshError(path, int(face_line[np.argmax(counts != 2 * sizes)]), "texcoord list is not two numbers per corner")
+            raise MeshError(path, int(face_line[np.argmax(counts != 2 * sizes)]),
+                            "texcoord list is not two numbers per corner")
         texcoords, corner_texcoord = uv.reshape(-1, 2).astype(np.float64), np.arange(len(corner_vertex))
         _require_finite(path, texcoords, 0 if np.isscalar(lines) else np.repeat(face_line, sizes))
     else:

@@ -41,7 +41,8 @@ def inline_ignores(path: str, face_line: np.ndarray) -> list[tuple[list[str], np
     for match, line in zip(found, lines.tolist()):
         start = data.rfind(b"\n", 0, match.start()) + 1
         keyword = data[start:match.start()].split(None, 1)[:1]
-        codes = ["ALL"] if match.group(1) is None else [c.strip().upper() for c in match.group(1).decode().split(",") if c.strip()]
+        codes = (["ALL"] if match.group(1) is None
+                 else [c.strip().upper() for c in match.group(1).decode().split(",") if c.strip()])
         if keyword == [b"f"]:
             at = np.searchsorted(face_line, line)
             faces = np.arange(at, np.searchsorted(face_line, line, side="right"))

@@ -48,7 +48,8 @@ class Chunk:
         return int(hits[0]) if len(hits) else -1
 
 
-def read_chunks(fh, first_line: int = 1, continuations: bool = False, size: int | None = None, count_lines: bool = True):
+def read_chunks(fh, first_line: int = 1, continuations: bool = False, size: int | None = None,
+                count_lines: bool = True):
     """Yield :class:`Chunk` s of whole lines from the binary file object ``fh``.
 
     With ``continuations`` a '\\' right before a line break joins the two lines

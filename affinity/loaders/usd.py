@@ -117,7 +117,8 @@ def load_usd(path, options: UsdOptions | None = None) -> Mesh:
         notes.append(f"no mesh has the primvar {options.uv_primvar!r}: texture coordinates not checked")
     mesh = _concatenate(os.fspath(path), parts, [str(prim.GetPath()) for prim in prims])
     mesh.up_axis = _stage_metadata(stage, "upAxis", lambda: str(UsdGeom.GetStageUpAxis(stage)), notes)
-    mesh.meters_per_unit = _stage_metadata(stage, "metersPerUnit", lambda: float(UsdGeom.GetStageMetersPerUnit(stage)), notes)
+    mesh.meters_per_unit = _stage_metadata(stage, "metersPerUnit", lambda: float(UsdGeom.GetStageMetersPerUnit(stage)),
+                                           notes)
     mesh.notes = notes
     return mesh
 

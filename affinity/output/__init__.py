@@ -125,12 +125,14 @@ def _rows(report: FileReport, hits: RuleHits, take: np.ndarray) -> list[tuple[in
 
 
 def _worst_first(hits: RuleHits) -> np.ndarray:
-    """(n,) int64 order of ``hits`` from the worst value (the rule's ``worst`` end) to the mildest, ties in file order."""
+    """(n,) int64 order of ``hits`` from the worst value (the rule's ``worst`` end) to the mildest,
+    ties in file order."""
     key = hits.values if RULES[hits.code].worst == "lowest" else -hits.values
     return np.lexsort((hits.faces, key))
 
 
-def file_findings(report: FileReport, limit: int | None = None, worst: bool = False) -> tuple[list[Finding], dict[str, int]]:
+def file_findings(report: FileReport, limit: int | None = None,
+                  worst: bool = False) -> tuple[list[Finding], dict[str, int]]:
     """The findings of one file in source order, and how many each rule left out.
 
     Parameters
@@ -217,7 +219,8 @@ def describe(f: Finding) -> str:
     """
     if not f.unit:
         return f.message
-    measured = format_value(f.value) if f.threshold is None else f"{format_value(f.value)} vs {format_value(f.threshold)}"
+    measured = (format_value(f.value) if f.threshold is None
+                else f"{format_value(f.value)} vs {format_value(f.threshold)}")
     return f"{f.message} ({with_unit(measured, f.unit)})"
 
 

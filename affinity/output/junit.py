@@ -33,7 +33,8 @@ def _finding_case(suite: ET.Element, f: Finding) -> None:
     name = " ".join(filter(None, [f.code, f.name, face_label(f)]))
     case = ET.SubElement(suite, "testcase", classname=f.path, name=name, file=f.path, line=str(f.line))
     props = ET.SubElement(case, "properties")
-    keys = ("face", "value", "threshold", "unit", "level", "line", "column", "code", "name", "group") + ("prim",) * (f.prim is not None)
+    keys = (("face", "value", "threshold", "unit", "level", "line", "column", "code", "name", "group")
+            + ("prim",) * (f.prim is not None))
     for key in keys:
         ET.SubElement(props, "property", name=key, value=str(getattr(f, key)))
     failure = ET.SubElement(case, "failure", type=f.code, message=describe(f))
@@ -66,7 +67,8 @@ def write(run: CheckRun, out: TextIO) -> None:
     if run.statistics:  # per-rule counts as properties of the run
         props = ET.SubElement(root, "properties")
         for row in statistics(run.reports):
-            ET.SubElement(props, "property", name=f"{row['code']} {row['name']} ({row['level']})", value=str(row["count"]))
+            ET.SubElement(props, "property", name=f"{row['code']} {row['name']} ({row['level']})",
+                          value=str(row["count"]))
     root.extend(_suite(report) for report in run.reports)
     for key in ("tests", "failures", "errors", "skipped"):
         root.set(key, str(sum(int(suite.get(key)) for suite in root if suite.tag == "testsuite")))

@@ -77,7 +77,8 @@ class _Ignores:
 
 
 def _excluded(settings: Settings, path: str, top: str) -> bool:
-    """Whether an ``exclude``/``extend-exclude`` glob matches ``path`` (relative to the configuration, else to ``top``)."""
+    """Whether an ``exclude``/``extend-exclude`` glob matches ``path`` (relative to the configuration, else to
+    ``top``)."""
     rel = settings.relative(path) or os.path.relpath(path, top).replace(os.sep, "/")
     return any(glob_matches(pattern, rel) for pattern in (*settings.exclude, *settings.extend_exclude))
 

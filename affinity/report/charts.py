@@ -52,7 +52,8 @@ def svg_markup(figure) -> str:
     # RDF metadata; both would only put URLs into a page that references nothing outside itself.
     text = re.sub(r"<metadata>.*?</metadata>\s*", "", text, flags=re.DOTALL)
     text = re.sub(r'\s+xmlns(:\w+)?="[^"]*"', "", text)
-    text = re.sub(r'(<svg[^>]*?) width="([\d.]+)pt" height="([\d.]+)pt"', r'\1 width="\2" height="\3" class="chart"', text, count=1)
+    text = re.sub(r'(<svg[^>]*?) width="([\d.]+)pt" height="([\d.]+)pt"', r'\1 width="\2" height="\3" class="chart"',
+                  text, count=1)
     return text
 
 

@@ -51,11 +51,13 @@ def colour_bar(stops, ticks: list[tuple[float, str]], label: str, width: int = 2
     ``ticks`` are (position in [0, 1] along the bar, text); ``label`` names the
     quantity and its unit. Text is 12 px, so it stays legible wherever the bar is.
     """
-    gradient = "".join(f'<stop offset="{k / (len(stops) - 1):.3f}" stop-color="{_hex(c)}"/>' for k, c in enumerate(stops))
+    gradient = "".join(f'<stop offset="{k / (len(stops) - 1):.3f}" stop-color="{_hex(c)}"/>'
+                       for k, c in enumerate(stops))
     bar_id = f"bar{abs(hash((tuple(map(tuple, stops)), label))) % 10**8}"
     marks = "".join(
         f'<line x1="{8 + t * (width - 16):.1f}" x2="{8 + t * (width - 16):.1f}" y1="20" y2="25" stroke="#374151"/>'
-        f'<text x="{8 + t * (width - 16):.1f}" y="38" text-anchor="{"start" if t == 0 else "end" if t == 1 else "middle"}">'
+        f'<text x="{8 + t * (width - 16):.1f}" y="38" '
+        f'text-anchor="{"start" if t == 0 else "end" if t == 1 else "middle"}">'
         f'{escape(text)}</text>' for t, text in ticks)
     return (f'<svg class="colour-bar" role="img" aria-label="colour bar: {escape(label)}" width="{width}" height="58" '
             f'viewBox="0 0 {width} 58" font-size="12" fill="#1f2937" font-family="system-ui, sans-serif">'

@@ -78,8 +78,8 @@ def _check(p: np.ndarray, quad: np.ndarray, w: np.ndarray, face: int, pixel) -> 
     from render.coords import mean_value
 
     from ..stability.condition import condition, tolerance
-    from ..stability.rows import UNIT_ROUNDOFF
     from ..stability.reference import Undefined, homogeneous, mean_value_exact, offsets
+    from ..stability.rows import UNIT_ROUNDOFF
 
     results = {}
     for precision in ("float64", "float32"):
@@ -127,5 +127,6 @@ def scene_stability(mesh, render, camera, up, size) -> SceneStability:
         result = _check(p[k], ndc[quads[k]], w[quads[k]], int(render.faces[quads[k]]), (int(rows[k]), int(cols[k])))
         if result is not None:
             checked.append(result)
-    checked.sort(key=lambda r: -max(r.condition / STIFF_CONDITION, r.error32 / r.tolerance32, r.error64 / r.tolerance64))
+    checked.sort(key=lambda r: -max(r.condition / STIFF_CONDITION, r.error32 / r.tolerance32,
+                                    r.error64 / r.tolerance64))
     return SceneStability(len(rows), checked)

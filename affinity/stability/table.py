@@ -39,7 +39,8 @@ def _summary_line(s: dict) -> str:
     line = f"{s['method']} {s['precision']}: {s['passed']} of {s['cases']} cases pass"
     if s["skipped"]:
         line += f" ({s['skipped']} skipped)"
-    return line + f"; worst ratio {number(s['worst_ratio'])} ({s['worst_case']}), worst error {number(s['worst_error'])}"
+    return line + (f"; worst ratio {number(s['worst_ratio'])} ({s['worst_case']}), "
+                   f"worst error {number(s['worst_error'])}")
 
 
 def summary(rows: list[Row]) -> list[dict]:
