@@ -67,7 +67,10 @@ class FileReport:
     ``prim_face_start`` (P + 1,) int64 their first faces (see
     :class:`affinity.mesh.Mesh`), so findings can name the prim and count faces
     within it; ``up_axis`` and ``meters_per_unit`` are the stage's. ``notes``
-    are the loader's remarks on what it did not check.
+    are the loader's remarks on what it did not check. ``transient`` marks an
+    error that says something about this run rather than about the file (an
+    internal error, a Dask worker that cannot see the path): such a report is
+    never cached.
     """
 
     path: str
@@ -81,6 +84,7 @@ class FileReport:
     up_axis: str | None = None
     meters_per_unit: float | None = None
     notes: list[str] = field(default_factory=list)
+    transient: bool = False
 
     @property
     def n_findings(self) -> int:

@@ -192,7 +192,8 @@ def test_a_file_rewritten_within_its_mtime_is_checked_again(tmp_path, tmp_path_f
 def test_internal_errors_are_never_stored(assets, tmp_path_factory, monkeypatch):
     folder = tmp_path_factory.mktemp("cache")
     monkeypatch.setattr(check_module, "check_file",
-                        lambda path, settings, usd=None: FileReport(path, error="internal error: boom"))
+                        lambda path, settings, usd=None: FileReport(path, error="internal error: boom",
+                                                                    transient=True))
     assert cached_run(folder, tasks_of(assets))[0].error == "internal error: boom"
     monkeypatch.undo()
     assert [r.error for r in cached_run(folder, tasks_of(assets))] == [None, None]

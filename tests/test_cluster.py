@@ -109,6 +109,24 @@ def test_a_path_the_worker_cannot_see_is_unreadable_with_the_reason(client, tmp_
     [(index, report)] = list(cluster_module.check_on_cluster(client, [(str(missing), Settings())]))
     assert index == 0 and report.path == str(missing)
     assert "not found on the Dask worker" in report.error and "shared storage" in report.error
+    assert report.transient  # a mount problem, not the file's result: never cached
+
+
+def test_a_worker_that_cannot_see_the_file_leaves_no_cache_entry(tmp_path):
+    """The client hashes the file, the worker reports it unseen: the next run (mount fixed) checks it."""
+    from affinity.findings import FileReport
+    from affinity.pipeline.cache import ResultCache
+
+    mesh = tmp_path / "crate.obj"
+    mesh.write_text(quad_obj([(trapezoid(0.5), UNIT_UV)]))
+    cache = ResultCache(str(tmp_path / "cache"), tool="t")
+    key = cache.key(str(mesh), Settings())
+    unseen = cluster_module._check_on_worker(str(tmp_path / "elsewhere.obj"), str(mesh), Settings(), None)
+    cache.put(key, unseen)
+    assert cache.get(key) is None
+    cache.put(key, FileReport(str(mesh), counts={"faces": 1}))
+    assert cache.get(key) is not None  # a real result under the same key is kept
+    cache.close()
 
 
 def test_cached_files_are_not_submitted(client, assets, tmp_path, monkeypatch):

@@ -19,8 +19,9 @@ again next time.
 The cache is one SQLite file in the user cache folder (``platformdirs``), or in
 ``AFFINITY_CACHE_DIR``. It is an optimisation only: a folder that cannot be
 written or a damaged database gives one warning line on stderr and the run goes
-on (a damaged database is replaced by a new one). Reports whose error starts
-with ``"internal error"`` are never stored. Entries unused for
+on (a damaged database is replaced by a new one). Reports that say more about
+the run than about the file (``FileReport.transient``: an internal error, a
+Dask worker that cannot see the path) are never stored. Entries unused for
 :data:`MAX_AGE_DAYS` days go, and the oldest go first when the entries exceed
 :data:`MAX_BYTES`.
 """
@@ -238,8 +239,8 @@ class ResultCache:
         return report
 
     def put(self, key: str | None, report: FileReport) -> None:
-        """Store ``report`` under ``key``; internal errors are not stored."""
-        if key is None or self._db is None or (report.error or "").startswith("internal error"):
+        """Store ``report`` under ``key``; transient reports (internal errors, unseen paths) are not stored."""
+        if key is None or self._db is None or report.transient:
             return
         self._write("INSERT OR REPLACE INTO results VALUES (?, ?, ?)", (key, report_to_bytes(report), self._now))
 

@@ -50,7 +50,7 @@ def load_and_check(path: str, settings: Settings, usd=None) -> tuple[FileReport,
         return FileReport(path, error=err.reason, error_line=err.line), None
     except Exception as err:
         reason = " ".join(f"internal error: {type(err).__name__}: {err}".split())
-        return FileReport(path, error=reason[:300], error_line=0), None
+        return FileReport(path, error=reason[:300], error_line=0, transient=True), None
     return report, mesh
 
 

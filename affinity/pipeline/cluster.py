@@ -12,7 +12,7 @@ tasks and tasks back into reports:
   puts them back in the files' order, so the output is that of a local run;
 - a worker lost mid-run is Dask's business: the scheduler reruns the tasks it
   held (``distributed.scheduler.allowed-failures`` times), and a task that
-  still fails becomes an "internal error" report (never cached).
+  still fails becomes an "internal error" report (transient: never cached).
 
 ``dask[distributed]`` is the optional extra ``distributed`` and is imported
 only here, only when a scheduler is asked for.
@@ -117,7 +117,7 @@ def check_on_cluster(client, tasks: list[tuple[str, Settings]], usd=None) -> Ite
         j = futures.pop(future)
         if future.status != "finished":
             result = FileReport(tasks[j][0], error=f"internal error on the Dask cluster: {type(result).__name__}: "
-                                                   f"{result}")
+                                                   f"{result}", transient=True)
         yield j, result
         future.release()
 
@@ -130,7 +130,8 @@ def _check_on_worker(absolute: str, given: str, settings: Settings, usd) -> File
         import socket
 
         return FileReport(given, error=f"not found on the Dask worker on {socket.gethostname()} "
-                                       f"(is the shared storage mounted there at {os.path.dirname(absolute)}?)")
+                                       f"(is the shared storage mounted there at {os.path.dirname(absolute)}?)",
+                          transient=True)
     report = check_file(absolute, settings, usd)
     report.path = given
     return report
