@@ -244,10 +244,14 @@ def test_makehuman_has_a_uv_layout(makehuman_report):
     browser, session, _ = makehuman_report
     layout = _evaluate(browser, session, """Array.from(document.querySelectorAll('figure[data-view="uv-layout"]'))
         .map(f => [f.querySelector("svg image").getBoundingClientRect().width, """
-                       """f.querySelectorAll("svg text").length])""")
+                       """Array.from(f.querySelectorAll("svg text")).map(t => {const r = t.getBoundingClientRect();
+                          return [t.textContent, r.left, r.top, r.right, r.bottom];})])""")
     assert len(layout) == 1
     width, labels = layout[0]
-    assert width >= 400 and labels >= 5
+    assert width >= 400 and sum(text.count("face ") for text, *_ in labels) >= 5
+    for k, (_, left, top, right, bottom) in enumerate(labels):  # as laid out by the browser's own font
+        for text, *other in labels[k + 1:]:
+            assert not (left < other[2] and other[0] < right and top < other[3] and other[1] < bottom), text
 
 
 @pytest.mark.parametrize("width", [1280, 800])

@@ -298,3 +298,19 @@ def test_report_options_max_views_and_a_bad_texture(tmp_path):
     failed = report("--texture", "not-an-image.png")
     assert failed.returncode == 2 and "not-an-image.png: not a readable image" in failed.stderr
     assert "Traceback" not in failed.stderr and not (tmp_path / "out.html").exists()
+
+
+def test_uv_layout_labels_places_at_one_uv_spot_once(tmp_path):
+    """Per-face unit uv (every face on the whole texture): one ring, one label naming every labelled face."""
+    import re
+
+    from test_formats import UNIT_UV, quad_obj, trapezoid
+
+    from affinity.loaders import load
+    from affinity.report.uvlayout import layout_svg
+
+    path = tmp_path / "tiles.obj"
+    path.write_text(quad_obj([(trapezoid(0.2 + 0.1 * k, 3 * k), UNIT_UV) for k in range(4)]))
+    svg = layout_svg(load(str(path)), np.ones(4, bool), [(3, "Q101"), (0, "Q101"), (2, "Q202")])
+    assert svg.count("<circle") == 1
+    assert re.findall(r"<text[^>]*>([^<]*)</text>", svg) == ["faces 3, 0 (Q101)", "face 2 (Q202)"]

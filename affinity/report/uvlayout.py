@@ -21,6 +21,11 @@ FACE_FILL = np.array([0.86, 0.89, 0.93])
 EDGE = np.array([0.42, 0.45, 0.50])
 #: Labelled faces per layout.
 LABELLED = 8
+#: The ring around a labelled face, and the label's line height and (12 px sans-serif) mean character width.
+RING_RADIUS = 7
+LABEL_LINE = 15
+LABEL_CHAR_WIDTH = 6.8
+FACES_PER_LINE = 4
 
 
 def uv_bounds(uv: np.ndarray) -> tuple[np.ndarray, float]:
@@ -75,24 +80,54 @@ def face_uv_centre(mesh: Mesh, face: int) -> np.ndarray:
     return np.nanmean(mesh.corner_attribute("texcoords", corners)[0], axis=0)
 
 
+def _label_lines(faces_by_code: dict[str, list[int]]) -> list[str]:
+    """A ring's label, one line per rule and :data:`FACES_PER_LINE` faces: ``faces 3, 7 (Q101)``."""
+    lines = []
+    for code, faces in faces_by_code.items():
+        for k in range(0, len(faces), FACES_PER_LINE):
+            some = faces[k : k + FACES_PER_LINE]
+            lines.append(f"face{'s' * (len(some) > 1)} {', '.join(map(str, some))} ({escape(code)})")
+    return lines
+
+
 def layout_svg(mesh: Mesh, flagged: np.ndarray, labelled: list[tuple[int, str]], size: int = 640) -> str | None:
     """The layout as inline SVG: the raster picture, and a ringed label ``face F (CODE)`` at each labelled face.
 
     ``labelled`` is (face, rule code) of the worst places. None without uv.
+    Places whose uv centres fall within a ring of each other (e.g. every face
+    mapped onto the whole texture) share one ring, labelled a line per rule
+    (``faces 3, 7 (Q101)``); a line goes to the side of its ring with room,
+    moved down until it overlaps no other.
     """
     drawn = layout_image(mesh, flagged, size)
     if drawn is None:
         return None
     image, low, side = drawn
-    marks = []
+    rings: list[tuple[float, float, dict[str, list[int]]]] = []
     for face, code in labelled[:LABELLED]:
         u, v = (face_uv_centre(mesh, face) - low) / side
         x, y = u * size, (1 - v) * size
-        anchor = "end" if x > size * 0.7 else "start"
-        dx = -10 if anchor == "end" else 10
-        marks.append(f'<circle cx="{x:.1f}" cy="{y:.1f}" r="7" fill="none" stroke="#111827" stroke-width="2"/>'
-                     f'<text x="{x + dx:.1f}" y="{y + 4:.1f}" text-anchor="{anchor}" paint-order="stroke" '
-                     f'stroke="#fff" stroke-width="3">face {face} ({escape(code)})</text>')
+        same = next((ring for ring in rings if np.hypot(ring[0] - x, ring[1] - y) < 2 * RING_RADIUS), None)
+        if same is None:
+            rings.append(same := (x, y, {}))
+        same[2].setdefault(code, []).append(face)
+    marks, boxes = [], []
+    for x, y, faces_by_code in rings:
+        marks.append(f'<circle cx="{x:.1f}" cy="{y:.1f}" r="{RING_RADIUS}" fill="none" stroke="#111827" '
+                     f'stroke-width="2"/>')
+        for text in _label_lines(faces_by_code):
+            width = LABEL_CHAR_WIDTH * len(text)
+            room_right, room_left = size - x - 10, x - 10
+            anchor = "start" if width <= room_right or room_right >= room_left else "end"
+            dx = 10 if anchor == "start" else -10
+            left = x + dx if anchor == "start" else x + dx - width
+            baseline = y + 4
+            while any(abs(baseline - b) < LABEL_LINE and left < right and start < left + width
+                      for start, right, b in boxes):
+                baseline += LABEL_LINE
+            boxes.append((left, left + width, baseline))
+            marks.append(f'<text x="{x + dx:.1f}" y="{baseline:.1f}" text-anchor="{anchor}" '
+                         f'paint-order="stroke" stroke="#fff" stroke-width="3">{text}</text>')
     return (f'<svg class="uv-layout" role="img" aria-label="uv layout" width="{size}" height="{size}" '
             f'viewBox="0 0 {size} {size}" font-size="12" font-family="system-ui, sans-serif" fill="#111827">'
             f'<image href="{image_uri(image)}" width="{size}" height="{size}"/>'
