@@ -2,13 +2,16 @@
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from test_formats import UNIT_UV, quad_obj, trapezoid
 
+from affinity.loaders import load
 from affinity.loaders.objwriter import write_obj
 from affinity.mesh import mesh_from_polygons
 
@@ -302,11 +305,6 @@ def test_report_options_max_views_and_a_bad_texture(tmp_path):
 
 def test_uv_layout_labels_places_at_one_uv_spot_once(tmp_path):
     """Per-face unit uv (every face on the whole texture): one ring, one label naming every labelled face."""
-    import re
-
-    from test_formats import UNIT_UV, quad_obj, trapezoid
-
-    from affinity.loaders import load
     from affinity.report.uvlayout import layout_svg
 
     path = tmp_path / "tiles.obj"

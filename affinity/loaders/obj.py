@@ -460,16 +460,21 @@ def _mixed_faces(tokens: Tokens, path, kind, face_lines):
 def _statement(tokens: Tokens, path, line, faces_before, part: _Part) -> None:
     """Handle one rare line: ``g``/``o``/``usemtl`` become events, ``mtllib`` is kept."""
     number = int(tokens.number[line])
-    raw = bytes(tokens.buf[tokens.begin[line] : tokens.end[line]]).split()
-    comment = next((k for k, word in enumerate(raw) if word.startswith(b"#")), len(raw))
-    words = [_name_text(word) for word in raw[:comment]]
+    raw = uncommented(bytes(tokens.buf[tokens.begin[line] : tokens.end[line]]).split())
+    words = [_name_text(word) for word in raw]
     if not words or not _KEYWORD.fullmatch(words[0]):
         raise MeshError(path, number, f"not an OBJ statement: {' '.join(words)!r}")
     name = " ".join(words[1:])
     if words[0] in ("g", "o", "usemtl"):
         part.events.append((faces_before, words[0], name))
     elif words[0] == "mtllib":  # a file name: the bytes as the file system spells them
-        part.mtllibs.append(os.fsdecode(b" ".join(raw[1:comment])))
+        part.mtllibs.append(os.fsdecode(b" ".join(raw[1:])))
+
+
+def uncommented(words: list[bytes]) -> list[bytes]:
+    """A statement's words before the first one that starts a comment (``#``)."""
+    comment = next((k for k, word in enumerate(words) if word.startswith(b"#")), len(words))
+    return words[:comment]
 
 
 def _name_text(word: bytes) -> str:

@@ -38,6 +38,7 @@ import sys
 import time
 
 from ..findings import FileReport, report_from_bytes, report_to_bytes
+from ..loaders.obj import uncommented
 from ..settings import Settings
 
 #: Bump when the key or the stored report changes meaning.
@@ -309,13 +310,12 @@ def _mtllib_names(block: bytes, end: int) -> list[str]:
     names, last_line = [], -1
     for match in _MTLLIB.finditer(block, 0, end):
         line_start = block.rfind(b"\n", 0, match.start()) + 1
-        words = block[line_start : match.end()].split()
-        if line_start == last_line or words[0] != b"mtllib":  # said again on its line, or another statement
+        words = uncommented(block[line_start : match.end()].split())
+        if line_start == last_line or words[:1] != [b"mtllib"]:  # said again on its line, or another statement
             continue
         last_line = line_start
-        comment = next((k for k, word in enumerate(words) if word.startswith(b"#")), len(words))
-        if comment > 1:
-            names.append(os.fsdecode(b" ".join(words[1:comment])))
+        if len(words) > 1:
+            names.append(os.fsdecode(b" ".join(words[1:])))
     return names
 
 

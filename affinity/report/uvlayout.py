@@ -21,8 +21,10 @@ FACE_FILL = np.array([0.86, 0.89, 0.93])
 EDGE = np.array([0.42, 0.45, 0.50])
 #: Labelled faces per layout.
 LABELLED = 8
-#: The ring around a labelled face, and the label's line height and (12 px sans-serif) mean character width.
+#: The ring around a labelled face, the gap to its label, and the label's line height and (12 px
+#: sans-serif) mean character width.
 RING_RADIUS = 7
+LABEL_GAP = 10
 LABEL_LINE = 15
 LABEL_CHAR_WIDTH = 6.8
 FACES_PER_LINE = 4
@@ -117,9 +119,9 @@ def layout_svg(mesh: Mesh, flagged: np.ndarray, labelled: list[tuple[int, str]],
                      f'stroke-width="2"/>')
         for text in _label_lines(faces_by_code):
             width = LABEL_CHAR_WIDTH * len(text)
-            room_right, room_left = size - x - 10, x - 10
+            room_right, room_left = size - x - LABEL_GAP, x - LABEL_GAP
             anchor = "start" if width <= room_right or room_right >= room_left else "end"
-            dx = 10 if anchor == "start" else -10
+            dx = LABEL_GAP if anchor == "start" else -LABEL_GAP
             left = x + dx if anchor == "start" else x + dx - width
             baseline = y + 4
             while any(abs(baseline - b) < LABEL_LINE and left < right and start < left + width
