@@ -1,5 +1,6 @@
 """PLY loader: ASCII, binary little- and big-endian give the same mesh; attributes; skipping."""
 
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -177,6 +178,21 @@ def test_tristrips_read_as_triangles(tmp_path, fmt):
     assert any("triangle strip" in note and "2 degenerate" in note for note in mesh.notes)
     if fmt == "ascii":
         assert sorted(set(mesh.face_line.tolist())) == [23, 24]  # 10 header lines, 12 vertices
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+@pytest.mark.parametrize("bad", [2.5, float("nan"), float("inf"), 1e30])
+def test_tristrip_indices_that_are_not_whole_are_refused_at_their_line(tmp_path, fmt, bad):
+    """As in face lists: a float strip item must be a whole number, not truncated to a vertex (2.5 -> 2)."""
+    rows = [(0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (1.0, 1.0, 0.0), (2.0, 1.0, 0.0)]
+    strips = ("tristrips", [("list", "int", "float", "vertex_indices")], [([0.0, 1.0, 2.0, 3.0],),
+                                                                         ([1.0, 3.0, bad, 4.0],)])
+    path = write_ply(tmp_path / "strips.ply", fmt, [("vertex", VERTEX[:3], rows), strips])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no RuntimeWarning from casting NaN to an index
+        with pytest.raises(MeshError, match="vertex index out of range") as info:
+            load(path)
+    assert info.value.line == (17 if fmt == "ascii" else 0)  # 10 header lines, 5 vertices, the second strip
 
 
 @pytest.mark.parametrize("fmt", FORMATS)

@@ -40,6 +40,16 @@ def check_indices(path, index: np.ndarray, total: int, face_start, face_line, na
     raise MeshError(path, int(face_line[face]), f"{name} index out of range (the file has {total})")
 
 
+def whole_indices(values: np.ndarray, invalid: int = -1) -> np.ndarray:
+    """(C,) int64 indices from list items as read: an item that is no whole number (2.5; NaN, inf and
+    1e30 from text or float lists) becomes ``invalid``, for :func:`check_indices` to report."""
+    values = np.asarray(values)
+    if values.dtype.kind in "iub":
+        return values.astype(np.int64)
+    whole = (values == np.round(values)) & (np.abs(values) < 2**62)
+    return np.where(whole, values, invalid).astype(np.int64)
+
+
 def unit_colors(path, colors: np.ndarray, scale: float, lines, notes: list) -> np.ndarray | None:
     """(V, 3) float64 colours divided by ``scale``; MeshError where one leaves [0, 1].
 
@@ -83,8 +93,7 @@ def polygon_mesh(path, positions, sizes, corners, face_line, texcoords=None, cor
         raise MeshError(path, int(face_line[np.argmax(small)]),
                         f"face with {sizes[small][0]} corners (at least 3 needed)")
     face_start = np.concatenate(([0], np.cumsum(sizes)))
-    whole = (corners == np.round(corners)) & (np.abs(corners) < 2**62)  # NaN, inf and 1e30 are no index
-    corner_vertex = np.where(whole, corners, -1).astype(np.int64)
+    corner_vertex = whole_indices(corners)
     check_indices(path, corner_vertex, len(positions), face_start, face_line, "vertex")
     if texcoords is not None and corner_texcoord is None:
         corner_texcoord = corner_vertex

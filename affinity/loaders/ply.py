@@ -21,7 +21,7 @@ import numpy as np
 
 from ..errors import MeshError
 from ..mesh import Mesh
-from .faces import polygon_mesh, ragged_positions, unit_colors
+from .faces import check_indices, polygon_mesh, ragged_positions, unit_colors, whole_indices
 from .text import read_rows
 
 _TYPES = {
@@ -299,8 +299,12 @@ def _mesh(path, elements, columns) -> Mesh:
     strips = columns.get("tristrips", {})
     strips = strips.get("vertex_indices", strips.get("vertex_index"))
     if strips is not None and len(sizes) == 0:
-        strip_lines = columns.get("tristrips:lines", np.zeros(len(strips[0]), np.int64))
-        sizes, corner_vertex, face_line, dropped = strip_triangles(*strips, strip_lines)
+        counts, items = strips
+        strip_lines = columns.get("tristrips:lines", np.zeros(len(counts), np.int64))
+        items = whole_indices(items, invalid=-2)  # -1 restarts a strip
+        check_indices(path, items, len(positions), np.concatenate(([0], np.cumsum(counts))), strip_lines,
+                      "vertex", absent=-1)  # every item, also those only in the joins strip_triangles drops
+        sizes, corner_vertex, face_line, dropped = strip_triangles(counts, items, strip_lines)
         notes.append(f"{len(sizes)} triangles read from {len(strips[0])} triangle strip list"
                      f"{'s' * (len(strips[0]) != 1)}"
                      + (f" ({dropped} degenerate joining triangles left out)" if dropped else ""))
