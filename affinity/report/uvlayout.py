@@ -99,7 +99,7 @@ def layout_svg(mesh: Mesh, flagged: np.ndarray, labelled: list[tuple[int, str]],
     Places whose uv centres fall within a ring of each other (e.g. every face
     mapped onto the whole texture) share one ring, labelled a line per rule
     (``faces 3, 7 (Q101)``); a line goes to the side of its ring with room,
-    moved down until it overlaps no other.
+    moved down until it covers no other line and no ring.
     """
     drawn = layout_image(mesh, flagged, size)
     if drawn is None:
@@ -113,7 +113,8 @@ def layout_svg(mesh: Mesh, flagged: np.ndarray, labelled: list[tuple[int, str]],
         if same is None:
             rings.append(same := (x, y, {}))
         same[2].setdefault(code, []).append(face)
-    marks, boxes = [], []
+    marks = []
+    boxes = [(x - RING_RADIUS, x + RING_RADIUS, y + 4) for x, y, _ in rings]  # a label covers no ring
     for x, y, faces_by_code in rings:
         marks.append(f'<circle cx="{x:.1f}" cy="{y:.1f}" r="{RING_RADIUS}" fill="none" stroke="#111827" '
                      f'stroke-width="2"/>')
