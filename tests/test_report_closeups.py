@@ -312,3 +312,17 @@ def test_uv_layout_labels_places_at_one_uv_spot_once(tmp_path):
     svg = layout_svg(load(str(path)), np.ones(4, bool), [(3, "Q101"), (0, "Q101"), (2, "Q202")])
     assert svg.count("<circle") == 1
     assert re.findall(r"<text[^>]*>([^<]*)</text>", svg) == ["faces 3, 0 (Q101)", "face 2 (Q202)"]
+
+
+def test_uv_layout_labels_crowded_at_the_bottom_stay_inside_the_picture(tmp_path):
+    from affinity.report.uvlayout import layout_svg
+
+    # five small uv squares in a row at the bottom edge, 19 px apart: rings apart, labels colliding
+    tiles = [[(0.05 + 0.03 * k + 0.004 * du, 0.003 + 0.004 * dv) for du, dv in UNIT_UV] for k in range(5)]
+    path = tmp_path / "crowded.obj"
+    path.write_text(quad_obj([(trapezoid(0.5, 3 * k), uv) for k, uv in enumerate(tiles)]))
+    svg = layout_svg(load(str(path)), np.ones(5, bool), [(k, "Q101") for k in range(5)], size=640)
+    baselines = sorted(float(y) for y in re.findall(r'<text x="[^"]+" y="([^"]+)"', svg))
+    assert len(baselines) == 5 and svg.count("<circle") == 5
+    assert 12 <= baselines[0] and baselines[-1] <= 640 - 3  # none below the picture's edge
+    assert min(np.diff(baselines)) >= 15  # stacked a line apart: they overlap horizontally

@@ -92,6 +92,18 @@ def _label_lines(faces_by_code: dict[str, list[int]]) -> list[str]:
     return lines
 
 
+def _free_baseline(baseline: float, left: float, width: float, boxes: list, size: int) -> float:
+    """The first baseline at or below ``baseline`` (else above it) where a line ``left`` to ``left + width``
+    covers none of ``boxes`` ((left, right, baseline) each) and stays inside the picture."""
+    below = np.arange(baseline, size - 3, LABEL_LINE)
+    above = np.arange(baseline - LABEL_LINE, 12, -LABEL_LINE)
+    for candidate in (*below, *above):
+        if not any(abs(candidate - b) < LABEL_LINE and left < right and start < left + width
+                   for start, right, b in boxes):
+            return float(candidate)
+    return baseline
+
+
 def layout_svg(mesh: Mesh, flagged: np.ndarray, labelled: list[tuple[int, str]], size: int = 640) -> str | None:
     """The layout as inline SVG: the raster picture, and a ringed label ``face F (CODE)`` at each labelled face.
 
@@ -99,7 +111,7 @@ def layout_svg(mesh: Mesh, flagged: np.ndarray, labelled: list[tuple[int, str]],
     Places whose uv centres fall within a ring of each other (e.g. every face
     mapped onto the whole texture) share one ring, labelled a line per rule
     (``faces 3, 7 (Q101)``); a line goes to the side of its ring with room,
-    moved down until it covers no other line and no ring.
+    moved down (at the bottom, up) until it covers no other line and no ring.
     """
     drawn = layout_image(mesh, flagged, size)
     if drawn is None:
@@ -124,10 +136,7 @@ def layout_svg(mesh: Mesh, flagged: np.ndarray, labelled: list[tuple[int, str]],
             anchor = "start" if width <= room_right or room_right >= room_left else "end"
             dx = LABEL_GAP if anchor == "start" else -LABEL_GAP
             left = x + dx if anchor == "start" else x + dx - width
-            baseline = y + 4
-            while any(abs(baseline - b) < LABEL_LINE and left < right and start < left + width
-                      for start, right, b in boxes):
-                baseline += LABEL_LINE
+            baseline = _free_baseline(y + 4, left, width, boxes, size)
             boxes.append((left, left + width, baseline))
             marks.append(f'<text x="{x + dx:.1f}" y="{baseline:.1f}" text-anchor="{anchor}" '
                          f'paint-order="stroke" stroke="#fff" stroke-width="3">{text}</text>')
