@@ -18,11 +18,12 @@ from functools import cached_property
 
 import numpy as np
 
+from .attributes import ATTRIBUTES, attribute_named, scoring_rules
 from .findings import RuleHits
 from .geometry import PlanarQuads, planar_quads_by_component, squared_lengths
 from .loaders.imagesize import image_size
 from .measures import split_error_by_component, split_scale
-from .mesh import ATTRIBUTE_NAMES, Mesh
+from .mesh import Mesh
 from .rules import RULES, resolve_codes
 from .settings import Settings
 
@@ -37,12 +38,8 @@ class CornerTables:
 
     def __init__(self, mesh: Mesh):
         self.mesh = mesh
-        self.corner_index = {
-            "positions": mesh.corner_vertex,
-            "colors": mesh.corner_vertex,
-            "texcoords": mesh.corner_texcoord,
-            "normals": mesh.corner_normal,
-        }
+        self.corner_index = {"positions": mesh.corner_vertex,
+                             **{a.field: getattr(mesh, a.corner_index) for a in ATTRIBUTES.values()}}
         self.tables: dict[str, np.ndarray | None] = {}
         self.has_nan: dict[str, bool] = {}
 
@@ -70,7 +67,7 @@ class CornerTables:
         missing = index < 0
         np.maximum(index, 0, out=index)
         values = np.ascontiguousarray(np.transpose(table.take(index, axis=0), (2, 0, 1)))
-        if name == "normals":
+        if name in ATTRIBUTES and ATTRIBUTES[name].unit_length:
             length = np.sqrt(squared_lengths(values))
             np.divide(values, length, out=values, where=length > 0)
         if complete and (self.has_nan[name] or missing.any()):
@@ -111,7 +108,7 @@ class QuadBatch:
         attribute (K, 4, n) of those quads."""
         found = self.tables.gather(name, self.corners)
         if found is None:
-            width = {"texcoords": 2}.get(name, 3)
+            width = ATTRIBUTES[name].width if name in ATTRIBUTES else 3
             return np.zeros(0, dtype=np.int64), np.zeros((width, 4, 0))
         return found
 
@@ -267,13 +264,22 @@ class QuadScores:
 
 
 def scored_codes(mesh: Mesh) -> list[str]:
-    """The scored rules (Q101-Q103) whose attribute the mesh has, in code order."""
+    """The scored rules (Q101-Q103, and any registered later) whose attribute the mesh has, in code order."""
     return [code for code, rule in RULES.items() if rule.scored and getattr(mesh, rule.attribute) is not None]
 
 
-def scored_code_of(attribute: str) -> str:
-    """The scored rule of an attribute named as on the command line (``"uv"``, ``"color"``, ``"normal"``)."""
-    return next(code for code, rule in RULES.items() if rule.scored and ATTRIBUTE_NAMES[rule.attribute] == attribute)
+def scored_codes_of(attribute: str, mesh: Mesh | None = None) -> list[str]:
+    """Every scored rule of an attribute named as on the command line (``"uv"``, ``"color"``,
+    ``"colour"``, ``"normal"``), in code order; with ``mesh``, only those the mesh can be scored by."""
+    codes = scoring_rules(attribute_named(attribute).field)
+    return codes if mesh is None else [code for code in codes if code in scored_codes(mesh)]
+
+
+def scored_code_of(attribute: str, mesh: Mesh | None = None) -> str:
+    """The first of :func:`scored_codes_of` (with ``mesh``, the first the mesh can be scored by;
+    the first registered when it can be scored by none)."""
+    codes = scored_codes_of(attribute)
+    return next((code for code in codes if mesh is None or code in scored_codes(mesh)), codes[0])
 
 
 def quad_scores(mesh: Mesh, settings: Settings, code: str) -> QuadScores:
@@ -287,5 +293,5 @@ def quad_scores(mesh: Mesh, settings: Settings, code: str) -> QuadScores:
     hits = lint_mesh(mesh, everything)
     faces = hits[0].faces if hits else np.zeros(0, dtype=np.int64)
     values = hits[0].values if hits else np.zeros(0)
-    return QuadScores(code, ATTRIBUTE_NAMES[rule.attribute], rule.unit_for(settings.measure),
+    return QuadScores(code, ATTRIBUTES[rule.attribute].name, rule.unit_for(settings.measure),
                       settings.threshold(code), faces, values)

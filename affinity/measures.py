@@ -359,16 +359,14 @@ def pixel_error(values: np.ndarray, reference: np.ndarray, attribute: str, textu
     ----------
     values, reference : (N, K) float64, the attribute at N pixels
     attribute : the Mesh field they come from: ``"texcoords"``, ``"colors"`` or ``"normals"``
+        (a key of :data:`affinity.attributes.ATTRIBUTES`)
     texture_size : (width, height) in texels, for texture coordinates
 
     Returns
     -------
     (N,) float64: |du, dv| in texels, |d rgb| in 1/255 steps, or the angle
-    between the two normals in degrees.
+    between the two normals in degrees (the attribute's ``difference``).
     """
-    if attribute == "texcoords":
-        return texels(values - reference, texture_size)
-    if attribute == "colors":
-        return color_steps(values - reference)
-    cross = np.linalg.norm(np.cross(values, reference), axis=-1)
-    return np.degrees(np.arctan2(cross, np.einsum("nk,nk->n", values, reference)))
+    from .attributes import ATTRIBUTES  # the registry reads this module's units
+
+    return ATTRIBUTES[attribute].difference(values, reference, texture_size)

@@ -14,8 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-#: How each per-corner attribute is named on the command line and in pictures (``--show uv``).
-ATTRIBUTE_NAMES = {"texcoords": "uv", "colors": "color", "normals": "normal"}
+from .attributes import ATTRIBUTES
 
 
 @dataclass(eq=False)
@@ -137,11 +136,10 @@ class Mesh:
         (n, k, D) float64, NaN for corners that lack the attribute, or None when
         the mesh has no such attribute at all.
         """
-        if name in ("positions", "colors"):
-            values = getattr(self, name)
-            return None if values is None else values[self.corner_vertex[corners]]
         values = getattr(self, name)
-        index = getattr(self, "corner_" + name[:-1])
+        if name == "positions" or ATTRIBUTES[name].per_vertex:
+            return None if values is None else values[self.corner_vertex[corners]]
+        index = getattr(self, ATTRIBUTES[name].corner_index)
         if values is None or index is None or len(values) == 0:
             return None
         picked = index[corners]
@@ -204,14 +202,15 @@ class Mesh:
         require(len(self.face_material) == 0 or (self.face_material.min() >= -1
                                                  and self.face_material.max() < len(self.material_names)),
                 "face_material has an entry outside material_names")
-        for values, index, width in (("texcoords", "corner_texcoord", 2), ("normals", "corner_normal", 3)):
+        for values, index, width in ((a.field, a.corner_index, a.width) for a in ATTRIBUTES.values()
+                                     if not a.per_vertex):
             array = getattr(self, values)
             require((array is None) == (getattr(self, index) is None), f"{values} and {index} are not both given")
             if array is not None and shaped(values, array, width, "f"):
                 require(np.isfinite(array).all(), f"{values} are not all finite")
                 if getattr(self, index) is not None:
                     indexes(index, getattr(self, index), len(array), -1)
-        if self.colors is not None and shaped("colors", self.colors, 3, "f"):
+        if self.colors is not None and shaped("colors", self.colors, ATTRIBUTES["colors"].width, "f"):
             require(len(self.colors) == n_vertices, f"colors has {len(self.colors)} rows for {n_vertices} vertices")
             inside = (self.colors >= 0) & (self.colors <= 1)
             require((inside | np.isnan(self.colors)).all(), "a colour is outside [0, 1]")

@@ -11,8 +11,11 @@ EXIT_CLEAN, EXIT_FINDINGS, EXIT_ERROR = 0, 1, 2
 
 
 def spelling(text: str) -> str:
-    """An argparse ``type`` for attribute names: ``color`` everywhere, ``colour`` accepted."""
-    return "color" if text == "colour" else text
+    """An argparse ``type`` for attribute names: each attribute's own name (``color``) everywhere,
+    its aliases (``colour``) accepted (:data:`affinity.attributes.ATTRIBUTES`)."""
+    from ..attributes import canonical_name
+
+    return canonical_name(text)
 
 
 def require(modules: tuple[str, ...], extra: str) -> None:

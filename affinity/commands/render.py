@@ -12,7 +12,13 @@ from ..errors import UsageError
 from . import EXIT_CLEAN, camera, image_size, pixel_tolerance, require, spelling
 
 METHODS = ("hybrid", "split", "mvc", "bilinear", "projective", "exact")
-SHOW_MODES = ("uv", "color", "normal", "shaded")  # what affinity.draw.shading.shade draws
+
+
+def show_modes() -> tuple[str, ...]:
+    """What ``--show`` takes (what :func:`affinity.draw.shading.shade` draws): each attribute's name, and shaded."""
+    from ..attributes import ATTRIBUTES
+
+    return (*(attribute.name for attribute in ATTRIBUTES.values()), "shaded")
 
 
 def add_parser(sub) -> None:
@@ -31,7 +37,7 @@ def add_parser(sub) -> None:
     p.add_argument("--camera", type=camera, metavar="EX,EY,EZ,TX,TY,TZ,FOV")
     p.add_argument("--up", choices=["x", "y", "z"], default=None,
                    help="world up axis (default: the stage's upAxis for USD, else y; z for the demo)")
-    p.add_argument("--show", choices=SHOW_MODES, type=spelling,
+    p.add_argument("--show", choices=show_modes(), type=spelling,
                    help="what to draw (default: uv when the mesh has it, else color, else shaded)")
     p.add_argument("--texture", metavar="IMAGE", help="texture image for uv (default: map_Kd, else a checker)")
     p.add_argument("--overlay", choices=["flags"], help="tint the quads sent to mvc")

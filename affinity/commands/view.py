@@ -9,7 +9,12 @@ from __future__ import annotations
 from ..errors import MeshError, SkippedFile, UsageError
 from . import EXIT_CLEAN, require, spelling
 
-ATTRIBUTES = ("uv", "color", "normal")
+
+def attribute_choices() -> tuple[str, ...]:
+    """The attribute names ``--attribute`` takes, from the attribute registry."""
+    from ..attributes import ATTRIBUTES
+
+    return tuple(attribute.name for attribute in ATTRIBUTES.values())
 
 
 def add_parser(sub) -> None:
@@ -18,7 +23,7 @@ def add_parser(sub) -> None:
         description="Open MESH in a window, coloured by every quad's affinity score, flagged quads outlined.",
     )
     p.add_argument("mesh", metavar="MESH")
-    p.add_argument("--attribute", choices=ATTRIBUTES, type=spelling,
+    p.add_argument("--attribute", choices=attribute_choices(), type=spelling,
                    help="the score to colour by (default: uv, else colour, else normal)")
     p.add_argument("--up", choices=["x", "y", "z"], help="world up axis")
     p.add_argument("--screenshot", metavar="PNG", help="render off-screen into PNG instead of opening a window")
@@ -33,7 +38,7 @@ def _scores(mesh, path: str, attribute: str | None):
     if attribute is None:
         code = next(iter(scored_codes(mesh)), None)  # uv, else colours, else normals
     else:
-        code = scored_code_of(attribute)
+        code = scored_code_of(attribute, mesh)
         if code not in scored_codes(mesh):
             raise UsageError(f"{path}: the mesh has no {attribute} attribute to score")
     if code is None:

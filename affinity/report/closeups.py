@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..attributes import ATTRIBUTE_NAMES
 from ..mesh import Mesh
 from ..rules import RULES
 from ..settings import Settings
@@ -26,7 +27,7 @@ CLOSEUP_METHODS = ("split", "hybrid", "exact")
 FRAMED_FACES = 12
 PLAIN = np.ones((1, 1, 3), dtype=np.float32)
 #: Attribute shown for each scored rule; the geometric rules show uv when the mesh has it.
-SHOW_FOR = {"texcoords": "uv", "colors": "color", "normals": "normal"}
+SHOW_FOR = ATTRIBUTE_NAMES
 
 
 @dataclass

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..mesh import ATTRIBUTE_NAMES
+from ..attributes import ATTRIBUTE_NAMES, ATTRIBUTES
 from ..rules import RULES, resolve_codes, with_unit
 from .build import MeshResult, ReportRun
 from .images import data_uri, heat_bar, heatmap_uri, image_uri, png_bytes
@@ -30,7 +30,7 @@ METHOD_CAPTIONS = {
 WORST_LISTED = 5
 #: Scores below this fraction of the threshold are affine up to rounding; they go in the first bin.
 SCORE_FLOOR = 1e-3
-MISSING_ATTRIBUTE = {"texcoords": "no texture coordinates", "colors": "no vertex colours", "normals": "no normals"}
+MISSING_ATTRIBUTE = {field: attribute.missing for field, attribute in ATTRIBUTES.items()}
 #: The committed study (``affinity bench``'s table), shipped as package data for the demo report.
 STUDY_RESULTS = Path(__file__).resolve().parents[1] / "data" / "study" / "study.csv"
 

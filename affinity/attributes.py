@@ -1,0 +1,124 @@
+"""The attribute registry: one :class:`Attribute` record per per-corner mesh attribute.
+
+What a quad can carry besides its positions (texture coordinates, vertex
+colours, normals) is described here once: the :class:`~affinity.mesh.Mesh`
+fields that hold it, its width, its unit, the note a report gives when a mesh
+lacks it, the name every command uses for it (``render --show``, ``view
+--attribute``), and how a difference of two values reads in that unit. Which
+rules score an attribute is read from the rule registry
+(:func:`scoring_rules`), so a new rule on an attribute is found without
+touching this table. Imports nothing at load (the command line reads the
+names); the measures are imported when a difference is taken.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import numpy as np
+
+
+def _texel_difference(values: np.ndarray, reference: np.ndarray, texture_size) -> np.ndarray:
+    """|du W, dv H| in texels."""
+    from .measures import texels
+
+    return texels(values - reference, texture_size)
+
+
+def _color_difference(values: np.ndarray, reference: np.ndarray, texture_size) -> np.ndarray:
+    """|d rgb| in 1/255 steps."""
+    from .measures import color_steps
+
+    return color_steps(values - reference)
+
+
+def _normal_difference(values: np.ndarray, reference: np.ndarray, texture_size) -> np.ndarray:
+    """The angle between two normals in degrees: atan2(|n x r|, n . r) (accurate for small angles)."""
+    import numpy as np
+
+    from .geometry import lengths
+
+    cross = lengths(np.cross(values, reference))
+    return np.degrees(np.arctan2(cross, np.einsum("nk,nk->n", values, reference)))
+
+
+@dataclass(frozen=True, kw_only=True)
+class Attribute:
+    """Everything about one per-corner attribute.
+
+    Attributes
+    ----------
+    field : the :class:`~affinity.mesh.Mesh` field of its values, ``"texcoords"``
+    corner_index : the Mesh field indexing ``field`` per corner (``"corner_texcoord"``;
+        ``"corner_vertex"`` for an attribute stored per position vertex)
+    name : how every command and picture names it (``"uv"``, ``"color"``, ``"normal"``)
+    aliases : other spellings accepted on the command line (``"colour"``)
+    width : components per value: (T, width) float64
+    unit : the unit a split error of it is measured in (``"texels"``, ``"1/255"``, ``"degrees"``)
+    missing : what a report says of a mesh without it (``"no texture coordinates"``)
+    unit_length : values are directions, scaled to unit length before measuring
+    difference : ``difference(values, reference, texture_size) -> (N,)`` float64, the
+        difference of (N, width) values against a reference in ``unit``
+    """
+
+    field: str
+    corner_index: str
+    name: str
+    aliases: tuple[str, ...] = ()
+    width: int
+    unit: str
+    missing: str
+    unit_length: bool = False
+    difference: Callable[[np.ndarray, np.ndarray, object], np.ndarray]
+
+    @property
+    def per_vertex(self) -> bool:
+        """Stored per position vertex (reached through ``corner_vertex``), not per corner."""
+        return self.corner_index == "corner_vertex"
+
+
+#: Every attribute by Mesh field, in the order scores and pictures prefer them.
+ATTRIBUTES: dict[str, Attribute] = {
+    attribute.field: attribute
+    for attribute in (
+        Attribute(field="texcoords", corner_index="corner_texcoord", name="uv", width=2, unit="texels",
+                  missing="no texture coordinates", difference=_texel_difference),
+        Attribute(field="colors", corner_index="corner_vertex", name="color", aliases=("colour",), width=3,
+                  unit="1/255", missing="no vertex colours", difference=_color_difference),
+        Attribute(field="normals", corner_index="corner_normal", name="normal", width=3, unit="degrees",
+                  missing="no normals", unit_length=True, difference=_normal_difference),
+    )
+}
+
+#: Mesh field -> command-line name, for callers that only need the name.
+ATTRIBUTE_NAMES = {field: attribute.name for field, attribute in ATTRIBUTES.items()}
+
+
+def attribute_named(text: str) -> Attribute:
+    """The attribute a command-line name or alias means (``"uv"``, ``"colour"``); KeyError for none."""
+    for attribute in ATTRIBUTES.values():
+        if text in (attribute.name, *attribute.aliases):
+            return attribute
+    raise KeyError(text)
+
+
+def canonical_name(text: str) -> str:
+    """``text`` with an alias replaced by the attribute's own name; anything else unchanged.
+
+    >>> canonical_name("colour"), canonical_name("uv"), canonical_name("shaded")
+    ('color', 'uv', 'shaded')
+    """
+    try:
+        return attribute_named(text).name
+    except KeyError:
+        return text
+
+
+def scoring_rules(field: str) -> list[str]:
+    """Codes of the scored rules (``Rule.scored``) on the attribute ``field``, in code order."""
+    from .rules import RULES
+
+    return [code for code, rule in RULES.items() if rule.scored and rule.attribute == field]
