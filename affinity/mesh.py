@@ -50,6 +50,9 @@ class Mesh:
         Index into ``material_names``, -1 for faces without ``usemtl``.
     material_textures : dict of str to str
         Material name to its ``map_Kd`` path (resolved against the .mtl file's folder).
+    resources : list of affinity.loaders.resources.Resource
+        The files the mesh file references (material libraries, texture maps by
+        role, USD layers), in file order, as its loader read them.
     prim_face_start : (P + 1,) int64 or None
         USD only: the faces of mesh prim ``p`` (group ``p``) are
         ``prim_face_start[p]:prim_face_start[p + 1]``. None for other formats.
@@ -77,6 +80,7 @@ class Mesh:
     material_names: list[str] = field(default_factory=list)
     face_material: np.ndarray | None = None
     material_textures: dict[str, str] = field(default_factory=dict)
+    resources: list = field(default_factory=list)
     prim_face_start: np.ndarray | None = None
     up_axis: str | None = None
     meters_per_unit: float | None = None

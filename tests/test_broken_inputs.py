@@ -85,7 +85,7 @@ def test_an_exception_inside_one_file_is_that_files_q901(tmp_path, monkeypatch):
     assert reports[0].error_line == 0
     assert reports[1].error is None and reports[1].n_findings == 1
 
-    def out_of_memory(path, usd=None):
+    def out_of_memory(path, usd=None, source=None):
         raise MemoryError("Unable to allocate 29.8 GiB for an array with shape (4000000000,)")
 
     monkeypatch.setattr(affinity.loaders, "load", out_of_memory)

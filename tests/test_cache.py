@@ -76,9 +76,9 @@ class Counting:
     def __init__(self):
         self.paths: list[str] = []
 
-    def __call__(self, path, settings, usd=None):
+    def __call__(self, path, settings, usd=None, source=None):
         self.paths.append(os.path.basename(path))
-        return check_file(path, settings, usd)
+        return check_file(path, settings, usd, source)
 
 
 @pytest.fixture
@@ -192,7 +192,7 @@ def test_a_file_rewritten_within_its_mtime_is_checked_again(tmp_path, tmp_path_f
 def test_internal_errors_are_never_stored(assets, tmp_path_factory, monkeypatch):
     folder = tmp_path_factory.mktemp("cache")
     monkeypatch.setattr(check_module, "check_file",
-                        lambda path, settings, usd=None: FileReport(path, error="internal error: boom",
+                        lambda path, settings, usd=None, source=None: FileReport(path, error="internal error: boom",
                                                                     transient=True))
     assert cached_run(folder, tasks_of(assets))[0].error == "internal error: boom"
     monkeypatch.undo()
@@ -340,23 +340,15 @@ def named_libraries(text: bytes) -> list[str]:
 
 
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
-@given(lines=st.lists(st.sampled_from(_LINES), max_size=30), chunk=st.integers(1, 64), newline=st.booleans())
-def test_the_mtllib_scan_reads_what_the_loader_reads_at_any_chunk_size(tmp_path, monkeypatch, lines, chunk, newline):
+@given(lines=st.lists(st.sampled_from(_LINES), max_size=30), newline=st.booleans())
+def test_the_cache_and_the_loader_read_the_libraries_the_obj_rule_names(tmp_path, lines, newline):
+    from affinity.loaders.resources import obj_resources
+
     text = b"\n".join(lines) + b"\n" * newline
     path = tmp_path / "mesh.obj"
     path.write_bytes(text)
-    monkeypatch.setattr(cache_module, "_CHUNK", chunk)
+    expected = list(dict.fromkeys(os.path.abspath(tmp_path / name) for name in named_libraries(text)))
     _, deps = cache_module._hash_file(str(path))
-    assert deps == [os.path.abspath(tmp_path / name) for name in named_libraries(text)]
-
-
-def test_a_file_without_line_breaks_is_scanned_in_bounded_blocks(tmp_path, monkeypatch):
-    path = tmp_path / "one-line.obj"
-    path.write_bytes(b"mtllib a.mtl #" + b"x" * 200_000)
-    blocks = []
-    real = cache_module._mtllib_names
-    monkeypatch.setattr(cache_module, "_CHUNK", 1000)
-    monkeypatch.setattr(cache_module, "_LINE_START", 100)
-    monkeypatch.setattr(cache_module, "_mtllib_names", lambda block, end: blocks.append(len(block)) or real(block, end))
-    _, deps = cache_module._hash_file(str(path))
-    assert deps == [str(tmp_path / "a.mtl")] and max(blocks) <= 1100
+    assert deps == expected
+    resources = obj_resources(str(path), text)  # what load_obj puts in Mesh.resources
+    assert [os.path.abspath(r.path) for r in resources if r.role == "mtllib"] == expected

@@ -24,10 +24,38 @@ LOADERS = {".obj": load_obj, ".ply": load_ply, ".off": load_off, **dict.fromkeys
 LFS_POINTER = b"version https://git-lfs.github.com/spec/"
 
 
-def load(path, usd: UsdOptions | None = None) -> Mesh:
+def _opened(path, read):
+    """``read(fh)`` of the file at ``path`` opened for bytes; MeshError for a directory or an unreadable file."""
+    try:
+        with open(path, "rb") as fh:
+            return read(fh)
+    except IsADirectoryError:
+        raise MeshError(path, 0, "is a directory, not a mesh file") from None
+    except OSError as error:
+        raise MeshError(path, 0, f"cannot read: {error.strerror or error}") from None
+
+
+def read_source(path) -> bytes:
+    """Every byte of the file at ``path``, read once for all who need them (the OBJ reader, the
+    cache's hash, the inline-ignore scan). MeshError for a directory or an unreadable file."""
+    return _opened(path, lambda fh: fh.read())
+
+
+def reads_whole(path) -> bool:
+    """Whether the loader of ``path`` parses the file's bytes as :func:`read_source` gives them (OBJ)."""
+    return os.path.splitext(os.fspath(path))[1].lower() in WHOLE_SOURCE
+
+
+#: Formats whose loader takes the file's bytes (``source=``), so a check reads such a file once.
+WHOLE_SOURCE = (".obj",)
+
+
+def load(path, usd: UsdOptions | None = None, source: bytes | None = None) -> Mesh:
     """Read the mesh at ``path``, choosing the reader by its extension (case-insensitive).
 
     ``usd`` says how to read a USD stage (time, uv primvar); other formats ignore it.
+    ``source`` is the file's bytes (:func:`read_source`) when the caller has them: an
+    OBJ file is then not opened again; other formats open the file themselves.
 
     Raises
     ------
@@ -41,13 +69,12 @@ def load(path, usd: UsdOptions | None = None) -> Mesh:
     if extension not in LOADERS:
         known = ", ".join(LOADERS)
         raise MeshError(path, 0, f"unknown mesh format {extension or '(no extension)'!r}; expected one of {known}")
-    try:
-        with open(path, "rb") as fh:
-            head = fh.read(len(LFS_POINTER))
-    except IsADirectoryError:
-        raise MeshError(path, 0, "is a directory, not a mesh file") from None
-    except OSError as error:
-        raise MeshError(path, 0, f"cannot read: {error.strerror or error}") from None
+    if source is None and extension in WHOLE_SOURCE:
+        source = read_source(path)
+    if source is not None:
+        head = source[: len(LFS_POINTER)]
+    else:
+        head = _opened(path, lambda fh: fh.read(len(LFS_POINTER)))
     if not head:
         raise MeshError(path, 0, "empty file")
     if head == LFS_POINTER:
@@ -55,9 +82,11 @@ def load(path, usd: UsdOptions | None = None) -> Mesh:
     try:
         if extension in USD_SUFFIXES:
             return load_usd(path, usd)
+        if extension in WHOLE_SOURCE:
+            return LOADERS[extension](path, source=source)
         return LOADERS[extension](path)
     except OSError as error:  # e.g. the file vanished or became unreadable while reading
         raise MeshError(path, 0, f"cannot read: {error.strerror or error}") from None
 
 
-__all__ = ["LOADERS", "load"]
+__all__ = ["LOADERS", "load", "read_source", "reads_whole"]

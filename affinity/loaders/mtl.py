@@ -1,4 +1,8 @@
-"""Wavefront material (.mtl) files: only what the linter needs, the ``map_Kd`` texture per material."""
+"""Wavefront material (.mtl) files: only what the linter needs, the texture maps per material.
+
+Which statements name texture maps is the resource registry's
+(:func:`affinity.loaders.resources.roles_named_in`): ``map_Kd`` today.
+"""
 
 from __future__ import annotations
 
@@ -13,18 +17,23 @@ _FIXED_ARGUMENTS = {
 _VECTOR_OPTIONS = ("-o", "-s", "-t")
 
 
-def read_material_textures(path) -> dict[str, str]:
-    """Material name -> ``map_Kd`` path (resolved against the .mtl's folder).
+def material_maps(path) -> list[tuple[str, str, str, str]]:
+    """``(role, material, name, path)`` of every texture map statement of the MTL file ``path``,
+    in file order: the resource role (``"map_Kd"``), the material, the file name as written
+    after the statement's options, and that file resolved against the .mtl's folder.
 
-    A missing or unreadable file gives an empty dict: materials are optional.
+    A missing or unreadable file gives an empty list: materials are optional.
     """
+    from .resources import roles_named_in
+
     try:
         with open(path, "rb") as fh:
             text = fh.read().decode("utf-8", "replace")
     except OSError:
-        return {}
+        return []
+    statements = {role.statement: role.name for role in roles_named_in("mtl")}
     folder = os.path.dirname(os.fspath(path))
-    textures: dict[str, str] = {}
+    maps = []
     material = None
     for line in text.splitlines():
         words = line.split()
@@ -33,10 +42,17 @@ def read_material_textures(path) -> dict[str, str]:
             continue
         if words[0] == "newmtl":
             material = " ".join(words[1:])
-        elif words[0] == "map_Kd" and material is not None:
+        elif words[0] in statements and material is not None:
             name = texture_file_name(words[1:])
-            textures[material] = os.path.normpath(os.path.join(folder, name.replace("\\", "/")))
-    return textures
+            maps.append((statements[words[0]], material, name,
+                         os.path.normpath(os.path.join(folder, name.replace("\\", "/")))))
+    return maps
+
+
+def read_material_textures(path) -> dict[str, str]:
+    """Material name -> ``map_Kd`` path (resolved against the .mtl's folder; the last statement
+    of a material wins). A missing or unreadable file gives an empty dict."""
+    return {material: texture for role, material, _, texture in material_maps(path) if role == "map_Kd"}
 
 
 def texture_file_name(arguments: list[str]) -> str:

@@ -26,6 +26,7 @@ whole file.
 
 from __future__ import annotations
 
+import io
 import os
 import re
 from concurrent.futures import ThreadPoolExecutor
@@ -36,8 +37,8 @@ import numpy as np
 from ..errors import MeshError
 from ..mesh import Mesh
 from .faces import check_indices, color_note, ragged_positions
-from .mtl import read_material_textures
 from .numbers import PAD, parse_floats, parse_ints
+from .resources import obj_resources, uncommented
 from .text import Tokens, floats_or_raise, read_chunks, tokenize
 
 _V, _VT, _VN, _F = 1, 2, 3, 4
@@ -75,7 +76,6 @@ class _Part:
     lines: int  # lines of the chunk
     bytes: int  # bytes of the chunk's lines
     events: list = field(default_factory=list)  # (face in chunk, keyword, name)
-    mtllibs: list = field(default_factory=list)
     nan_colors: list = field(default_factory=list)  # (vertices, first line) with a NaN colour
 
 
@@ -83,22 +83,27 @@ class _Part:
 _WORKERS = 2
 
 
-def load_obj(path, chunk_bytes: int | None = None) -> Mesh:
-    """Read a Wavefront OBJ file (and the ``map_Kd`` entries of its ``mtllib`` files).
+def load_obj(path, chunk_bytes: int | None = None, source: bytes | None = None) -> Mesh:
+    """Read a Wavefront OBJ file (and the texture maps of its ``mtllib`` files, ``Mesh.resources``).
 
     ``chunk_bytes`` (default :data:`~affinity.loaders.text.CHUNK_BYTES`) is how
-    much is read at a time; the mesh does not depend on it.
+    much is parsed at a time; the mesh does not depend on it. ``source`` is the
+    file's bytes when the caller has read them already (the check hashes them
+    for its cache and scans them for inline ignores: one read of the file).
     """
+    if source is None:
+        with open(path, "rb") as fh:
+            source = fh.read()
     pending = []
-    with open(path, "rb") as fh, ThreadPoolExecutor(_WORKERS) as pool:
-        assembly = _Assembly(os.fstat(fh.fileno()).st_size)
-        for chunk in read_chunks(fh, continuations=True, size=chunk_bytes, count_lines=False):
+    with ThreadPoolExecutor(_WORKERS) as pool:
+        assembly = _Assembly(len(source))
+        for chunk in read_chunks(io.BytesIO(source), continuations=True, size=chunk_bytes, count_lines=False):
             pending.append(pool.submit(_parse_chunk, chunk, path))
             if len(pending) > 2 * _WORKERS:  # bound the chunks held in memory
                 assembly.add(assembly.result(pending.pop(0)))
         for future in pending:
             assembly.add(assembly.result(future))
-    return assembly.mesh(path)
+    return assembly.mesh(path, obj_resources(os.fspath(path), source))
 
 
 def _parse_chunk(chunk, path) -> _Part:
@@ -458,7 +463,8 @@ def _mixed_faces(tokens: Tokens, path, kind, face_lines):
 
 
 def _statement(tokens: Tokens, path, line, faces_before, part: _Part) -> None:
-    """Handle one rare line: ``g``/``o``/``usemtl`` become events, ``mtllib`` is kept."""
+    """Handle one rare line: ``g``/``o``/``usemtl`` become events (``mtllib`` lines are read from the
+    file's bytes with the resources, :func:`affinity.loaders.resources.mtllib_statements`)."""
     number = int(tokens.number[line])
     raw = uncommented(bytes(tokens.buf[tokens.begin[line] : tokens.end[line]]).split())
     words = [_name_text(word) for word in raw]
@@ -467,14 +473,6 @@ def _statement(tokens: Tokens, path, line, faces_before, part: _Part) -> None:
     name = " ".join(words[1:])
     if words[0] in ("g", "o", "usemtl"):
         part.events.append((faces_before, words[0], name))
-    elif words[0] == "mtllib":  # a file name: the bytes as the file system spells them
-        part.mtllibs.append(os.fsdecode(b" ".join(raw[1:])))
-
-
-def uncommented(words: list[bytes]) -> list[bytes]:
-    """A statement's words before the first one that starts a comment (``#``)."""
-    comment = next((k for k, word in enumerate(words) if word.startswith(b"#")), len(words))
-    return words[:comment]
 
 
 def _name_text(word: bytes) -> str:
@@ -577,7 +575,6 @@ class _Assembly:
         self.corners = [None, None, None]  # slot -> _Growing, once a chunk has the slot
         self.bounds = [(0, -1)] * 3
         self.events = []
-        self.mtllibs = []
         self.nan_colors = []  # (vertices, line) with a NaN colour, in file order
 
     def _growing(self, dtype, width=None) -> _Growing:
@@ -604,7 +601,6 @@ class _Assembly:
         self.nan_colors += part.nan_colors
         n_faces = len(part.face_line)
         if n_faces == 0:
-            self.mtllibs += part.mtllibs
             self.events += [(face + self.n_faces, key, name) for face, key, name in part.events]
             return
         n_corners = self._add_sizes(part.face_sizes, n_faces)
@@ -630,7 +626,6 @@ class _Assembly:
             self.bounds[which] = (min(self.bounds[which][0], low), max(self.bounds[which][1], high))
         self.face_line.append(part.face_line)
         self.events += [(face + self.n_faces, key, name) for face, key, name in part.events]
-        self.mtllibs += part.mtllibs
         self.n_faces += n_faces
         self.n_corners += n_corners
 
@@ -658,7 +653,7 @@ class _Assembly:
         np.cumsum(self.sizes.array(), out=face_start[1:])
         return face_start
 
-    def mesh(self, path) -> Mesh:
+    def mesh(self, path, resources: list) -> Mesh:
         elements = {k: self.elements[k].array() for k in _WIDTHS}
         elements = {k: v if v.shape[1] else v.reshape(0, _WIDTHS[k][0]) for k, v in elements.items()}
         if len(elements[_V]) == 0 and self.n_faces == 0:
@@ -681,11 +676,6 @@ class _Assembly:
         vertices, texcoords, normals = elements[_V], elements[_VT], elements[_VN]
         group_names, face_group = _groups(self.events, self.n_faces)
         material_names, face_material = _materials(self.events, self.n_faces)
-        folder = os.path.dirname(os.fspath(path))
-        textures: dict[str, str] = {}
-        for library in self.mtllibs:
-            for material, texture in read_material_textures(os.path.join(folder, library)).items():
-                textures.setdefault(material, texture)
         notes = []
         if self.nan_colors:
             notes.append(color_note(sum(count for count, _ in self.nan_colors), 0, self.nan_colors[0][1]))
@@ -704,9 +694,21 @@ class _Assembly:
             face_group=face_group,
             material_names=material_names,
             face_material=face_material,
-            material_textures=textures,
+            material_textures=_diffuse_textures(resources),
+            resources=resources,
             notes=notes,
         )
+
+
+def _diffuse_textures(resources: list) -> dict[str, str]:
+    """Material -> ``map_Kd`` path: the first library naming a material wins, and within a
+    library its last ``map_Kd`` (as a renderer reads the libraries in order)."""
+    textures: dict[str, str] = {}
+    for library in (r for r in resources if r.role == "mtllib"):
+        own = {r.material: r.path for r in resources if r.role == "map_Kd" and r.library == library.name}
+        for material, texture in own.items():
+            textures.setdefault(material, texture)
+    return textures
 
 
 def _texcoords(vt: np.ndarray) -> np.ndarray:

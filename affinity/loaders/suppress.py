@@ -23,12 +23,11 @@ def _line_numbers(newlines: np.ndarray, offsets: list[int]) -> np.ndarray:
     return np.searchsorted(newlines, np.asarray(offsets, dtype=np.int64)) + 1
 
 
-def inline_ignores(path: str, face_line: np.ndarray) -> list[tuple[list[str], np.ndarray]]:
+def inline_ignores(data: bytes, face_line: np.ndarray) -> list[tuple[list[str], np.ndarray]]:
     """``(codes, faces)`` pairs: the rule codes (prefixes; ``["ALL"]``) each directive
-    silences and the (k,) int64 faces it covers. ``face_line`` (F,) int64 is the
+    silences and the (k,) int64 faces it covers. ``data`` is the OBJ file's bytes, as its
+    loader read them (:func:`affinity.loaders.read_source`); ``face_line`` (F,) int64 is the
     1-based source line of every face, ascending (OBJ file order)."""
-    with open(path, "rb") as fh:
-        data = fh.read()
     if data.find(_MARKER) < 0:
         return []
     found = list(_DIRECTIVE.finditer(data))

@@ -80,6 +80,22 @@ class _Primvar:
     indices: np.ndarray | None = None
 
 
+def asset_paths(path: str) -> list[str]:
+    """The sublayers, references and payloads the USD layer ``path`` names, as absolute paths,
+    sorted (the resource role ``usd-asset``); none without ``pxr`` or when the layer cannot be opened."""
+    try:
+        from pxr import Sdf, Tf
+    except ImportError:
+        return []
+    try:
+        layer = Sdf.Layer.FindOrOpen(path)
+    except Tf.ErrorException:
+        return []
+    if layer is None:
+        return []
+    return [layer.ComputeAbsolutePath(asset) for asset in sorted(layer.GetCompositionAssetDependencies())]
+
+
 def load_usd(path, options: UsdOptions | None = None) -> Mesh:
     """Read every drawn mesh prim of the USD stage at ``path`` as one mesh (see the module docstring).
 

@@ -2,9 +2,10 @@
 
 A report is stored under a key made of
 
-- the content hash of the file and of everything it pulls in: an OBJ's
-  ``mtllib`` files and their ``map_Kd`` textures, a USD layer's sublayers,
-  references and payloads (recursively; ``pxr``'s ``GetCompositionAssetDependencies``);
+- the content hash of the file and of everything it pulls in, recursively: the
+  files of every role of the resource registry (:mod:`affinity.loaders.resources`:
+  an OBJ's ``mtllib`` files, their texture maps, a USD layer's sublayers,
+  references and payloads), read by the loaders' own readers;
 - the path as given (reports name it) and the resolved settings of the file,
   and the USD reading options;
 - the tool: its version and a hash of the installed package's source files,
@@ -32,13 +33,13 @@ import dataclasses
 import hashlib
 import json
 import os
-import re
 import sqlite3
 import sys
 import time
 
+from ..errors import MeshError
 from ..findings import FileReport, report_from_bytes, report_to_bytes
-from ..loaders.obj import uncommented
+from ..loaders.usd import USD_SUFFIXES
 from ..settings import Settings
 
 #: Bump when the key or the stored report changes meaning.
@@ -51,11 +52,6 @@ RACY_SECONDS = 2.0
 COMMIT_EVERY = 200
 
 _DAY = 86_400.0
-#: Starts with its literal, so ``re`` skips ahead to each "mtllib" (a ``^`` anchor made it try every byte).
-_MTLLIB = re.compile(rb"mtllib[^\n]*")
-#: The bytes of an unfinished line kept for the next chunk: far longer than any library name.
-_LINE_START = 1 << 16
-_USD_SUFFIXES = (".usd", ".usda", ".usdc", ".usdz")
 _CHUNK = 1 << 20
 
 _TABLES = """
@@ -163,28 +159,32 @@ class ResultCache:
 
     # -- keys -------------------------------------------------------------------------------------
 
-    def key(self, path: str, settings: Settings, usd=None) -> str | None:
-        """The key of ``path`` checked with ``settings``; None when the file cannot be hashed (no caching)."""
+    def key(self, path: str, settings: Settings, usd=None, source=None) -> str | None:
+        """The key of ``path`` checked with ``settings``; None when the file cannot be hashed (no caching).
+
+        ``source``, when given, is called for the file's bytes if they must be hashed (the
+        file changed since its pre-key): ``lambda: data`` of a read the check then reuses.
+        """
         if self._db is None:
             return None
         try:
-            tree = self._tree(os.path.abspath(path), set())
+            tree = self._tree(os.path.abspath(path), set(), source)
         except sqlite3.Error as err:
             self._warn(f"cannot read it ({err})")
             return None
         if tree is None:
             return None
         usd_key = None
-        if os.path.splitext(path)[1].lower() in _USD_SUFFIXES:
+        if os.path.splitext(path)[1].lower() in USD_SUFFIXES:
             usd_key = [_usd_reader(), None if usd is None else dataclasses.asdict(usd)]
         if id(settings) not in self._settings:  # files share a few Settings objects: describe each once
             self._settings[id(settings)] = (settings, dataclasses.asdict(settings))
         payload = _json([SCHEMA, self.tool, path, tree, self._settings[id(settings)][1], usd_key])
         return hashlib.blake2b(payload.encode(), digest_size=20).hexdigest()
 
-    def _tree(self, path: str, seen: set[str]) -> list | None:
+    def _tree(self, path: str, seen: set[str], source=None) -> list | None:
         """``[path, digest, dependency trees...]``; None when ``path`` is not a readable file."""
-        found = self._digest(path)
+        found = self._digest(path, source)
         if found is None:
             return None
         digest, deps = found
@@ -192,7 +192,7 @@ class ResultCache:
         trees = [[dep, "cycle"] if dep in seen else self._tree(dep, seen) or [dep, "missing"] for dep in deps]
         return [path, digest, *trees]
 
-    def _digest(self, path: str) -> tuple[str, list[str]] | None:
+    def _digest(self, path: str, source=None) -> tuple[str, list[str]] | None:
         """A file's content hash and the files it pulls in, from its pre-key when it is unchanged."""
         try:
             st = os.stat(path)
@@ -206,8 +206,8 @@ class ResultCache:
         if row is not None and tuple(row[:3]) == prekey:
             return row[3], json.loads(row[4])
         try:
-            digest, deps = _hash_file(path)
-        except OSError:
+            digest, deps = _hash_file(path, None if source is None else source())
+        except (OSError, MeshError):
             return None
         if st.st_mtime_ns < (self._now - RACY_SECONDS) * 1e9:
             self._write("INSERT OR REPLACE INTO files VALUES (?, ?, ?, ?, ?, ?, ?)",
@@ -275,48 +275,23 @@ class ResultCache:
         self._db = None
 
 
-def _hash_file(path: str) -> tuple[str, list[str]]:
-    """The content hash of ``path`` and the absolute paths of the files it pulls in."""
-    suffix = os.path.splitext(path)[1].lower()
-    digest = hashlib.blake2b(digest_size=20)
-    libraries: list[str] = []
-    tail = b""  # the start of the line a chunk ended in
-    with open(path, "rb") as fh:
-        while chunk := fh.read(_CHUNK):
-            digest.update(chunk)
-            if suffix == ".obj":  # mtllib lines, scanned whole: a chunk may end inside a line
-                block = tail + chunk
-                cut = block.rfind(b"\n") + 1
-                libraries += _mtllib_names(block, cut)
-                tail = block[cut : cut + _LINE_START]  # a line's start names its library; no quadratic copies
-    libraries += _mtllib_names(tail, len(tail))
-    folder = os.path.dirname(path)
-    if suffix == ".obj":
-        deps = [os.path.join(folder, name) for name in libraries]
-    elif suffix == ".mtl":
-        from ..loaders.mtl import read_material_textures
+def _hash_file(path: str, data: bytes | None = None) -> tuple[str, list[str]]:
+    """The content hash of ``path`` (of its bytes ``data`` when given) and the absolute paths of
+    the files it names (:func:`affinity.loaders.resources.named_files`)."""
+    from ..loaders import reads_whole
+    from ..loaders.resources import named_files
 
-        deps = list(dict.fromkeys(read_material_textures(path).values()))
-    elif suffix in _USD_SUFFIXES:
-        deps = _usd_dependencies(path)
+    if data is None and reads_whole(path):  # its references are read from the bytes: read them once
+        with open(path, "rb") as fh:
+            data = fh.read()
+    if data is not None:
+        digest = hashlib.blake2b(data, digest_size=20)
     else:
-        deps = []
-    return digest.hexdigest(), [os.path.abspath(dep) for dep in deps]
-
-
-def _mtllib_names(block: bytes, end: int) -> list[str]:
-    """The library names of the ``mtllib`` statements in ``block[:end]``, read as the OBJ loader reads them:
-    the words after the keyword, up to a word that starts a comment, as the file system spells them."""
-    names, last_line = [], -1
-    for match in _MTLLIB.finditer(block, 0, end):
-        line_start = block.rfind(b"\n", 0, match.start()) + 1
-        words = uncommented(block[line_start : match.end()].split())
-        if line_start == last_line or words[:1] != [b"mtllib"]:  # said again on its line, or another statement
-            continue
-        last_line = line_start
-        if len(words) > 1:
-            names.append(os.fsdecode(b" ".join(words[1:])))
-    return names
+        digest = hashlib.blake2b(digest_size=20)
+        with open(path, "rb") as fh:
+            while chunk := fh.read(_CHUNK):
+                digest.update(chunk)
+    return digest.hexdigest(), [os.path.abspath(dep) for dep in named_files(path, data)]
 
 
 def _usd_reader() -> str | None:
@@ -332,18 +307,3 @@ def _usd_reader() -> str | None:
         return version("usd-core")
     except PackageNotFoundError:  # pxr from a USD build rather than the wheel
         return "pxr"
-
-
-def _usd_dependencies(path: str) -> list[str]:
-    """The sublayers, references and payloads a USD layer names, as paths (none without ``pxr``)."""
-    try:
-        from pxr import Sdf, Tf
-    except ImportError:
-        return []
-    try:
-        layer = Sdf.Layer.FindOrOpen(path)
-    except Tf.ErrorException:
-        return []
-    if layer is None:
-        return []
-    return [layer.ComputeAbsolutePath(asset) for asset in sorted(layer.GetCompositionAssetDependencies())]

@@ -19,25 +19,33 @@ from ..mesh import Mesh
 from ..settings import Settings
 
 
-def check_file(path: str, settings: Settings, usd=None) -> FileReport:
+def check_file(path: str, settings: Settings, usd=None, source: bytes | None = None) -> FileReport:
     """Load and lint one file; never raises for bad input.
 
     ``usd`` (:class:`affinity.loaders.usd.UsdOptions`) says how to read USD stages.
+    ``source`` is the file's bytes when the caller has read them (the cache, to hash
+    them): an OBJ file is read once, by whoever reads it first.
     """
-    return load_and_check(path, settings, usd)[0]
+    return load_and_check(path, settings, usd, source)[0]
 
 
-def load_and_check(path: str, settings: Settings, usd=None) -> tuple[FileReport, Mesh | None]:
+def load_and_check(path: str, settings: Settings, usd=None,
+                   source: bytes | None = None) -> tuple[FileReport, Mesh | None]:
     """:func:`check_file`, also handing back the loaded mesh (None when it could not be read)."""
     from ..lint import lint_mesh
-    from ..loaders import load
+    from ..loaders import load, read_source, reads_whole
 
     try:
-        mesh = load(path, usd)
+        if reads_whole(path):
+            source = read_source(path) if source is None else source
+        else:
+            source = None  # the other loaders read their files themselves
+        mesh = load(path, usd, source)
+        ignores = _inline_ignores(source, mesh) if reads_whole(path) else []
         report = FileReport(
             path,
             counts=mesh.counts(),
-            hits=settle(lint_mesh(mesh, settings), settings, list(mesh.group_names), _inline_ignores(path, mesh)),
+            hits=settle(lint_mesh(mesh, settings), settings, list(mesh.group_names), ignores),
             group_names=list(mesh.group_names),
             prim_face_start=mesh.prim_face_start,
             up_axis=mesh.up_axis,
@@ -54,13 +62,11 @@ def load_and_check(path: str, settings: Settings, usd=None) -> tuple[FileReport,
     return report, mesh
 
 
-def _inline_ignores(path: str, mesh: Mesh) -> list:
-    """The ``# affinity: ignore[...]`` comments of an OBJ file (see :mod:`affinity.loaders.suppress`)."""
-    if not str(path).lower().endswith(".obj"):
-        return []
+def _inline_ignores(source: bytes, mesh: Mesh) -> list:
+    """The ``# affinity: ignore[...]`` comments of an OBJ file's bytes (see :mod:`affinity.loaders.suppress`)."""
     from ..loaders.suppress import inline_ignores
 
-    return inline_ignores(path, mesh.face_line)
+    return inline_ignores(source, mesh.face_line)
 
 
 #: Mesh bytes that pay for one more worker process: starting one costs about as
@@ -108,6 +114,12 @@ def check_files(
     when some file is not in the cache, it returns a context manager giving a
     ``dask.distributed.Client``, e.g. ``lambda: cluster.connect("local:2")``.
     """
+    if cache is not None and cluster is None and _workers(tasks, jobs) <= 1:
+        stream = _check_cached_here(tasks, usd, cache)
+        reports: list[FileReport | None] = [None] * len(tasks)
+        for i, report in _tracked(stream, len(tasks), progress):
+            reports[i] = report
+        return reports
     keys = [None] * len(tasks) if cache is None else [cache.key(path, s, usd) for path, s in tasks]
     known = {} if cache is None else {i: hit for i, key in enumerate(keys) if (hit := cache.get(key)) is not None}
     todo = [i for i in range(len(tasks)) if i not in known]
@@ -118,12 +130,32 @@ def check_files(
             fresh = check_on_cluster(client, [tasks[i] for i in todo], usd)
         else:
             fresh = enumerate(_check_here([tasks[i] for i in todo], jobs, usd))
-        reports: list[FileReport | None] = [None] * len(tasks)
+        reports = [None] * len(tasks)
         for i, report in _tracked(_chain(known, todo, fresh), len(tasks), progress):
             reports[i] = report
             if cache is not None and i not in known:
                 cache.put(keys[i], report)
     return reports
+
+
+def _check_cached_here(tasks: list[tuple[str, Settings]], usd, cache) -> Iterator[tuple[int, FileReport]]:
+    """``(task index, report)`` of every task, in this process, each file read at most once:
+    the bytes the cache hashes (a file changed since its pre-key) are the bytes the loader parses."""
+    from ..loaders import read_source, reads_whole
+
+    for i, (path, settings) in enumerate(tasks):
+        read = []
+
+        def source(path=path, read=read) -> bytes:
+            read.append(read_source(path))
+            return read[0]
+
+        key = cache.key(path, settings, usd, source if reads_whole(path) else None)
+        report = cache.get(key)
+        if report is None:
+            report = check_file(path, settings, usd, source=read[0]) if read else check_file(path, settings, usd)
+            cache.put(key, report)
+        yield i, report
 
 
 def _chain(known: dict, todo: list[int], fresh) -> Iterator[tuple[int, FileReport]]:
@@ -133,12 +165,17 @@ def _chain(known: dict, todo: list[int], fresh) -> Iterator[tuple[int, FileRepor
         yield todo[j], report
 
 
+def _workers(tasks: list[tuple[str, Settings]], jobs: int | None) -> int:
+    """Processes that check ``tasks``: ``jobs``, else :func:`auto_jobs`, at most one a task."""
+    return min(auto_jobs([path for path, _ in tasks]) if jobs is None else jobs, len(tasks))
+
+
 def _check_here(tasks: list[tuple[str, Settings]], jobs: int | None, usd) -> Iterator[FileReport]:
     """The reports of ``tasks`` in order, checked in this process or a local process pool."""
     paths = [path for path, _ in tasks]
     settings = [s for _, s in tasks]
     check = partial(check_file, usd=usd)
-    workers = min(auto_jobs(paths) if jobs is None else jobs, len(tasks))
+    workers = _workers(tasks, jobs)
     if workers <= 1:
         yield from map(check, paths, settings)
         return

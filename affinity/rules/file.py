@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import os
-import re
 
 import numpy as np
 
@@ -44,9 +43,6 @@ def no_faces(mesh, settings) -> tuple | None:
     return np.array([-1]), np.array([1]), np.array([float(len(mesh.positions))])
 
 
-_MTLLIB = re.compile(rb"^[ \t]*mtllib[ \t]+([^\r\n#]*)", re.MULTILINE)
-
-
 def _unusable(path: str, image: bool) -> str | None:
     """Why the resource at ``path`` cannot be used (``"not found"``, ...), or None when it can."""
     from ..loaders import LFS_POINTER
@@ -73,8 +69,9 @@ def missing_resources(mesh, settings) -> tuple | None:
 
     What it does:
         Reports, once per file and resource, an mtllib library or a map_Kd texture
-        that is missing, unreadable, not an image, or a Git LFS pointer. Q101's
-        texel unit then comes from the texture-size setting, and the finding says so.
+        (or a file of any other role in the resource registry) that is missing,
+        unreadable, not an image, or a Git LFS pointer. Q101's texel unit then comes
+        from the texture-size setting, and the finding says so.
 
     Why it matters:
         Without the texture the same quad reads a different number of texels (256
@@ -97,45 +94,33 @@ def missing_resources(mesh, settings) -> tuple | None:
         Add the file next to the mesh (git lfs pull for LFS pointers), or fix the
         name in the mtllib or map_Kd line.
     """
-    # One scan of the file's bytes for mtllib lines (the reader resolves them but keeps
-    # no lines). A finding sits on its mtllib line (face -1); its detail names the
-    # resource and, where the texel unit would have come from that texture, the
-    # texture-size used instead. Returns (faces, lines, values, details) or None.
-    from ..loaders.mtl import read_material_textures
+    # The files the loader found referenced (``mesh.resources``, the resource registry's
+    # roles), each looked at once. A finding sits on the line that pulls the file in
+    # (face -1); its detail names the resource and, where the texel unit would have come
+    # from that texture, the texture-size used instead. Returns (faces, lines, values, details) or None.
+    from ..loaders.resources import ROLES
 
-    if not mesh.path.lower().endswith(".obj"):
-        return None
-    try:
-        with open(mesh.path, "rb") as fh:
-            data = fh.read()
-    except OSError:
-        return None
-    if data.find(b"mtllib") < 0:
-        return None
     folder = os.path.dirname(mesh.path)
     texels = mesh.texcoords is not None and "Q101" in RULES
     used = mesh.texture_path()
     fallback = f"; texels use texture-size {settings.texture_size}"
     lines, details, seen = [], [], set()
-    for match in _MTLLIB.finditer(data):
-        name = match.group(1).decode("utf-8", "replace").strip()
-        library = os.path.normpath(os.path.join(folder, name))
-        if not name or library in seen:
+    for resource in mesh.resources:
+        role = ROLES.get(resource.role)
+        if role is None or resource.path in seen:
             continue
-        seen.add(library)
-        line = data.count(b"\n", 0, match.start()) + 1
-        problem = _unusable(library, image=False)
-        if problem:
-            lines.append(line)
-            details.append(f"mtllib {name} {problem}" + (fallback if texels and used is None else ""))
+        seen.add(resource.path)
+        problem = _unusable(resource.path, image=role.image)
+        if not problem:
             continue
-        for texture in dict.fromkeys(read_material_textures(library).values()):
-            problem = None if texture in seen else _unusable(texture, image=True)
-            seen.add(texture)
-            if problem:
-                shown = os.path.relpath(texture, folder) if folder else texture
-                lines.append(line)
-                details.append(f"map_Kd {shown} (in {name}) {problem}" + (fallback if texels and texture == used else ""))
+        lines.append(resource.line)
+        if resource.library is None:
+            texture_unit_lost = texels and used is None and role.name == "mtllib"
+            details.append(f"{role.statement} {resource.name} {problem}" + (fallback if texture_unit_lost else ""))
+        else:
+            shown = os.path.relpath(resource.path, folder) if folder else resource.path
+            details.append(f"{role.statement} {shown} (in {resource.library}) {problem}"
+                           + (fallback if texels and resource.path == used else ""))
     if not lines:
         return None
     n = len(lines)
