@@ -1,25 +1,25 @@
 """Mesh loaders: ``load(path) -> Mesh`` dispatching on the file extension.
 
-Supported: Wavefront OBJ (``.obj``), PLY (``.ply``; ASCII and binary) and OFF
-(``.off``; with the C/N/ST prefixes), and USD stages (``.usd``, ``.usda``, ``.usdc``,
-``.usdz``) when usd-core is installed (see :mod:`affinity.loaders.usd`). Every problem with the input is a
+Supported (the format table, :data:`.formats.LOADERS`): Wavefront OBJ (``.obj``),
+PLY (``.ply``; ASCII and binary) and OFF (``.off``; with the C/N/ST prefixes), and
+USD stages (``.usd``, ``.usda``, ``.usdc``, ``.usdz``) when usd-core is installed
+(see :mod:`affinity.loaders.usd`). Every problem with the input is a
 :class:`~affinity.mesh.MeshError` naming the file and line; a Git LFS pointer
-is a :class:`~affinity.mesh.SkippedFile`. Only NumPy is imported (``pxr`` when a
-USD file is read).
+is a :class:`~affinity.mesh.SkippedFile`. A reader is imported when a file of its
+format is read (NumPy; ``pxr`` for USD).
 """
 
 from __future__ import annotations
 
 import os
+from typing import TYPE_CHECKING
 
 from ..errors import MeshError, SkippedFile
-from ..mesh import Mesh
-from .obj import load_obj
-from .off import load_off
-from .ply import load_ply
-from .usd import USD_SUFFIXES, UsdOptions, load_usd
+from .formats import LOADERS
 
-LOADERS = {".obj": load_obj, ".ply": load_ply, ".off": load_off, **dict.fromkeys(USD_SUFFIXES, load_usd)}
+if TYPE_CHECKING:
+    from ..mesh import Mesh
+    from .usd import UsdOptions
 
 LFS_POINTER = b"version https://git-lfs.github.com/spec/"
 
@@ -43,11 +43,8 @@ def read_source(path) -> bytes:
 
 def reads_whole(path) -> bool:
     """Whether the loader of ``path`` parses the file's bytes as :func:`read_source` gives them (OBJ)."""
-    return os.path.splitext(os.fspath(path))[1].lower() in WHOLE_SOURCE
-
-
-#: Formats whose loader takes the file's bytes (``source=``), so a check reads such a file once.
-WHOLE_SOURCE = (".obj",)
+    found = LOADERS.get(os.path.splitext(os.fspath(path))[1].lower())
+    return found is not None and found.whole_source
 
 
 def load(path, usd: UsdOptions | None = None, source: bytes | None = None) -> Mesh:
@@ -69,7 +66,8 @@ def load(path, usd: UsdOptions | None = None, source: bytes | None = None) -> Me
     if extension not in LOADERS:
         known = ", ".join(LOADERS)
         raise MeshError(path, 0, f"unknown mesh format {extension or '(no extension)'!r}; expected one of {known}")
-    if source is None and extension in WHOLE_SOURCE:
+    mesh_format = LOADERS[extension]
+    if source is None and mesh_format.whole_source:
         source = read_source(path)
     if source is not None:
         head = source[: len(LFS_POINTER)]
@@ -80,11 +78,12 @@ def load(path, usd: UsdOptions | None = None, source: bytes | None = None) -> Me
     if head == LFS_POINTER:
         raise SkippedFile(path, "lfs-pointer")
     try:
-        if extension in USD_SUFFIXES:
-            return load_usd(path, usd)
-        if extension in WHOLE_SOURCE:
-            return LOADERS[extension](path, source=source)
-        return LOADERS[extension](path)
+        read = mesh_format.load_function()
+        if mesh_format.key == "usd":
+            return read(path, usd)
+        if mesh_format.whole_source:
+            return read(path, source=source)
+        return read(path)
     except OSError as error:  # e.g. the file vanished or became unreadable while reading
         raise MeshError(path, 0, f"cannot read: {error.strerror or error}") from None
 

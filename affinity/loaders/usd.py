@@ -47,8 +47,9 @@ import numpy as np
 
 from ..errors import MeshError, SkippedFile
 from ..mesh import Mesh
+from .formats import format_named
 
-USD_SUFFIXES = (".usd", ".usda", ".usdc", ".usdz")
+USD_SUFFIXES = format_named("usd").suffixes
 INSTALL = "pip install 'quad-affinity[usd]'"
 
 _TEXCOORD2 = ("texCoord2f[]", "texCoord2d[]", "texCoord2h[]")

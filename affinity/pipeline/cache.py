@@ -39,7 +39,7 @@ import time
 
 from ..errors import MeshError
 from ..findings import FileReport, report_from_bytes, report_to_bytes
-from ..loaders.usd import USD_SUFFIXES
+from ..loaders.formats import format_named
 from ..settings import Settings
 
 #: Bump when the key or the stored report changes meaning.
@@ -175,7 +175,7 @@ class ResultCache:
         if tree is None:
             return None
         usd_key = None
-        if os.path.splitext(path)[1].lower() in USD_SUFFIXES:
+        if os.path.splitext(path)[1].lower() in format_named("usd").suffixes:
             usd_key = [_usd_reader(), None if usd is None else dataclasses.asdict(usd)]
         if id(settings) not in self._settings:  # files share a few Settings objects: describe each once
             self._settings[id(settings)] = (settings, dataclasses.asdict(settings))

@@ -17,9 +17,8 @@ from collections.abc import Callable
 from pathlib import Path
 
 from ..errors import UsageError
+from ..loaders.formats import MESH_SUFFIXES
 from ..settings import Settings, glob_matches
-
-MESH_SUFFIXES = (".obj", ".ply", ".off", ".usd", ".usda", ".usdc", ".usdz")
 
 
 def is_environment(folder: str) -> bool:
