@@ -212,17 +212,6 @@ def normal_mapped(tmp_path) -> Path:
     return tmp_path
 
 
-class Counting:
-    """``check_file`` that records the files it really checks."""
-
-    def __init__(self):
-        self.paths: list[str] = []
-
-    def __call__(self, path, settings, usd=None, source=None):
-        self.paths.append(os.path.basename(path))
-        return check_file(path, settings, usd, source)
-
-
 def _cached_check(folder: Path, mesh: Path) -> list:
     cache = ResultCache(str(folder), tool="tool")
     try:
@@ -232,14 +221,18 @@ def _cached_check(folder: Path, mesh: Path) -> list:
 
 
 def _recheck_after_touching_the_normal_map(assets: Path, cache: Path, monkeypatch) -> list[str]:
-    counting = Counting()
-    monkeypatch.setattr(check_module, "check_file", counting)
+    """The files checked again (not served by the cache) after the normal map changed."""
+    checked = []
+    real = check_module.load_and_check
+    monkeypatch.setattr(check_module, "load_and_check",
+                        lambda path, *args: checked.append(os.path.basename(path)) or real(path, *args))
     _cached_check(cache, assets / "mesh.obj")
+    assert checked == ["mesh.obj"]
     (assets / "nrm.png").write_bytes(png_header(256, 256))
     age(assets / "nrm.png")
-    counting.paths.clear()
+    checked.clear()
     _cached_check(cache, assets / "mesh.obj")
-    return counting.paths
+    return checked
 
 
 def test_without_its_role_the_cache_does_not_see_a_normal_map(normal_mapped, tmp_path_factory, monkeypatch):
