@@ -304,3 +304,26 @@ def test_every_output_format_writes_one_mesh(tmp_path, capsys):
             assert out.startswith("::") and "line=9" in out
         else:
             assert "trapezoid.obj:9:1: Q101 uv-disaffine:" in out
+
+
+def test_a_usd_stage_lists_its_layers_as_resources_and_the_cache_hashes_them(tmp_path):
+    pytest.importorskip("pxr")
+    from affinity.pipeline.cache import _hash_file
+
+    (tmp_path / "quad.usda").write_text("""#usda 1.0
+def Mesh "quad"
+{
+    int[] faceVertexCounts = [4]
+    int[] faceVertexIndices = [0, 1, 2, 3]
+    point3f[] points = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)]
+}
+""")
+    (tmp_path / "stage.usda").write_text('#usda 1.0\n(\n    subLayers = [@./quad.usda@, @./gone.usda@]\n)\n')
+    mesh = load(tmp_path / "stage.usda")
+    assert mesh.n_faces == 1
+    assert [(r.role, r.name, r.path) for r in mesh.resources] == [
+        ("usd-asset", "./gone.usda", str(tmp_path / "gone.usda")),
+        ("usd-asset", "./quad.usda", str(tmp_path / "quad.usda"))]
+    _, deps = _hash_file(str(tmp_path / "stage.usda"))
+    assert deps == [r.path for r in mesh.resources]
+    assert check_file(str(tmp_path / "stage.usda"), Settings(select=["Q902"])).hits == []

@@ -48,6 +48,7 @@ import numpy as np
 from ..errors import MeshError, SkippedFile
 from ..mesh import Mesh
 from .formats import format_named
+from .resources import Resource
 
 USD_SUFFIXES = format_named("usd").suffixes
 INSTALL = "pip install 'quad-affinity[usd]'"
@@ -81,20 +82,26 @@ class _Primvar:
     indices: np.ndarray | None = None
 
 
-def asset_paths(path: str) -> list[str]:
-    """The sublayers, references and payloads the USD layer ``path`` names, as absolute paths,
-    sorted (the resource role ``usd-asset``); none without ``pxr`` or when the layer cannot be opened."""
+def layer_assets(path: str) -> list[tuple[str, str]]:
+    """``(asset, absolute path)`` of the sublayers, references and payloads the USD layer ``path``
+    names, sorted by asset path (the resource role ``usd-asset``); none without ``pxr`` or when the
+    layer cannot be opened."""
     try:
         from pxr import Sdf, Tf
     except ImportError:
         return []
     try:
-        layer = Sdf.Layer.FindOrOpen(path)
+        layer = Sdf.Layer.FindOrOpen(os.fspath(path))
     except Tf.ErrorException:
         return []
     if layer is None:
         return []
-    return [layer.ComputeAbsolutePath(asset) for asset in sorted(layer.GetCompositionAssetDependencies())]
+    return [(asset, layer.ComputeAbsolutePath(asset)) for asset in sorted(layer.GetCompositionAssetDependencies())]
+
+
+def asset_paths(path: str) -> list[str]:
+    """The absolute paths of :func:`layer_assets`."""
+    return [absolute for _, absolute in layer_assets(path)]
 
 
 def load_usd(path, options: UsdOptions | None = None) -> Mesh:
@@ -137,6 +144,8 @@ def load_usd(path, options: UsdOptions | None = None) -> Mesh:
     mesh.meters_per_unit = _stage_metadata(stage, "metersPerUnit", lambda: float(UsdGeom.GetStageMetersPerUnit(stage)),
                                            notes)
     mesh.notes = notes
+    mesh.resources = [Resource(role="usd-asset", name=asset, path=os.path.normpath(absolute))
+                      for asset, absolute in layer_assets(path)]
     return mesh
 
 

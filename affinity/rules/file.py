@@ -95,7 +95,8 @@ def missing_resources(mesh, settings) -> tuple | None:
         name in the mtllib or map_Kd line.
     """
     # The files the loader found referenced (``mesh.resources``, the resource registry's
-    # roles), each looked at once. A finding sits on the line that pulls the file in
+    # roles), each looked at once; a USD stage's layers are pxr's to compose, and their
+    # changes reach the cache, but a missing one is not a finding (Q902 is about OBJ and MTL). A finding sits on the line that pulls the file in
     # (face -1); its detail names the resource and, where the texel unit would have come
     # from that texture, the texture-size used instead. Returns (faces, lines, values, details) or None.
     from ..loaders.resources import ROLES
@@ -107,7 +108,7 @@ def missing_resources(mesh, settings) -> tuple | None:
     lines, details, seen = [], [], set()
     for resource in mesh.resources:
         role = ROLES.get(resource.role)
-        if role is None or resource.path in seen:
+        if role is None or role.named_in == "usd" or resource.path in seen:
             continue
         seen.add(resource.path)
         problem = _unusable(resource.path, image=role.image)
