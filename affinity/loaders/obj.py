@@ -29,7 +29,6 @@ from __future__ import annotations
 import io
 import os
 import re
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -91,6 +90,8 @@ def load_obj(path, chunk_bytes: int | None = None, source: bytes | None = None) 
     file's bytes when the caller has read them already (the check hashes them
     for its cache and scans them for inline ignores: one read of the file).
     """
+    from concurrent.futures import ThreadPoolExecutor  # here, not at import: off a cached check's path
+
     if source is None:
         with open(path, "rb") as fh:
             source = fh.read()
