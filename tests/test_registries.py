@@ -327,3 +327,10 @@ def Mesh "quad"
     _, deps = _hash_file(str(tmp_path / "stage.usda"))
     assert deps == [r.path for r in mesh.resources]
     assert check_file(str(tmp_path / "stage.usda"), Settings(select=["Q902"])).hits == []
+
+
+def test_the_check_and_report_help_name_every_suffix_of_the_table():
+    commands = cli.build_parser()._subparsers._group_actions[0].choices
+    for command in ("check", "report"):
+        text = " ".join(commands[command].format_help().split())
+        assert all(suffix in text for suffix in MESH_SUFFIXES), command

@@ -82,13 +82,14 @@ def _measure(text: str) -> str:
 
 
 def add_parser(sub) -> None:
+    from ..loaders.formats import described
     from ..output import FORMATS
     from ..rules import LEVELS
     from ..settings import DIAGONALS, MEASURES
 
     p = sub.add_parser(
         "check", help="lint mesh files for quad affinity and shape problems",
-        description="Lint .obj/.ply/.off and USD (.usd/.usda/.usdc/.usdz, with the usd extra) files "
+        description=f"Lint {described()} files "
                     "(directories are searched recursively). "
                     "Settings come from affinity.toml or [tool.affinity] in pyproject.toml, found by "
                     "walking up from each file; flags given here win.",

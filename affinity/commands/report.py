@@ -16,7 +16,7 @@ import os
 import sys
 
 from ..errors import UsageError
-from ..loaders.formats import suffix_list
+from ..loaders.formats import described
 from ..report import MAX_VIEWS, RENDER_SIZE
 from . import EXIT_CLEAN, EXIT_ERROR, camera, image_size, pixel_tolerance, require
 
@@ -30,7 +30,7 @@ def add_parser(sub) -> None:
                "is written), a single MESH that is skipped (nothing is written), or an unreadable or skipped mesh "
                "among several (the report is still written, with its row).",
     )
-    p.add_argument("meshes", nargs="*", metavar="MESH", help=f"{suffix_list()} files or directories")
+    p.add_argument("meshes", nargs="*", metavar="MESH", help=f"{described()} files or directories")
     p.add_argument("-o", "--output", default="report.html", metavar="HTML",
                    help="where to write the report (default: report.html)")
     p.add_argument("--up", choices=["x", "y", "z"], default=None,

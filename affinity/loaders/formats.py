@@ -66,9 +66,17 @@ def format_named(key: str) -> MeshFormat:
     return next(f for f in FORMATS if f.key == key)
 
 
-def suffix_list(separator: str = "/") -> str:
-    """The suffixes for a help text: ``".obj/.ply/.off/.usd/.usda/.usdc/.usdz"``."""
-    return separator.join(MESH_SUFFIXES)
+def described() -> str:
+    """The formats for a help text, each extra named.
+
+    >>> described()
+    '.obj/.ply/.off and USD (.usd/.usda/.usdc/.usdz, with the usd extra)'
+    """
+    text = "/".join(suffix for f in FORMATS if f.extra is None for suffix in f.suffixes)
+    for f in FORMATS:
+        if f.extra is not None:
+            text += f" and {f.title} ({'/'.join(f.suffixes)}, with the {f.extra} extra)"
+    return text
 
 
 def hook_pattern() -> str:
