@@ -259,6 +259,16 @@ def test_a_normal_map_rule_needs_one_rule_and_one_resource_role(q104, normal_map
     assert missing.details == ["norm nrm.png (in look.mtl) not found"]
 
 
+def test_a_role_registered_after_the_cache_was_warmed_is_followed(normal_mapped, tmp_path_factory, monkeypatch):
+    cache = tmp_path_factory.mktemp("c")
+    _cached_check(cache, normal_mapped / "mesh.obj")  # look.mtl's files read without the normal-map role
+    register_role(NORMAL_MAP)
+    try:
+        assert _recheck_after_touching_the_normal_map(normal_mapped, cache, monkeypatch) == ["mesh.obj"]
+    finally:
+        unregister_role(NORMAL_MAP.name)
+
+
 # -- formats: one table -----------------------------------------------------------------------------
 
 

@@ -12,7 +12,9 @@ A report is stored under a key made of
   since the version string does not change between commits.
 
 Content hashes are remembered per file under a pre-key (path, size, mtime_ns,
-inode), so an unchanged file costs one ``stat`` and is not read. A file
+inode), so an unchanged file costs one ``stat`` and is not read; its list of
+the files it names is kept with the resource roles it was read with (a role
+registered since, and the file is read again). A file
 modified in the last :data:`RACY_SECONDS` gets no pre-key (its mtime may not
 yet tell two versions apart, as in git's "racy" index entries): it is hashed
 again next time.
@@ -203,15 +205,18 @@ class ResultCache:
         prekey = (st.st_size, st.st_mtime_ns, st.st_ino)
         row = self._db.execute("SELECT size, mtime_ns, inode, digest, deps FROM files WHERE path = ?",
                                (path,)).fetchone()
+        readers = _readers()
         if row is not None and tuple(row[:3]) == prekey:
-            return row[3], json.loads(row[4])
+            stored = json.loads(row[4])
+            if isinstance(stored, dict) and stored.get("readers") == readers:
+                return row[3], stored["deps"]
         try:
             digest, deps = _hash_file(path, None if source is None else source())
         except (OSError, MeshError):
             return None
         if st.st_mtime_ns < (self._now - RACY_SECONDS) * 1e9:
             self._write("INSERT OR REPLACE INTO files VALUES (?, ?, ?, ?, ?, ?, ?)",
-                        (path, *prekey, digest, _json(deps), self._now))
+                        (path, *prekey, digest, _json({"readers": readers, "deps": deps}), self._now))
         return digest, deps
 
     # -- entries ----------------------------------------------------------------------------------
@@ -273,6 +278,14 @@ class ResultCache:
         except sqlite3.Error as err:
             self._warn(f"cannot write it ({err})")
         self._db = None
+
+
+def _readers() -> str:
+    """What a file's stored dependencies were read with: the resource roles registered (a role
+    registered later, e.g. a plug-in's normal map, must not be served an MTL file's old list)."""
+    from ..loaders.resources import ROLES
+
+    return _json(sorted((role.name, role.statement, role.named_in) for role in ROLES.values()))
 
 
 def _hash_file(path: str, data: bytes | None = None) -> tuple[str, list[str]]:
