@@ -12,8 +12,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_cli_check import TRAPEZOID, run, write
-from test_sarif import assert_valid
+from helpers.cli import TRAPEZOID, run, write
+from helpers.sarif import assert_valid
 
 if sys.version_info >= (3, 11):
     import tomllib

@@ -16,7 +16,7 @@ import subprocess
 from pathlib import Path
 
 import pytest
-from test_formats import SQUARE, UNIT_UV, quad_obj, trapezoid
+from helpers.quads import SQUARE, UNIT_UV, quad_obj, trapezoid
 
 ROOT = Path(__file__).resolve().parents[1]
 

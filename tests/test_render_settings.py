@@ -3,23 +3,15 @@ routing read the configuration ``affinity check`` reads (issue 27)."""
 
 from __future__ import annotations
 
-import subprocess
-import sys
-
 import numpy as np
 import pytest
+from helpers.cli import TRAPEZOID, run
 
 from affinity.draw import RenderOptions, render_mesh
 
-# A trapezoid with the unit square's uv: 0.25 uv units (256 texels) of split error, far above Q101's 0.5.
-TRAPEZOID = "v -1 0 0\nv 1 0 0\nv 0.5 1 0\nv -0.5 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n"
+# TRAPEZOID carries the unit square's uv: 176 texels of split error, far above Q101's 0.5.
 LINT_ROUTE = {"method": "hybrid", "route": "lint", "show": "uv", "width": 64, "height": 64,
               "camera": ((0.0, 0.5, 3.0), (0.0, 0.5, 0.0), 60.0)}
-
-
-def cli(*args: str, cwd) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "affinity.cli", *args], capture_output=True, text=True,
-                          cwd=cwd, timeout=300)
 
 
 @pytest.fixture
@@ -39,7 +31,7 @@ def test_lint_route_without_configuration_sends_the_trapezoid_to_mvc(tmp_path):
 
 
 def test_configured_threshold_is_the_lint_routes_threshold(configured):
-    check = cli("check", str(configured), cwd=configured.parent)
+    check = run("check", str(configured), cwd=configured.parent)
     assert check.returncode == 0 and "Q101" not in check.stdout, check.stdout + check.stderr
     result = render_mesh(str(configured), RenderOptions(**LINT_ROUTE))
     assert list(result.methods) == ["split"]
@@ -47,7 +39,7 @@ def test_configured_threshold_is_the_lint_routes_threshold(configured):
 
 
 def test_render_command_with_the_configuration_routes_nothing_to_mvc(configured):
-    done = cli("render", str(configured), "-o", str(configured.with_suffix(".png")), "--route", "lint",
+    done = run("render", str(configured), "-o", str(configured.with_suffix(".png")), "--route", "lint",
                cwd=configured.parent)
     assert done.returncode == 0, done.stderr
     assert "hybrid: 0 of 1 quads to mvc" in done.stderr

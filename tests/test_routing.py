@@ -1,7 +1,7 @@
 """The hybrid's routing rule against hand-computed screen sizes and the sampled split displacement."""
 
 import numpy as np
-from split_reference import random_convex_quad, sampled_sup
+from helpers.split_reference import random_convex_quad, sampled_sup
 
 from affinity.draw.routing import (
     clip_components,
