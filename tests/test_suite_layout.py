@@ -10,6 +10,7 @@ import pytest
 
 TESTS = Path(__file__).resolve().parent
 TEST_MODULES = sorted(TESTS.glob("test_*.py"))
+HELPERS = sorted((TESTS / "helpers").glob("*.py"))
 LOCAL_MODULES = {path.stem for path in TESTS.glob("*.py")} - {"conftest"}
 
 
@@ -37,6 +38,12 @@ def test_the_check_sees_a_test_module_importing_another(tmp_path):
 def test_no_test_module_imports_another_module_of_tests(path):
     siblings = {name for name in imported_modules(path) if name.split(".")[0] in LOCAL_MODULES or name.startswith(".")}
     assert not siblings, f"{path.name} imports {sorted(siblings)}: move shared code into tests/helpers/"
+
+
+@pytest.mark.parametrize("path", HELPERS, ids=lambda p: p.name)
+def test_helpers_import_no_test_module(path):
+    tests = {name for name in imported_modules(path) if name.split(".")[0] in LOCAL_MODULES}
+    assert not tests, f"helpers/{path.name} imports {sorted(tests)}"
 
 
 def test_only_helpers_sit_beside_the_test_modules():
