@@ -141,7 +141,7 @@ def main(argv=None) -> int:
     renderer = ctx.info["GL_RENDERER"]
     rows = [compare(ctx, clip, uv, size, method, cull, frames) for cull in (False, True) for method in ("split", "mvc")]
     hybrid = hybrid_rows(clip, uv, pole_rank, size, frames)
-    load = "{:.1f}".format(os.getloadavg()[0])
+    load = f"{os.getloadavg()[0]:.1f}"
     table = markdown(rows, hybrid, size, frames, clip.shape[0], renderer.split(" (")[0], load)
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "bench_opengl.md").write_text(table)
