@@ -86,8 +86,11 @@ def compare(ctx, clip, uv, size, method, cull, frames):
 def hybrid_rows(clip, uv, pole_rank, size, frames):
     """Median NumPy times of split, a per-quad array of all 'split' (the hybrid with nothing routed)
     and the hybrid with the 10% of quads nearest the poles in mvc, frames in turns."""
-    cases = {"split": "split", "hybrid, nothing routed": np.full(clip.shape[0], "split"),
-             "hybrid, 10% mvc": hybrid_methods(pole_rank)}
+    cases = {
+        "split": "split",
+        "hybrid, nothing routed": np.full(clip.shape[0], "split"),
+        "hybrid, 10% mvc": hybrid_methods(pole_rank),
+    }
     times = {name: [] for name in cases}
     for _ in range(frames):
         for name, method in cases.items():
@@ -95,8 +98,10 @@ def hybrid_rows(clip, uv, pole_rank, size, frames):
             rasterize_quads(clip, uv, size, size, method)
             times[name].append(time.perf_counter() - start)
     split = statistics.median(times["split"])
-    return [{"case": name, "numpy_ms": 1000 * statistics.median(t), "over_split": statistics.median(t) / split}
-            for name, t in times.items()]
+    return [
+        {"case": name, "numpy_ms": 1000 * statistics.median(t), "over_split": statistics.median(t) / split}
+        for name, t in times.items()
+    ]
 
 
 SMALL_SIZE = 128

@@ -114,8 +114,11 @@ class OpenGLQuads:
             self.buffers.append(ctx.buffer(np.concatenate([clip, padded], axis=1).tobytes()))  # (Q, 8, 4)
             self.buffers[2].bind_to_storage_buffer(0)
         # The mvc shader reads the attributes from the storage buffer: the vertices' are skipped.
-        layout = (self.buffers[0], "4f 4f", "in_clip", "in_attrs") if method == "split" else (
-            self.buffers[0], "4f 16x", "in_clip")
+        layout = (
+            (self.buffers[0], "4f 4f", "in_clip", "in_attrs")
+            if method == "split"
+            else (self.buffers[0], "4f 16x", "in_clip")
+        )
         self.vao = ctx.vertex_array(self.program, [layout], index_buffer=self.buffers[1])
         self.target = ctx.renderbuffer((width, height), 4, dtype="f4")
         self.depth = ctx.depth_renderbuffer((width, height))
