@@ -130,9 +130,14 @@ def mean_value_terms(sx, sy, ex, ey):
         C_i = s_{i-1} x s_{i+1} and E_i = s_{i-1} . s_{i+1}, formed on demand.
     """
     sxn, syn = sx[NEXT], sy[NEXT]
-    r = np.sqrt(sx * sx + sy * sy)
-    D = sx * sxn + sy * syn
-    A = np.where(r <= r[NEXT], sx * ey - sy * ex, sxn * ey - syn * ex)
+    r = sx * sx
+    r += sy * sy
+    np.sqrt(r, out=r)
+    D = sx * sxn
+    D += sy * syn
+    shorter = r <= r[NEXT]
+    A = np.where(shorter, sx, sxn) * ey
+    A -= np.where(shorter, sy, syn) * ex
     return r, A, D, Diagonals(sx, sy, ex, ey)
 
 
@@ -232,7 +237,9 @@ def mean_value_from_terms(r, A, D, diagonals) -> np.ndarray:
     rr = r * r[NEXT]
     h = rr + np.abs(D)  # r_i r_{i+1} + |D_i|: never cancels
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        t = np.where(D > 0, A / h, h / A)
+        acute = D > 0
+        t = np.where(acute, A, h)
+        t /= np.where(acute, h, A)
         summed = t[PREV] + t
         cols = np.flatnonzero((A[PREV] * A < 0).any(axis=0))
         if cols.size:

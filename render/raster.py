@@ -308,11 +308,15 @@ def _draw_band(frame, scene, row_start, row_stop, selection) -> int:
     length = np.maximum(c_hi - c_lo + 1, 0)
 
     z0, zc, zr = np.take(scene.depth_planes, scene.parent[pair_tri], axis=1)
-    pair, column = expand_ranges(length)
-    column += c_lo[pair]
-    pixel = (pair_row - row_start)[pair] * width + column
-    depth = (z0 + zr * pair_row)[pair] + zc[pair] * column
-    tag = tag_order[owner][pair]
+    # Fragment k of a span (row, c_lo .. c_hi) is pixel c_lo + k; every per-fragment array is one
+    # np.repeat of a per-span value, plus k.
+    k = np.arange(length.sum()) - np.repeat(np.cumsum(length) - length, length)
+    pixel = np.repeat((pair_row - row_start) * width + c_lo, length)
+    pixel += k
+    depth = np.repeat(zc, length)
+    depth *= k
+    depth += np.repeat(z0 + zr * pair_row + zc * c_lo, length)
+    tag = np.repeat(tag_order[owner], length)
 
     if exclusive.any():
         tail = length[: rows[: np.count_nonzero(~exclusive)].sum()].sum()
@@ -345,7 +349,9 @@ def _shade(frame, scene, row, col, triangle):
     """Depth and attributes of the winning fragments at pixels (row, col), (N,) each."""
     width = scene.width
     quad = triangle >> 1
-    planes = np.take(scene.planes, triangle, axis=2)
+    # Weight methods need only the depth plane of the triangle.
+    planes = np.take(scene.planes if PLANE_METHODS.intersection(scene.names) else scene.depth_planes[:, None],
+                     triangle, axis=2)
     flat = row * width + col
     frame.face.reshape(-1)[flat] = quad
     frame.depth.reshape(-1)[flat] = np.clip(evaluate(planes[:, -1], col, row), -1.0, 1.0)
