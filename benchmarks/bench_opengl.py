@@ -8,7 +8,9 @@ OpenGL, and the median of ``--frames`` frames of each is kept; the OpenGL time i
 ``glFinish`` (the data uploaded once before), the time to read the frame back into NumPy is
 given beside it. The two frames must agree: faces on all but ``FACE_SHARE`` of the covered
 pixels (pixel centres within rounding of an edge) and attributes to ``ATTRIBUTE_TOLERANCE``
-(llvmpipe works in float32) where the faces agree; the script exits 1 otherwise.
+(llvmpipe works in float32) where the faces agree; the script exits 1 otherwise. The process keeps
+freed memory as the ``affinity`` command line does (``keep_freed_memory``), so that NumPy's
+temporaries are not page-faulted in afresh on every frame.
 
     apt-get install -y libegl1 libgl1-mesa-dri libegl-mesa0 && pip install moderngl
     python benchmarks/bench_opengl.py [--frames 7] [--size 1024] [--small] [--out reports/bench]
@@ -35,6 +37,7 @@ sys.path[:0] = [str(ROOT / "tests"), str(ROOT / "benchmarks")]
 from bench_render import SCENES, clip_space, hybrid_methods, uv_sphere  # noqa: E402
 from opengl_reference import OpenGLQuads, create_context  # noqa: E402
 
+from affinity.commands.allocator import keep_freed_memory  # noqa: E402
 from render import rasterize_quads  # noqa: E402
 
 FACE_SHARE = 1e-4  # of the covered pixels may show another face (centres on an edge)
@@ -110,10 +113,12 @@ SPHERE = {True: (200, 100), False: (40, 20)}  # full size or --small
 
 def markdown(rows, hybrid, size, frames, quads, renderer, load):
     lines = [
-        f"NumPy `rasterize_quads` against Mesa llvmpipe ({renderer}) on the {quads:,}-quad lat-long sphere at "
+        f"NumPy `rasterize_quads` against {renderer} on the {quads:,}-quad lat-long sphere at "
         f"{size}x{size}, median of {frames} frames each, taken in turns in one run "
         f"({datetime.date.today().isoformat()}; 2-CPU machine shared with other jobs, load average {load}). "
-        "llvmpipe: clear + draw + `glFinish`, data uploaded once; readback of the frame into NumPy beside it. "
+        f"llvmpipe ({os.environ.get('LP_NUM_THREADS', os.cpu_count())} threads): clear + draw + `glFinish`, "
+        "data uploaded once; readback of the frame into NumPy beside it. "
+        "NumPy: one thread, freed memory kept as by the `affinity` command line. "
         f"Agreement: faces on all but {FACE_SHARE:g} of the covered pixels, uv within {ATTRIBUTE_TOLERANCE:g}.",
         "",
         "| method | back faces | fragments | NumPy ms | llvmpipe ms | llvmpipe readback ms | NumPy / llvmpipe "
@@ -140,14 +145,15 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     size, frames = (SMALL_SIZE, min(args.frames, 3)) if args.small else (args.size, args.frames)
 
+    keep_freed_memory()
     corners, uv, pole_rank = uv_sphere(*SPHERE[not args.small])
     clip = clip_space(corners, size, size, SCENES["sphere"][1])
     ctx = create_context()
-    renderer = ctx.info["GL_RENDERER"]
+    renderer = "Mesa {} {}".format(ctx.info["GL_VERSION"].split()[-1], ctx.info["GL_RENDERER"])
     rows = [compare(ctx, clip, uv, size, method, cull, frames) for cull in (False, True) for method in ("split", "mvc")]
     hybrid = hybrid_rows(clip, uv, pole_rank, size, frames)
     load = f"{os.getloadavg()[0]:.1f}"
-    table = markdown(rows, hybrid, size, frames, clip.shape[0], renderer.split(" (")[0], load)
+    table = markdown(rows, hybrid, size, frames, clip.shape[0], renderer, load)
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "bench_opengl.md").write_text(table)
     (args.out / "bench_opengl.json").write_text(json.dumps({"rows": rows, "hybrid": hybrid}, indent=1) + "\n")
