@@ -349,32 +349,31 @@ def _shade(frame, scene, row, col, triangle):
     """Depth and attributes of the winning fragments at pixels (row, col), (N,) each."""
     width = scene.width
     quad = triangle >> 1
-    # Weight methods need only the depth plane of the triangle.
-    planes = np.take(scene.planes if PLANE_METHODS.intersection(scene.names) else scene.depth_planes[:, None],
-                     triangle, axis=2)
     flat = row * width + col
     frame.face.reshape(-1)[flat] = quad
-    frame.depth.reshape(-1)[flat] = np.clip(evaluate(planes[:, -1], col, row), -1.0, 1.0)
+    depth = evaluate(np.take(scene.depth_planes, triangle, axis=1), col, row)
+    frame.depth.reshape(-1)[flat] = np.clip(depth, -1.0, 1.0, out=depth)
     attrs = frame.attrs.reshape(scene.height * width, frame.attrs.shape[2])
-    if len(scene.names) == 1:
-        attrs[flat] = _attributes(scene, scene.names[0], planes, quad, col, row)
-        return
-    method = scene.method_of_quad[quad]
+    method = scene.method_of_quad[quad] if len(scene.names) > 1 else None
     for code, name in enumerate(scene.names):
-        m = np.flatnonzero(method == code)
-        attrs[flat[m]] = _attributes(scene, name, np.take(planes, m, axis=2), quad[m], col[m], row[m])
+        m = np.flatnonzero(method == code) if method is not None else None
+        if m is None or m.size == flat.size:  # one method for all: no subsets to gather
+            attrs[flat] = _attributes(scene, name, triangle, quad, col, row)
+        elif m.size:
+            attrs[flat[m]] = _attributes(scene, name, triangle[m], quad[m], col[m], row[m])
 
 
-def _attributes(scene, name, planes, quad, col, row) -> np.ndarray:
-    """Attributes (N, K) of pixels (col, row) drawn by ``name`` in ``quad``, (N,) each.
+def _attributes(scene, name, triangle, quad, col, row) -> np.ndarray:
+    """Attributes (N, K) of pixels (col, row) drawn by ``name`` in split triangle ``triangle``
+    of ``quad``, (N,) each.
 
     Split and projective quads take their attributes from their triangle's
-    ``planes`` (3, K + 2, N): rho a / w over rho / w. The others weight their
+    planes (``_Scene.planes``): rho a / w over rho / w. The others weight their
     quad's corner attributes with their method's corner weights.
     """
     channels = scene.attrs.shape[1]
     if name in PLANE_METHODS:
-        v = evaluate(planes[:, : channels + 1], col, row)
+        v = evaluate(np.take(scene.planes[:, : channels + 1], triangle, axis=2), col, row)
         return (v[:channels] / v[channels]).T
     px = (col + 0.5) * (2.0 / scene.width) - 1.0
     py = 1.0 - (row + 0.5) * (2.0 / scene.height)
