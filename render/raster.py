@@ -329,7 +329,8 @@ def _draw_band(frame, scene, row_start, row_stop, selection) -> int:
     triangle = scene.parent[selection[winner]]
     for block in range(0, covered.size, SHADE_BLOCK):
         part = slice(block, block + SHADE_BLOCK)
-        row, col = np.divmod(covered[part], width)
+        row = covered[part] // width  # floor_divide and a product: np.divmod is several times slower
+        col = covered[part] - row * width
         _shade(frame, scene, row + row_start, col, triangle[part])
     return pixel.size
 
@@ -350,21 +351,27 @@ def _shade(frame, scene, row, col, triangle):
     width = scene.width
     quad = triangle >> 1
     flat = row * width + col
+    col, row = col.astype(np.float64), row.astype(np.float64)  # once, not in every plane's product
     frame.face.reshape(-1)[flat] = quad
     depth = evaluate(np.take(scene.depth_planes, triangle, axis=1), col, row)
     frame.depth.reshape(-1)[flat] = np.clip(depth, -1.0, 1.0, out=depth)
-    attrs = frame.attrs.reshape(scene.height * width, frame.attrs.shape[2])
+    # One channel at a time: scattering rows of K values is several times slower than K scatters.
+    channels = frame.attrs.reshape(scene.height * width, frame.attrs.shape[2]).T
     method = scene.method_of_quad[quad] if len(scene.names) > 1 else None
     for code, name in enumerate(scene.names):
         m = np.flatnonzero(method == code) if method is not None else None
         if m is None or m.size == flat.size:  # one method for all: no subsets to gather
-            attrs[flat] = _attributes(scene, name, triangle, quad, col, row)
+            pixels, values = flat, _attributes(scene, name, triangle, quad, col, row)
         elif m.size:
-            attrs[flat[m]] = _attributes(scene, name, triangle[m], quad[m], col[m], row[m])
+            pixels, values = flat[m], _attributes(scene, name, triangle[m], quad[m], col[m], row[m])
+        else:
+            continue
+        for channel, value in zip(channels, values):
+            channel[pixels] = value
 
 
 def _attributes(scene, name, triangle, quad, col, row) -> np.ndarray:
-    """Attributes (N, K) of pixels (col, row) drawn by ``name`` in split triangle ``triangle``
+    """Attributes (K, N) of pixels (col, row) drawn by ``name`` in split triangle ``triangle``
     of ``quad``, (N,) each.
 
     Split and projective quads take their attributes from their triangle's
@@ -374,12 +381,12 @@ def _attributes(scene, name, triangle, quad, col, row) -> np.ndarray:
     channels = scene.attrs.shape[1]
     if name in PLANE_METHODS:
         v = evaluate(np.take(scene.planes[:, : channels + 1], triangle, axis=2), col, row)
-        return (v[:channels] / v[channels]).T
+        return v[:channels] / v[channels]
     px = (col + 0.5) * (2.0 / scene.width) - 1.0
     py = 1.0 - (row + 0.5) * (2.0 / scene.height)
     weights = WEIGHTS[name](np.take(scene.corners, quad, axis=2), px, py)
     corner_attrs = np.take(scene.attrs, quad, axis=2)  # (4, K, N)
-    return sum(weights[i] * corner_attrs[i] for i in range(4)).T
+    return sum(weights[i] * corner_attrs[i] for i in range(4))
 
 
 def _checked_input(clip, attrs, width, height, method):

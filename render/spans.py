@@ -146,7 +146,7 @@ def row_spans(triangles: ScreenTriangles, tri, row, width):
     """
     # All three edges at once, (3, P), in place: the pairs are as many as the fragments' spans.
     K = np.take(triangles.edge_r, tri, axis=1)
-    K *= row
+    K *= row.astype(np.float64)  # once: a mixed int-float product casts every element
     K += np.take(triangles.edge_k, tri, axis=1)
     c = np.take(triangles.edge_c, tri, axis=1)
     horizontal_out = (c[2] == 0) & (K[2] < 0)
