@@ -149,10 +149,10 @@ class _Scene:
     Quads: ``corners`` (4, 4, Q) float64 clip x, y, z, w (component, corner,
     quad); ``attrs`` (4, K, Q) (corner, channel, quad); ``method_of_quad``
     (Q,) int index into ``names``. Split triangles (index 2 q + half):
-    ``planes`` (3, K + 2, 2Q), the interpolation planes (``render.planes``)
-    of rho a / w for the K attributes, of rho / w (rho = 1 except for
-    projective quads) and of NDC depth, the last also alone as
-    ``depth_planes`` (3, 2Q) for the fragment loop; ``orientation`` (2Q,)
+    ``attribute_planes`` (3, K + 1, 2Q), the interpolation planes
+    (``render.planes``) of rho a / w for the K attributes and of rho / w
+    (rho = 1 except for projective quads), and ``depth_planes`` (3, 2Q), of
+    NDC depth (each contiguous: gathers from views are slower); ``orientation`` (2Q,)
     the sign of the homogeneous determinant (+1 counter-clockwise in NDC).
     Screen triangles (the clipped, snapped pieces): ``screen``, ``parent``
     (T,) split-triangle index, ``exclusive`` (T,) True for pieces of quads
@@ -166,7 +166,7 @@ class _Scene:
     method_of_quad: np.ndarray
     corners: np.ndarray
     attrs: np.ndarray
-    planes: np.ndarray
+    attribute_planes: np.ndarray
     depth_planes: np.ndarray
     orientation: np.ndarray
     screen: ScreenTriangles
@@ -202,7 +202,7 @@ class _Scene:
             method_of_quad=method_of_quad,
             corners=np.ascontiguousarray(clip.transpose(2, 1, 0)),
             attrs=np.ascontiguousarray(attrs.transpose(1, 2, 0)),
-            planes=planes,
+            attribute_planes=np.ascontiguousarray(planes[:, :-1]),
             depth_planes=np.ascontiguousarray(planes[:, -1]),
             orientation=orientation,
             screen=ScreenTriangles.concatenate(screens),
@@ -375,12 +375,12 @@ def _attributes(scene, name, triangle, quad, col, row) -> np.ndarray:
     of ``quad``, (N,) each.
 
     Split and projective quads take their attributes from their triangle's
-    planes (``_Scene.planes``): rho a / w over rho / w. The others weight their
+    planes (``_Scene.attribute_planes``): rho a / w over rho / w. The others weight their
     quad's corner attributes with their method's corner weights.
     """
     channels = scene.attrs.shape[1]
     if name in PLANE_METHODS:
-        v = evaluate(np.take(scene.planes[:, : channels + 1], triangle, axis=2), col, row)
+        v = evaluate(np.take(scene.attribute_planes, triangle, axis=2), col, row)
         return v[:channels] / v[channels]
     px = (col + 0.5) * (2.0 / scene.width) - 1.0
     py = 1.0 - (row + 0.5) * (2.0 / scene.height)
