@@ -104,7 +104,7 @@ def mean_value(p, quad, w=None) -> np.ndarray:
     return mean_value_from_terms(r, A, D, diagonals).T
 
 
-def cyclic(ufunc, a, b, shift, dtype=None):
+def _cyclic(ufunc, a, b, shift, dtype=None):
     """``ufunc(a_i, b_{i + shift})`` for corner-major arrays (4, ...), i cyclic, shift 1 or -1.
 
     Formed from slices of ``b``: ``b[NEXT]`` would first copy all of it. The same values as
@@ -152,7 +152,7 @@ def mean_value_terms(sx, sy, ex, ey):
     np.sqrt(r, out=r)
     D = sx * sxn
     D += sy * syn
-    shorter = cyclic(np.less_equal, r, r, 1, bool)
+    shorter = _cyclic(np.less_equal, r, r, 1, bool)
     A = np.where(shorter, sx, sxn) * ey
     A -= np.where(shorter, sy, syn) * ex
     return r, A, D, Diagonals(sx, sy, ex, ey)
@@ -251,15 +251,15 @@ def mean_value_from_terms(r, A, D, diagonals) -> np.ndarray:
         vector e_i at the corner, and the unit vector of the nearest corner
         where sum_j mu_j is 0 or not finite.
     """
-    rr = cyclic(np.multiply, r, r, 1)
+    rr = _cyclic(np.multiply, r, r, 1)
     h = np.abs(D)
     h += rr  # r_i r_{i+1} + |D_i|: never cancels
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         acute = D > 0
         t = np.where(acute, A, h)
         t /= np.where(acute, h, A)
-        summed = cyclic(np.add, t, t, -1)
-        cols = np.flatnonzero((cyclic(np.multiply, A, A, -1) < 0).any(axis=0))
+        summed = _cyclic(np.add, t, t, -1)
+        cols = np.flatnonzero((_cyclic(np.multiply, A, A, -1) < 0).any(axis=0))
         if cols.size:
             sub = (slice(None), cols)
             summed[sub] = _balanced_sums(r[sub], A[sub], D[sub], rr[sub], h[sub], t[sub], *diagonals.terms(cols))
