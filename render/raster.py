@@ -80,7 +80,7 @@ TRIANGLE_CORNERS = np.array([[0, 1, 2], [0, 2, 3]])
 NEAR_FAR_PLANES = np.array([[0, 0, 1.0, 1.0], [0, 0, -1.0, 1.0]])  # -w <= z <= w
 SCREEN_PLANES = np.array([[-1.0, 0, 0, 1], [1.0, 0, 0, 1], [0, -1.0, 0, 1], [0, 1.0, 0, 1]])
 DEFAULT_BATCH_FRAGMENTS = 1 << 16
-SETUP_QUADS = 1 << 16  # quads set up at once
+SETUP_QUADS = 1 << 13  # quads set up at once: their temporaries stay small enough to be reused
 SHADE_BLOCK = 1 << 14  # pixels shaded at once: temporaries stay in cache
 
 
