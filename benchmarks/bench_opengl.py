@@ -149,7 +149,12 @@ def main(argv=None) -> int:
     keep_freed_memory()
     corners, uv, pole_rank = uv_sphere(*SPHERE[not args.small])
     clip = clip_space(corners, size, size, SCENES["sphere"][1])
-    ctx = create_context()
+    try:
+        ctx = create_context()
+    except Exception as error:  # moderngl missing, or no EGL device / driver
+        print(f"bench_opengl: no OpenGL 4.3 context on EGL ({type(error).__name__}: {error}); install with "
+              "apt-get install -y libegl1 libgl1-mesa-dri libegl-mesa0 && pip install moderngl", file=sys.stderr)
+        return 2
     renderer = "Mesa {} {}".format(ctx.info["GL_VERSION"].split()[-1], ctx.info["GL_RENDERER"])
     rows = [compare(ctx, clip, uv, size, method, cull, frames) for cull in (False, True) for method in ("split", "mvc")]
     hybrid = hybrid_rows(clip, uv, pole_rank, size, frames)
