@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import os
 import re
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -89,6 +88,8 @@ def load_obj(path, chunk_bytes: int | None = None) -> Mesh:
     ``chunk_bytes`` (default :data:`~affinity.loaders.text.CHUNK_BYTES`) is how
     much is read at a time; the mesh does not depend on it.
     """
+    from concurrent.futures import ThreadPoolExecutor  # here, not at import: off a cached check's path
+
     pending = []
     with open(path, "rb") as fh, ThreadPoolExecutor(_WORKERS) as pool:
         assembly = _Assembly(os.fstat(fh.fileno()).st_size)

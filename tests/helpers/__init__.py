@@ -6,5 +6,6 @@
 - :mod:`.sarif`: validation against the official SARIF schema;
 - :mod:`.nodes`: FIFOs and device nodes for output tests;
 - :mod:`.generated_obj`: random valid OBJ files;
-- :mod:`.split_reference`: the split's error by dense sampling (never the closed form).
+- :mod:`.split_reference`: the split's error by dense sampling (never the closed form);
+- :mod:`.opengl_reference`: a second rasterizer, Mesa llvmpipe through OpenGL.
 """
