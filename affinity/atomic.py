@@ -17,7 +17,6 @@ import errno
 import io
 import os
 import stat
-import tempfile
 from pathlib import Path
 
 
@@ -53,6 +52,8 @@ def atomic_write(path: str | os.PathLike, binary: bool = False):
             yield out
         return
     target = Path(os.path.realpath(path))
+    import tempfile  # here, not at import: it pulls in shutil, random and the compression modules
+
     fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
     try:
         os.fchmod(fd, stat.S_IMODE(mode) if mode is not None else 0o666 & ~_umask())

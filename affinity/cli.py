@@ -22,9 +22,17 @@ from .errors import UsageError
 
 SUBCOMMANDS = [check_command, render_command, rules_command, report_command, view_command, stability_command,
                bench_command]
+# The subcommand names each module adds; all of them are set up only when the arguments name none.
+COMMAND_NAMES = {"check": check_command, "render": render_command, "rules": rules_command, "rule": rules_command,
+                 "report": report_command, "view": view_command, "stability": stability_command,
+                 "bench": bench_command}
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
+    """The ``affinity`` parser. When ``argv`` (default ``sys.argv[1:]``) starts with a subcommand, only
+    that one gets its options (the others are bare names, still valid choices): setting up every
+    subcommand's options, and importing what their choices list, is a good share of a pre-commit
+    hook's start-up."""
     from . import __version__
 
     # No prefix matching anywhere: '--stat' is not '--statistics', and '--fail-on error' never
@@ -37,15 +45,20 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND",
                                 parser_class=functools.partial(argparse.ArgumentParser, allow_abbrev=False))
-    for command in SUBCOMMANDS:
+    args = sys.argv[1:] if argv is None else argv
+    chosen = COMMAND_NAMES.get(args[0]) if args else None
+    for command in SUBCOMMANDS if chosen is None else [chosen]:
         command.add_parser(sub)
+    for name in COMMAND_NAMES:
+        if name not in sub.choices:
+            sub.add_parser(name)
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
     from .commands.allocator import keep_freed_memory
 
-    args = build_parser().parse_args(argv)
+    args = build_parser(argv).parse_args(argv)
     keep_freed_memory()
     try:
         return args.run(args)

@@ -288,3 +288,12 @@ class Resolver:
         table = _table(source) or {}
         prefix = f"{source}: " + ("[tool.affinity] " if source.name == "pyproject.toml" else "")
         return {key: _RUN_KEYS[key](table[key], prefix + key) for key in _RUN_KEYS.keys() & table.keys()}
+
+
+def file_settings(path: str) -> Settings:
+    """The settings ``affinity check PATH`` lints ``path`` with when no flag is given: the governing
+    configuration file's (per-file ignores applied), else the defaults; the defaults too for a path
+    that names no file (a mesh built in memory, a built-in scene)."""
+    if not os.path.isfile(path):
+        return Settings()
+    return Resolver({}).resolve(path).settings.for_file(path)

@@ -22,8 +22,15 @@ from .rules import LEVELS, RULES
 MEASURES = ("error", "centre", "barycentric")
 #: Old measure names still accepted, with one warning line: name -> the measure it now means.
 DEPRECATED_MEASURES = {"misplacement": "error"}
-#: Folders a directory walk never enters unless ``exclude`` is set (``extend-exclude`` adds to them).
-DEFAULT_EXCLUDE = (".git", "node_modules", "__pycache__")
+#: Folders a directory walk never enters unless ``exclude`` is set (``extend-exclude`` adds to them): ruff's
+#: default excludes, which name version-control metadata, virtual environments, tool caches and build output
+#: (any of them can hold other projects' meshes or schema files), and ``__pycache__``. They apply below the
+#: paths a run is given, never to a path named on the command line.
+DEFAULT_EXCLUDE = (
+    ".bzr", ".direnv", ".eggs", ".git", ".git-rewrite", ".hg", ".ipynb_checkpoints", ".mypy_cache", ".nox",
+    ".pants.d", ".pyenv", ".pytest_cache", ".pytype", ".ruff_cache", ".svn", ".tox", ".venv", ".vscode",
+    "__pycache__", "__pypackages__", "_build", "buck-out", "build", "dist", "node_modules", "site-packages", "venv",
+)
 DIAGONALS = ("both", "02", "13", "shortest")
 
 
@@ -108,10 +115,21 @@ class Settings:
         rel = os.path.relpath(os.path.abspath(path), self.root)
         return None if rel.startswith("..") else rel.replace(os.sep, "/")
 
+    @property
+    def default_exclude(self) -> list[str]:
+        """The default folder names still in force (none once ``exclude`` is configured)."""
+        return list(DEFAULT_EXCLUDE) if self.exclude == list(DEFAULT_EXCLUDE) else []
+
+    @property
+    def configured_exclude(self) -> list[str]:
+        """The ``exclude`` and ``extend-exclude`` globs a configuration or flag set (not the defaults)."""
+        return [*(self.exclude if not self.default_exclude else []), *self.extend_exclude]
+
     def is_excluded(self, path: str) -> bool:
-        """Whether an ``exclude`` or ``extend-exclude`` glob matches ``path``."""
+        """Whether a configured ``exclude`` or ``extend-exclude`` glob matches ``path``, a path named on the
+        command line: the default folder names apply only inside the folders a run walks."""
         rel = self.relative(path)
-        return rel is not None and any(glob_matches(pattern, rel) for pattern in (*self.exclude, *self.extend_exclude))
+        return rel is not None and any(glob_matches(pattern, rel) for pattern in self.configured_exclude)
 
     def for_file(self, path: str) -> Settings:
         """The settings to lint ``path`` with: ``ignore`` extended by the matching per-file

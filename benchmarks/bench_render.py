@@ -9,23 +9,33 @@ the split time. Prints a markdown table.
     python benchmarks/bench_render.py                 # all scenes at 1024x1024
     python benchmarks/bench_render.py --scene sphere --size 2048 --repeat 7
     python benchmarks/bench_render.py --memory        # 4096x4096, 1M quads: time and peak memory
+    python benchmarks/bench_render.py --small --out /tmp/bench   # a quick run at 128x128
 
 "Fragments" are covered pixel centres before the depth test (``Frame.fragments``),
 counted once per method; the time is the best of ``--repeat`` runs of
 ``rasterize_quads`` (clip-space quads in, frame out; building the scene and
-the camera transform are not timed).
+the camera transform are not timed). The process keeps freed memory as the
+``affinity`` command line does (``keep_freed_memory``): NumPy's temporaries are
+then not page-faulted in afresh on every frame. The table goes to
+``OUT/bench_render.md`` (default ``reports/bench``).
 """
 
 from __future__ import annotations
 
 import argparse
+import datetime
 import functools
+import os
 import time
 import tracemalloc
+from pathlib import Path
 
 import numpy as np
 
+from affinity.commands.allocator import keep_freed_memory
 from render import frame_bounds, rasterize_quads, to_clip
+
+OUT = Path(__file__).resolve().parents[1] / "reports" / "bench"
 
 METHODS = ("split", "mvc", "bilinear", "hybrid")
 
@@ -144,21 +154,38 @@ def main(argv=None):
     parser.add_argument("--scene", choices=[*SCENES, "all"], default="all")
     parser.add_argument("--repeat", type=int, default=5, help="runs per measurement, best is kept")
     parser.add_argument("--memory", action="store_true", help="also render 4096x4096 with 1M quads")
+    parser.add_argument("--small", action="store_true", help="a quick run: 128x128, best of 2, no --memory")
+    parser.add_argument("--out", type=Path, default=OUT, help="folder for bench_render.md")
     args = parser.parse_args(argv)
+    if args.small:
+        args.size, args.repeat, args.memory = 128, min(args.repeat, 2), False
+    keep_freed_memory()
 
     scenes = list(SCENES) if args.scene == "all" else [args.scene]
-    print(f"## Rasterizer speed, {args.size}x{args.size}, best of {args.repeat}\n")
-    print("| scene | quads | method | fragments | covered pixels | time (s) | M fragments/s | time / split |")
-    print("|---|---:|---|---:|---:|---:|---:|---:|")
+    lines = [
+        f"Rasterizer speed, {args.size}x{args.size}, best of {args.repeat} ({datetime.date.today().isoformat()}; "
+        f"2-CPU machine shared with other jobs, load average {os.getloadavg()[0]:.1f}).",
+        "",
+        "| scene | quads | method | fragments | covered pixels | time (s) | M fragments/s | time / split |",
+        "|---|---:|---|---:|---:|---:|---:|---:|",
+    ]
     for name in scenes:
         for row in bench_scene(name, args.size, args.size, args.repeat):
-            print("| {} | {} | {} | {} | {} | {:.3f} | {:.1f} | {:.2f} |".format(*row))
+            lines.append("| {} | {} | {} | {} | {} | {:.3f} | {:.1f} | {:.2f} |".format(*row))
     if args.memory:
         quads, fragments, seconds, peak, inputs = bench_memory(4096, 1000, 1000)
-        print("\n## Memory, 4096x4096, sphere 1000x1000 (hybrid)\n")
-        print("| quads | fragments | time (s) | peak traced memory (GiB) | of which inputs (GiB) |")
-        print("|---:|---:|---:|---:|---:|")
-        print(f"| {quads} | {fragments} | {seconds:.1f} | {peak / 2**30:.2f} | {inputs / 2**30:.2f} |")
+        lines += [
+            "",
+            "Memory, 4096x4096, sphere 1000x1000 (hybrid):",
+            "",
+            "| quads | fragments | time (s) | peak traced memory (GiB) | of which inputs (GiB) |",
+            "|---:|---:|---:|---:|---:|",
+            f"| {quads} | {fragments} | {seconds:.1f} | {peak / 2**30:.2f} | {inputs / 2**30:.2f} |",
+        ]
+    table = "\n".join(lines) + "\n"
+    args.out.mkdir(parents=True, exist_ok=True)
+    (args.out / "bench_render.md").write_text(table)
+    print(table, end="")
 
 
 if __name__ == "__main__":

@@ -104,6 +104,23 @@ def mean_value(p, quad, w=None) -> np.ndarray:
     return mean_value_from_terms(r, A, D, diagonals).T
 
 
+def _cyclic(ufunc, a, b, shift, dtype=None):
+    """``ufunc(a_i, b_{i + shift})`` for corner-major arrays (4, ...), i cyclic, shift 1 or -1.
+
+    Formed from slices of ``b``: ``b[NEXT]`` would first copy all of it. The same values as
+    ``ufunc(a, b[NEXT])`` (shift 1) or ``ufunc(a, b[PREV])`` (shift -1), bit for bit, of
+    ``dtype`` (default: that of a and b).
+    """
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape), dtype or np.result_type(a, b))
+    if shift == 1:
+        ufunc(a[:3], b[1:], out=out[:3])
+        ufunc(a[3], b[0], out=out[3])
+    else:
+        ufunc(a[1:], b[:3], out=out[1:])
+        ufunc(a[0], b[3], out=out[0])
+    return out
+
+
 def mean_value_terms(sx, sy, ex, ey):
     """The per-corner terms r_i, A_i, D_i of HT04 section 4.2, and the diagonal terms.
 
@@ -130,9 +147,14 @@ def mean_value_terms(sx, sy, ex, ey):
         C_i = s_{i-1} x s_{i+1} and E_i = s_{i-1} . s_{i+1}, formed on demand.
     """
     sxn, syn = sx[NEXT], sy[NEXT]
-    r = np.sqrt(sx * sx + sy * sy)
-    D = sx * sxn + sy * syn
-    A = np.where(r <= r[NEXT], sx * ey - sy * ex, sxn * ey - syn * ex)
+    r = sx * sx
+    r += sy * sy
+    np.sqrt(r, out=r)
+    D = sx * sxn
+    D += sy * syn
+    shorter = _cyclic(np.less_equal, r, r, 1, bool)
+    A = np.where(shorter, sx, sxn) * ey
+    A -= np.where(shorter, sy, syn) * ex
     return r, A, D, Diagonals(sx, sy, ex, ey)
 
 
@@ -229,12 +251,15 @@ def mean_value_from_terms(r, A, D, diagonals) -> np.ndarray:
         vector e_i at the corner, and the unit vector of the nearest corner
         where sum_j mu_j is 0 or not finite.
     """
-    rr = r * r[NEXT]
-    h = rr + np.abs(D)  # r_i r_{i+1} + |D_i|: never cancels
+    rr = _cyclic(np.multiply, r, r, 1)
+    h = np.abs(D)
+    h += rr  # r_i r_{i+1} + |D_i|: never cancels
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        t = np.where(D > 0, A / h, h / A)
-        summed = t[PREV] + t
-        cols = np.flatnonzero((A[PREV] * A < 0).any(axis=0))
+        acute = D > 0
+        t = np.where(acute, A, h)
+        t /= np.where(acute, h, A)
+        summed = _cyclic(np.add, t, t, -1)
+        cols = np.flatnonzero((_cyclic(np.multiply, A, A, -1) < 0).any(axis=0))
         if cols.size:
             sub = (slice(None), cols)
             summed[sub] = _balanced_sums(r[sub], A[sub], D[sub], rr[sub], h[sub], t[sub], *diagonals.terms(cols))

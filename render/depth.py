@@ -42,11 +42,12 @@ def nearest_fragments(pixel, depth, tag, n_pixels, n_tags):
     """
     tag_bits = max(int(n_tags - 1).bit_length(), 1)
     depth_bits = 63 - tag_bits
-    bits = (depth + 3.0).view(np.int64) - _TWO_BITS  # 0 .. 2^52, monotone in depth
-    if depth_bits >= 53:
-        key = bits << tag_bits
-    else:
-        key = (bits >> (53 - depth_bits)) << tag_bits
+    # One array, worked on in place: the fragments are many.
+    key = np.add(depth, 3.0).view(np.int64)
+    key -= _TWO_BITS  # 0 .. 2^52, monotone in depth
+    if depth_bits < 53:
+        key >>= 53 - depth_bits
+    key <<= tag_bits
     key |= tag
     best = np.full(n_pixels, EMPTY, dtype=np.int64)
     np.minimum.at(best, pixel, key)

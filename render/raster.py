@@ -80,7 +80,7 @@ TRIANGLE_CORNERS = np.array([[0, 1, 2], [0, 2, 3]])
 NEAR_FAR_PLANES = np.array([[0, 0, 1.0, 1.0], [0, 0, -1.0, 1.0]])  # -w <= z <= w
 SCREEN_PLANES = np.array([[-1.0, 0, 0, 1], [1.0, 0, 0, 1], [0, -1.0, 0, 1], [0, 1.0, 0, 1]])
 DEFAULT_BATCH_FRAGMENTS = 1 << 16
-SETUP_QUADS = 1 << 16  # quads set up at once
+SETUP_QUADS = 1 << 13  # quads set up at once: their temporaries stay small enough to be reused
 SHADE_BLOCK = 1 << 14  # pixels shaded at once: temporaries stay in cache
 
 
@@ -149,10 +149,10 @@ class _Scene:
     Quads: ``corners`` (4, 4, Q) float64 clip x, y, z, w (component, corner,
     quad); ``attrs`` (4, K, Q) (corner, channel, quad); ``method_of_quad``
     (Q,) int index into ``names``. Split triangles (index 2 q + half):
-    ``planes`` (3, K + 2, 2Q), the interpolation planes (``render.planes``)
-    of rho a / w for the K attributes, of rho / w (rho = 1 except for
-    projective quads) and of NDC depth, the last also alone as
-    ``depth_planes`` (3, 2Q) for the fragment loop; ``orientation`` (2Q,)
+    ``attribute_planes`` (3, K + 1, 2Q), the interpolation planes
+    (``render.planes``) of rho a / w for the K attributes and of rho / w
+    (rho = 1 except for projective quads), and ``depth_planes`` (3, 2Q), of
+    NDC depth (each contiguous: gathers from views are slower); ``orientation`` (2Q,)
     the sign of the homogeneous determinant (+1 counter-clockwise in NDC).
     Screen triangles (the clipped, snapped pieces): ``screen``, ``parent``
     (T,) split-triangle index, ``exclusive`` (T,) True for pieces of quads
@@ -166,7 +166,7 @@ class _Scene:
     method_of_quad: np.ndarray
     corners: np.ndarray
     attrs: np.ndarray
-    planes: np.ndarray
+    attribute_planes: np.ndarray
     depth_planes: np.ndarray
     orientation: np.ndarray
     screen: ScreenTriangles
@@ -202,7 +202,7 @@ class _Scene:
             method_of_quad=method_of_quad,
             corners=np.ascontiguousarray(clip.transpose(2, 1, 0)),
             attrs=np.ascontiguousarray(attrs.transpose(1, 2, 0)),
-            planes=planes,
+            attribute_planes=np.ascontiguousarray(planes[:, :-1]),
             depth_planes=np.ascontiguousarray(planes[:, -1]),
             orientation=orientation,
             screen=ScreenTriangles.concatenate(screens),
@@ -308,11 +308,15 @@ def _draw_band(frame, scene, row_start, row_stop, selection) -> int:
     length = np.maximum(c_hi - c_lo + 1, 0)
 
     z0, zc, zr = np.take(scene.depth_planes, scene.parent[pair_tri], axis=1)
-    pair, column = expand_ranges(length)
-    column += c_lo[pair]
-    pixel = (pair_row - row_start)[pair] * width + column
-    depth = (z0 + zr * pair_row)[pair] + zc[pair] * column
-    tag = tag_order[owner][pair]
+    # Fragment k of a span (row, c_lo .. c_hi) is pixel c_lo + k; every per-fragment array is one
+    # np.repeat of a per-span value, plus k.
+    k = np.arange(length.sum()) - np.repeat(np.cumsum(length) - length, length)
+    pixel = np.repeat((pair_row - row_start) * width + c_lo, length)
+    pixel += k
+    depth = np.repeat(zc, length)
+    depth *= k
+    depth += np.repeat(z0 + zr * pair_row + zc * c_lo, length)
+    tag = np.repeat(tag_order[owner], length)
 
     if exclusive.any():
         tail = length[: rows[: np.count_nonzero(~exclusive)].sum()].sum()
@@ -325,7 +329,8 @@ def _draw_band(frame, scene, row_start, row_stop, selection) -> int:
     triangle = scene.parent[selection[winner]]
     for block in range(0, covered.size, SHADE_BLOCK):
         part = slice(block, block + SHADE_BLOCK)
-        row, col = np.divmod(covered[part], width)
+        row = covered[part] // width  # floor_divide and a product: np.divmod is several times slower
+        col = covered[part] - row * width
         _shade(frame, scene, row + row_start, col, triangle[part])
     return pixel.size
 
@@ -345,36 +350,43 @@ def _shade(frame, scene, row, col, triangle):
     """Depth and attributes of the winning fragments at pixels (row, col), (N,) each."""
     width = scene.width
     quad = triangle >> 1
-    planes = np.take(scene.planes, triangle, axis=2)
     flat = row * width + col
+    col, row = col.astype(np.float64), row.astype(np.float64)  # once, not in every plane's product
     frame.face.reshape(-1)[flat] = quad
-    frame.depth.reshape(-1)[flat] = np.clip(evaluate(planes[:, -1], col, row), -1.0, 1.0)
-    attrs = frame.attrs.reshape(scene.height * width, frame.attrs.shape[2])
-    if len(scene.names) == 1:
-        attrs[flat] = _attributes(scene, scene.names[0], planes, quad, col, row)
-        return
-    method = scene.method_of_quad[quad]
+    depth = evaluate(np.take(scene.depth_planes, triangle, axis=1), col, row)
+    frame.depth.reshape(-1)[flat] = np.clip(depth, -1.0, 1.0, out=depth)
+    # One channel at a time: scattering rows of K values is several times slower than K scatters.
+    channels = frame.attrs.reshape(scene.height * width, frame.attrs.shape[2]).T
+    method = scene.method_of_quad[quad] if len(scene.names) > 1 else None
     for code, name in enumerate(scene.names):
-        m = np.flatnonzero(method == code)
-        attrs[flat[m]] = _attributes(scene, name, np.take(planes, m, axis=2), quad[m], col[m], row[m])
+        m = np.flatnonzero(method == code) if method is not None else None
+        if m is None or m.size == flat.size:  # one method for all: no subsets to gather
+            pixels, values = flat, _attributes(scene, name, triangle, quad, col, row)
+        elif m.size:
+            pixels, values = flat[m], _attributes(scene, name, triangle[m], quad[m], col[m], row[m])
+        else:
+            continue
+        for channel, value in zip(channels, values):
+            channel[pixels] = value
 
 
-def _attributes(scene, name, planes, quad, col, row) -> np.ndarray:
-    """Attributes (N, K) of pixels (col, row) drawn by ``name`` in ``quad``, (N,) each.
+def _attributes(scene, name, triangle, quad, col, row) -> np.ndarray:
+    """Attributes (K, N) of pixels (col, row) drawn by ``name`` in split triangle ``triangle``
+    of ``quad``, (N,) each.
 
     Split and projective quads take their attributes from their triangle's
-    ``planes`` (3, K + 2, N): rho a / w over rho / w. The others weight their
+    planes (``_Scene.attribute_planes``): rho a / w over rho / w. The others weight their
     quad's corner attributes with their method's corner weights.
     """
     channels = scene.attrs.shape[1]
     if name in PLANE_METHODS:
-        v = evaluate(planes[:, : channels + 1], col, row)
-        return (v[:channels] / v[channels]).T
+        v = evaluate(np.take(scene.attribute_planes, triangle, axis=2), col, row)
+        return v[:channels] / v[channels]
     px = (col + 0.5) * (2.0 / scene.width) - 1.0
     py = 1.0 - (row + 0.5) * (2.0 / scene.height)
     weights = WEIGHTS[name](np.take(scene.corners, quad, axis=2), px, py)
     corner_attrs = np.take(scene.attrs, quad, axis=2)  # (4, K, N)
-    return sum(weights[i] * corner_attrs[i] for i in range(4)).T
+    return sum(weights[i] * corner_attrs[i] for i in range(4))
 
 
 def _checked_input(clip, attrs, width, height, method):

@@ -144,16 +144,20 @@ def row_spans(triangles: ScreenTriangles, tri, row, width):
     Returns ``c_lo, c_hi`` (P,) int64, inclusive and clamped to the image;
     ``c_lo > c_hi`` where the row misses the triangle.
     """
-    r = row.astype(np.float64)
-    K = [triangles.edge_r[e][tri] * r + triangles.edge_k[e][tri] for e in range(3)]
-    c0, c1, c2 = (triangles.edge_c[e][tri] for e in range(3))
-    c_lo = np.ceil(K[0] / c0)
-    c_hi = np.floor(K[1] / c1)
+    # All three edges at once, (3, P), in place: the pairs are as many as the fragments' spans.
+    K = np.take(triangles.edge_r, tri, axis=1)
+    K *= row.astype(np.float64)  # once: a mixed int-float product casts every element
+    K += np.take(triangles.edge_k, tri, axis=1)
+    c = np.take(triangles.edge_c, tri, axis=1)
+    horizontal_out = (c[2] == 0) & (K[2] < 0)
     with np.errstate(divide="ignore", invalid="ignore"):
-        third = K[2] / c2
-    c_lo = np.maximum(c_lo, np.where(c2 < 0, np.ceil(third), 0.0))
-    c_hi = np.minimum(c_hi, np.where(c2 > 0, np.floor(third), width - 1.0))
-    c_hi[(c2 == 0) & (K[2] < 0)] = -1.0
+        K /= c
+    c_lo, c_hi, third = K
+    np.ceil(c_lo, out=c_lo)
+    np.floor(c_hi, out=c_hi)
+    np.maximum(c_lo, np.where(c[2] < 0, np.ceil(third), 0.0), out=c_lo)
+    np.minimum(c_hi, np.where(c[2] > 0, np.floor(third), width - 1.0), out=c_hi)
+    c_hi[horizontal_out] = -1.0
     return np.maximum(c_lo, 0.0).astype(np.int64), np.minimum(c_hi, width - 1.0).astype(np.int64)
 
 

@@ -1,4 +1,5 @@
-"""What the whole suite shares: the real meshes of ../shared/meshes, and a temporary result cache.
+"""What the whole suite shares as fixtures: the real meshes of ../shared/meshes (``helpers.corpus``), and a
+temporary result cache. Shared functions and constants live in ``tests/helpers/``.
 
 Tests take the ``shared_meshes`` fixture (the folder) or a ``manifest_entry``
 argument (parametrized over MANIFEST.json). Without the folder those tests skip,
@@ -7,19 +8,10 @@ and the summary says so once.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import pytest
-
-SHARED_MESHES = Path(__file__).resolve().parents[2] / "shared" / "meshes"
-MANIFEST = SHARED_MESHES / "MANIFEST.json"
-ABSENT = f"{SHARED_MESHES} is absent: the tests on real meshes were skipped"
-
-
-def manifest_entries() -> list[dict]:
-    """MANIFEST.json's entries (file, counts, licence, ...); empty without the folder."""
-    return json.loads(MANIFEST.read_text(encoding="utf-8")) if MANIFEST.is_file() else []
+from helpers.corpus import ABSENT, MANIFEST, SHARED_MESHES, manifest_entries
 
 
 @pytest.fixture(scope="session")

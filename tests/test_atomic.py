@@ -5,29 +5,11 @@ Every node and link is made in tmp_path (the real /dev/null is never touched).
 
 import os
 import stat
-import threading
 
 import pytest
+from helpers.nodes import make_null_device, read_fifo_in_background
 
 from affinity.atomic import atomic_write
-
-
-def read_fifo_in_background(fifo):
-    """Start a reader on ``fifo``; returns a function giving what it read once the writer closed."""
-    received = {}
-
-    def reader():
-        with open(fifo, "rb") as f:
-            received["data"] = f.read()
-
-    thread = threading.Thread(target=reader, daemon=True)
-    thread.start()
-
-    def result():
-        thread.join(timeout=30)
-        return received.get("data")
-
-    return result
 
 
 def test_regular_file_is_replaced_whole_and_keeps_its_mode(tmp_path):
@@ -98,17 +80,6 @@ def test_fifo_gets_nothing_when_the_output_fails(tmp_path):
     assert stat.S_ISFIFO(os.stat(fifo).st_mode)
 
 
-def make_null_device(tmp_path):
-    """A character device with /dev/null's numbers, in tmp_path (needs root)."""
-    if os.geteuid() != 0:
-        pytest.skip("making a device node needs root")
-    device = tmp_path / "null"
-    numbers = os.stat("/dev/null").st_rdev
-    try:
-        os.mknod(device, 0o666 | stat.S_IFCHR, numbers)
-    except PermissionError:
-        pytest.skip("this container may not make device nodes")
-    return device
 
 
 def test_character_device_is_written_in_place(tmp_path):

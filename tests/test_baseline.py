@@ -5,8 +5,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from test_cli_check import run
-from test_formats import SQUARE, UNIT_UV, hits, quad_obj, trapezoid
+from helpers.cli import run
+from helpers.quads import SQUARE, UNIT_UV, hits, quad_obj, trapezoid
 
 from affinity.findings import FileReport
 from affinity.pipeline import baseline

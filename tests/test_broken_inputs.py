@@ -16,8 +16,8 @@ import subprocess
 import sys
 
 import pytest
-from test_atomic import make_null_device, read_fifo_in_background
-from test_cli_check import SQUARE, TRAPEZOID, run, write
+from helpers.cli import SQUARE, TRAPEZOID, run, write
+from helpers.nodes import make_null_device, read_fifo_in_background
 
 from affinity.errors import SkippedFile
 
@@ -193,15 +193,15 @@ def test_render_onto_a_device_node_keeps_the_node(tmp_path):
 
 def test_outputs_onto_a_symlink_keep_the_link(tmp_path):
     (tmp_path / "store").mkdir()
-    for name, command in (("image.png", RENDER), ("baseline.json", None), ("report.html", ("report", "-q"))):
+    mesh = str(write(tmp_path, "trap.obj", TRAPEZOID))  # one quad: its report is written as the demo's is
+    commands = {"image.png": [*RENDER, "-o"], "baseline.json": ["check", mesh, "--write-baseline"],
+                "report.html": ["report", mesh, "-q", "--size", "48x36", "-o"]}
+    for name, command in commands.items():
         target = tmp_path / "store" / name
         target.write_text("old")
         link = tmp_path / name
         link.symlink_to(target)
-        if command is None:
-            result = run("check", "--write-baseline", str(link), str(write(tmp_path, "trap.obj", TRAPEZOID)))
-        else:
-            result = run(*command, "-o", str(link))
+        result = run(*command, str(link))
         assert result.returncode == 0, (name, result.stderr)
         assert link.is_symlink() and os.readlink(link) == str(target), name
         assert target.read_bytes() != b"old", name

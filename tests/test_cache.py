@@ -11,10 +11,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers.cli import run
+from helpers.quads import SQUARE, UNIT_UV, quad_obj, sample_run, trapezoid
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from test_cli_check import run
-from test_formats import SQUARE, UNIT_UV, quad_obj, sample_run, trapezoid
 
 import affinity
 from affinity.findings import FileReport, RuleHits, report_from_bytes, report_to_bytes

@@ -63,11 +63,40 @@ def test_frame_bounds_sees_the_whole_box(projection, aspect):
     assert np.abs(clip[:, :2] / clip[:, 3:]).max() > 0.4
 
 
-def test_camera_matrix_is_projection_times_view_and_to_clip_is_homogeneous():
-    camera = Camera(eye=(0.0, 1.0, 5.0), target=(0.0, 0.0, 0.0), fov_y=45, aspect=4 / 3, near=0.1, far=50)
+def test_camera_projects_points_where_the_pinhole_puts_them():
+    """Closed form of a pinhole camera, from the eye's own axes (forward f, right r = f x up, up u = r x f):
+    a point at depth d = (p - eye).f lands at NDC x = (p - eye).r / (d tan(fov/2) aspect),
+    y = (p - eye).u / (d tan(fov/2)), z = (far + near) / (far - near) - 2 far near / ((far - near) d), w = d."""
+    eye, target, fov, aspect, near, far = np.array([0.0, 1.0, 5.0]), np.zeros(3), 45.0, 4 / 3, 0.1, 50.0
+    camera = Camera(eye=tuple(eye), target=tuple(target), fov_y=fov, aspect=aspect, near=near, far=far)
+    f = (target - eye) / np.linalg.norm(target - eye)
+    r = np.cross(f, [0.0, 1.0, 0.0])
+    r /= np.linalg.norm(r)
+    u = np.cross(r, f)
+    half = np.tan(np.radians(fov / 2))
+    d = np.linalg.norm(target - eye)
+    named = {  # where a point lands, by construction
+        "target": (target, (0, 0)),
+        "top edge": (target + u * d * half, (0, 1)),
+        "right edge": (target + r * d * half * aspect, (1, 0)),
+        "bottom-left corner": (target - u * d * half - r * d * half * aspect, (-1, -1)),
+    }
+    for name, (point, (x, y)) in named.items():
+        clip = to_clip(point[None], camera.matrix)[0]
+        np.testing.assert_allclose(clip[:2] / clip[3], (x, y), atol=1e-12, err_msg=name)
+        assert clip[3] == pytest.approx(d)
+    np.testing.assert_allclose(ndc(np.array([eye + near * f, eye + far * f]), camera.matrix)[:, 2], [-1, 1])
     points = np.random.default_rng(0).normal(size=(10, 3))
-    expected = (camera.projection_matrix @ camera.view @ np.hstack([points, np.ones((10, 1))]).T).T
-    assert np.allclose(to_clip(points, camera.matrix), expected)
-    assert to_clip(points, camera.matrix).dtype == np.float64
+    offset = points - eye
+    depth = offset @ f
+    expected = np.column_stack([
+        offset @ r / (depth * half * aspect),
+        offset @ u / (depth * half),
+        (far + near) / (far - near) - 2 * far * near / ((far - near) * depth),
+    ])
+    clip = to_clip(points, camera.matrix)
+    assert clip.dtype == np.float64
+    np.testing.assert_allclose(clip[:, 3], depth, rtol=1e-12)
+    np.testing.assert_allclose(clip[:, :3] / clip[:, 3:], expected, rtol=1e-10, atol=1e-12)
     with pytest.raises(ValueError):
         _ = Camera(eye=(0, 0, 1), target=(0, 0, 0), projection="fisheye").matrix

@@ -14,8 +14,8 @@ from contextlib import nullcontext
 from pathlib import Path
 
 import pytest
-from test_cli_check import run
-from test_formats import SQUARE, UNIT_UV, quad_obj, trapezoid
+from helpers.cli import run
+from helpers.quads import SQUARE, UNIT_UV, quad_obj, trapezoid
 
 from affinity.pipeline import cluster as cluster_module
 from affinity.pipeline.check import check_files

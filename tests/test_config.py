@@ -11,8 +11,8 @@ import json
 from pathlib import Path
 
 import pytest
-from test_cli_check import run
-from test_formats import UNIT_UV, quad_obj, trapezoid
+from helpers.cli import run
+from helpers.quads import UNIT_UV, quad_obj, trapezoid
 
 from affinity.config import ConfigError, Resolver, find_config
 from affinity.settings import Settings, glob_matches

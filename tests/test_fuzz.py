@@ -33,7 +33,8 @@ from collections import Counter
 from pathlib import Path
 
 import numpy as np
-from test_loaders_chunks import FIELDS, generate_obj
+from helpers.corpus import shared_mesh_paths
+from helpers.generated_obj import FIELDS, generate_obj
 
 from affinity.errors import MeshError, SkippedFile
 from affinity.lint import lint_mesh
@@ -43,7 +44,6 @@ from affinity.settings import Settings
 
 FUZZ_FILES = int(os.environ.get("AFFINITY_FUZZ_FILES", "600"))
 FUZZ_SEED = int(os.environ.get("AFFINITY_FUZZ_SEED", "17"))
-SHARED_MESHES = Path(__file__).resolve().parents[1].parent / "shared" / "meshes"
 DATA = Path(__file__).parent / "data" / "loaders"
 #: Seed files above this size are left out: mutations of small files find the same defects faster.
 LARGEST_SEED = 300_000
@@ -106,7 +106,7 @@ def generated_ply(rng: random.Random, fmt: str) -> bytes:
 def seed_files(rng: random.Random) -> list[tuple[str, bytes]]:
     """(suffix, content) of every seed: real meshes, fixtures and generated ones."""
     seeds = []
-    real = sorted(SHARED_MESHES.glob("*.obj")) if SHARED_MESHES.is_dir() else []
+    real = shared_mesh_paths("*.obj")
     for path in real + sorted(DATA.glob("*.*")):
         if path.suffix in (".obj", ".ply", ".off") and path.stat().st_size <= LARGEST_SEED:
             seeds.append((path.suffix, path.read_bytes()))

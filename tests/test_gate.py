@@ -12,8 +12,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_cli_check import TRAPEZOID, run, write
-from test_sarif import assert_valid
+from helpers.cli import SQUARE, TRAPEZOID, run, write
+from helpers.sarif import assert_valid
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -218,7 +218,8 @@ def test_show_settings_is_toml_that_reads_back(tmp_path):
     assert settings["thresholds"]["Q102"] == 3 and settings["thresholds"]["Q201"] == 1e-12
     assert settings["levels"]["Q203"] == "warning" and settings["levels"]["Q302"] == "info"
     assert settings["per-file-ignores"] == {"caf\u00e9 \U0001F600/*.obj::helper-*": ["Q101"]}
-    assert settings["exclude"] == [".git", "node_modules", "__pycache__"]
+    assert {".git", ".venv", "venv", "site-packages", "build", "dist", ".tox", ".nox", ".mypy_cache", "node_modules",
+            "__pycache__"} <= set(settings["exclude"]), "ruff's default folder names"
 
 
 @pytest.mark.parametrize("args", [
@@ -383,3 +384,29 @@ def test_output_file_is_written_whole(tmp_path):
     missing = run("check", "--output-file", str(tmp_path / "no" / "such" / "out.txt"), path)
     assert missing.returncode == 2 and "cannot write the output" in missing.stderr
     assert not (tmp_path / "no").exists()
+
+
+def test_default_excludes_skip_environments_by_name_like_ruff(tmp_path):
+    """Issue 29: a ``.venv`` without ``pyvenv.cfg`` holding a package's schema file is not walked into."""
+    (tmp_path / ".git").mkdir()
+    write(tmp_path, "panel.obj", SQUARE)
+    schema = tmp_path / ".venv" / "lib" / "python3.11" / "site-packages" / "pkg" / "generatedSchema.usda"
+    schema.parent.mkdir(parents=True)
+    schema.write_text("#usda 1.0\nclass \"Broken\" (\n")  # unreadable: checking it would exit 2
+    for name in ("venv", "build", "dist", ".tox", ".nox", ".mypy_cache", "site-packages"):
+        (tmp_path / name / "sub").mkdir(parents=True)
+        (tmp_path / name / "sub" / "other.obj").write_text("not a mesh\n")
+    result = run("check", cwd=tmp_path)
+    assert (result.returncode, result.stderr) == (0, ""), result.stdout + result.stderr
+    assert "generatedSchema" not in result.stdout and "other.obj" not in result.stdout
+    assert run("check", "--show-files", cwd=tmp_path).stdout.splitlines() == ["panel.obj"]
+
+
+def test_a_path_named_explicitly_is_checked_inside_a_default_excluded_folder(tmp_path):
+    write(tmp_path, "affinity.toml", "texture-size = 1024\n")  # a configuration root: globs match from here
+    (tmp_path / "build" / "deep").mkdir(parents=True)
+    mesh = write(tmp_path / "build" / "deep", "trapezoid.obj", TRAPEZOID)
+    assert "Q101" in run("check", str(mesh), cwd=tmp_path).stdout
+    assert run("check", "--show-files", "build", cwd=tmp_path).stdout.splitlines() == ["build/deep/trapezoid.obj"]
+    write(tmp_path, "affinity.toml", 'extend-exclude = ["deep"]\n')
+    assert run("check", "--show-files", str(mesh), cwd=tmp_path).stdout == "", "configured globs still apply"

@@ -13,17 +13,16 @@ offset 1e9, a change of 2.6e-4 that the rounded input really has.
 from __future__ import annotations
 
 import dataclasses
-from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers.corpus import ABSENT, shared_mesh_paths
 
 from affinity import scenes
 from affinity.lint import lint_mesh
 from affinity.settings import Settings
 
-MESHES = Path(__file__).resolve().parents[2] / "shared" / "meshes"
-SHARED = sorted(MESHES.glob("*.obj")) if MESHES.exists() else []
+SHARED = shared_mesh_paths("*.obj")
 DEMO_SCENES = [scenes.trapezoid, scenes.latlong_sphere, scenes.color_squares, scenes.quad_strip, scenes.demo_sphere,
                lambda: scenes.latlong_sphere(48, 24, dense_poles=True)]
 
@@ -78,7 +77,7 @@ def test_demo_scenes_keep_their_flags_when_moved_or_scaled(make):
         assert_same_flags(mesh, moved, f"{mesh.path} {what}", offset)
 
 
-@pytest.mark.skipif(not SHARED, reason="../shared/meshes is absent")
+@pytest.mark.skipif(not SHARED, reason=ABSENT)
 @pytest.mark.parametrize("path", SHARED, ids=lambda p: p.name)
 def test_shared_meshes_keep_their_flags_when_moved_or_scaled(path):
     from affinity.loaders import load

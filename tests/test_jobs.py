@@ -8,8 +8,8 @@ import sys
 from pathlib import Path
 
 import pytest
-from test_cli_check import run
-from test_formats import SQUARE, UNIT_UV, quad_obj, trapezoid
+from helpers.cli import run
+from helpers.quads import SQUARE, UNIT_UV, quad_obj, trapezoid
 
 from affinity.pipeline.check import BYTES_PER_WORKER, auto_jobs, available_cpus, check_files
 from affinity.settings import Settings

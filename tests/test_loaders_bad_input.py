@@ -197,12 +197,14 @@ def test_binary_ply_nan_and_count_mismatch(tmp_path):
 
 @pytest.mark.parametrize("name", ["textured_quads.obj", "square.off", "square.ply", "binary.ply"])
 def test_mutated_files_raise_only_mesh_errors(tmp_path, name):
-    """Seeded random byte edits of valid files: a Mesh or a MeshError, never another exception."""
+    """Seeded random byte edits of valid files: a Mesh with finite positions and corners in range, or a
+    MeshError of one line naming the file and a line within it, never another exception."""
     data = Path(__file__).parent / "data" / "loaders"
     original = binary_ply(3, struct.pack("<B3i", 3, 0, 1, 2)) if name == "binary.ply" else (data / name).read_bytes()
     rng = np.random.default_rng(sum(map(ord, name)))
     alphabet = list(b" \t\n\r/\\#-+.0123456789eEnaif\x00\xff")
     path = tmp_path / name
+    outcomes = {"mesh": 0, "error": 0}
     for _ in range(300):
         mutated = bytearray(original)
         for _ in range(rng.integers(1, 4)):
@@ -218,6 +220,15 @@ def test_mutated_files_raise_only_mesh_errors(tmp_path, name):
                 del mutated[at:]
         path.write_bytes(bytes(mutated))
         try:
-            load(path)
-        except MeshError:
-            pass
+            mesh = load(path)
+        except MeshError as err:
+            outcomes["error"] += 1
+            assert err.path == str(path) and err.reason.strip(), str(err)
+            assert "\n" not in err.reason and "Traceback" not in err.reason, err.reason
+            # At most one past the last line: a truncated PLY header names the line its end_header was due on.
+            assert 0 <= err.line <= mutated.count(b"\n") + 2, str(err)
+            continue
+        outcomes["mesh"] += 1
+        assert np.isfinite(mesh.positions).all()
+        assert ((mesh.corner_vertex >= 0) & (mesh.corner_vertex < len(mesh.positions))).all()
+    assert outcomes["error"] > 0 and outcomes["mesh"] > 0, outcomes  # both kinds of edit were made

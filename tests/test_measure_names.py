@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 
 import numpy as np
-from test_cli_check import TRAPEZOID, run, write
+from helpers.cli import TRAPEZOID, run, write
 
 #: The trapezoid (side ratio 1/2) with the unit-square uv at 1024 texels: the split's largest
 #: error (1 - r) / (1 + sqrt r)^2 and its shift at the centre (1 - r) / 4, in texels.

@@ -1,10 +1,9 @@
 """The ``error`` reading against the sampled supremum of split minus bilinear (tests/split_reference.py)."""
 
-from pathlib import Path
 
 import numpy as np
 import pytest
-from split_reference import (
+from helpers.split_reference import (
     random_convex_quad,
     random_plane_frame,
     sampled_sup,
@@ -102,11 +101,7 @@ def test_never_above_the_corner_extent_on_random_convex_and_folded_quads():
             assert np.isfinite(error).all()
 
 
-MESHES = Path(__file__).resolve().parents[2] / "shared" / "meshes"
-
-
-@pytest.mark.skipif(not MESHES.exists(), reason="../shared/meshes is absent")
-def test_never_above_the_corner_extent_on_the_shared_meshes():
+def test_never_above_the_corner_extent_on_the_shared_meshes(shared_meshes):
     """Every Q101-Q103 value of every quad (linted at threshold -inf) against the largest
     distance between two of its corner values, in the rule's unit."""
     from affinity.lint import lint_mesh
@@ -115,7 +110,7 @@ def test_never_above_the_corner_extent_on_the_shared_meshes():
     from affinity.settings import Settings
 
     checked = 0
-    for path in sorted(MESHES.glob("*.obj")):
+    for path in sorted(shared_meshes.glob("*.obj")):
         mesh = load(str(path))
         faces, corners = mesh.faces_of_size(4)
         size = image_size(mesh.texture_path()) or (1024, 1024)

@@ -1,11 +1,13 @@
 """The pre-commit hook, run by the real ``pre-commit`` against a snapshot of this checkout.
 
-``pre-commit try-repo`` installs the hook repository into a fresh virtualenv
-from a git revision. A snapshot (every file git tracks or would track, as it is
-in the working tree) committed to a temporary repository makes that revision
-equal to the working tree, uncommitted and untracked files included. Installing
-needs PyPI (setuptools, numpy) and nothing else; the pre-commit cache lives in
-the temporary folder, so the test is hermetic and takes about a minute.
+A snapshot (every file git tracks or would track, as it is in the working tree)
+committed to a temporary repository is the hook repository, so its revision equals
+the working tree, uncommitted and untracked files included. An asset repository
+names it in its ``.pre-commit-config.yaml`` as a user's would, and ``pre-commit
+run`` installs the hook into a virtualenv once (the pre-commit cache lives in the
+temporary folder, so the test is hermetic; ``try-repo`` would install it again for
+every call, into a store of its own). Installing needs PyPI (setuptools, numpy)
+and nothing else.
 """
 
 from __future__ import annotations
@@ -16,7 +18,7 @@ import subprocess
 from pathlib import Path
 
 import pytest
-from test_formats import SQUARE, UNIT_UV, quad_obj, trapezoid
+from helpers.quads import SQUARE, UNIT_UV, quad_obj, trapezoid
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -49,26 +51,29 @@ def snapshot(dest: Path) -> Path:
 
 def test_bad_mesh_fails_the_hook_and_good_mesh_passes(tmp_path):
     hook_repo = snapshot(tmp_path / "hook-repo")
+    revision = git("rev-parse", "HEAD", cwd=hook_repo).strip()
     work = tmp_path / "work"
     (work / "models").mkdir(parents=True)
     (work / "models" / "good.obj").write_text(quad_obj([(SQUARE, UNIT_UV)]))
     (work / "models" / "BAD.OBJ").write_text(quad_obj([(trapezoid(), UNIT_UV)]))
     (work / "notes.txt").write_text("not a mesh, never passed to the hook\n")
+    (work / ".pre-commit-config.yaml").write_text(
+        f"repos:\n  - repo: {hook_repo}\n    rev: {revision}\n    hooks:\n      - id: affinity-check\n")
     git("init", "-q", cwd=work)
     git("add", "-A", cwd=work)
     env = {**os.environ, "PRE_COMMIT_HOME": str(tmp_path / "cache"), "PRE_COMMIT_COLOR": "never"}
 
-    def try_repo(*files: str) -> subprocess.CompletedProcess:
+    def run_hook(*files: str) -> subprocess.CompletedProcess:
         return subprocess.run(
-            ["pre-commit", "try-repo", str(hook_repo), "affinity-check", "--verbose", "--files", *files],
+            ["pre-commit", "run", "affinity-check", "--verbose", "--files", *files],
             cwd=work, env=env, capture_output=True, text=True, timeout=600,
         )
 
-    good = try_repo("models/good.obj", "notes.txt")
+    good = run_hook("models/good.obj", "notes.txt")
     assert good.returncode == 0, good.stdout + good.stderr
     assert "No findings (1 file checked)" in good.stdout
 
-    bad = try_repo("models/good.obj", "models/BAD.OBJ")
+    bad = run_hook("models/good.obj", "models/BAD.OBJ")
     assert bad.returncode == 1, bad.stdout + bad.stderr
     assert "models/BAD.OBJ:9:1: Q101 uv-disaffine" in bad.stdout
     assert "Found 1 finding: 1 warning (2 files checked)" in bad.stdout

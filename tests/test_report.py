@@ -261,7 +261,7 @@ def test_output_into_an_unwritable_place_is_an_error_and_writes_nothing(tmp_path
 
 def test_scores_are_the_sampled_split_error_of_every_quad():
     """The report's histogram values, against the split error sampled on the quad (no affinity.measures)."""
-    from split_reference import sampled_sup
+    from helpers.split_reference import sampled_sup
 
     from affinity.lint import quad_scores
     from affinity.scenes import demo_sphere

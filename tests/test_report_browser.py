@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers.corpus import SHARED_MESHES
 
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 pytestmark = pytest.mark.skipif(CHROMIUM is None, reason="no chromium installed")
@@ -172,8 +173,7 @@ def test_screenshot_is_not_blank(loaded_report):
     assert len(colours) > 200  # the checker renders and anti-aliased text
 
 
-MESHES = Path(__file__).resolve().parents[2] / "shared" / "meshes"
-MAKEHUMAN = MESHES / "makehuman_base_hm08.obj"
+MAKEHUMAN = SHARED_MESHES / "makehuman_base_hm08.obj"
 
 #: Every SVG text's rendered height in CSS pixels: its getBBox() height times the screen scale of its element.
 TEXT_HEIGHTS = """Array.from(document.querySelectorAll("svg text")).filter(t => t.textContent.trim()).map(t => {

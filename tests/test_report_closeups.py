@@ -5,18 +5,17 @@ from __future__ import annotations
 import re
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
-from test_formats import UNIT_UV, quad_obj, trapezoid
+from helpers.corpus import ABSENT, SHARED_MESHES, shared_mesh_paths
+from helpers.quads import UNIT_UV, quad_obj, trapezoid
 
 from affinity.loaders import load
 from affinity.loaders.objwriter import write_obj
 from affinity.mesh import mesh_from_polygons
 
-MESHES = Path(__file__).resolve().parents[2] / "shared" / "meshes"
-needs_meshes = pytest.mark.skipif(not MESHES.is_dir(), reason="../shared/meshes is absent")
+needs_meshes = pytest.mark.skipif(not SHARED_MESHES.is_dir(), reason=ABSENT)
 
 
 def grid_mesh(n: int = 10, bent: tuple = ()) -> object:
@@ -239,7 +238,7 @@ def test_the_car_with_up_z_is_seen_from_the_side():
     from affinity.report.demo import MeshInput
     from affinity.settings import Settings
 
-    car = MeshInput(str(MESHES / "osd_catmark_car.obj"), "car")
+    car = MeshInput(str(SHARED_MESHES / "osd_catmark_car.obj"), "car")
     aspects = {}
     for up in ("z", "y"):
         result = collect_mesh(car, Settings(), options=ReportOptions(up=up, max_views=0))
@@ -258,7 +257,7 @@ def test_every_shared_mesh_with_flags_gets_closeups():
     from affinity.report.demo import MeshInput
     from affinity.settings import Settings
 
-    for path in sorted(MESHES.glob("*.obj")):
+    for path in shared_mesh_paths("*.obj"):
         file, _ = load_and_check(str(path), Settings())
         result = collect_mesh(MeshInput(str(path), path.name), Settings(), options=ReportOptions(max_views=2))
         flagged_rules = {hits.code for hits in file.hits if (hits.faces >= 0).any()}

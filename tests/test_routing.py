@@ -1,9 +1,10 @@
 """The hybrid's routing rule against hand-computed screen sizes and the sampled split displacement."""
 
 import numpy as np
-from split_reference import random_convex_quad, sampled_sup
+from helpers.split_reference import random_convex_quad, sampled_sup
 
 from affinity.draw.routing import (
+    clip_components,
     displacement_pixels,
     route_by_view,
     screen_area,
@@ -26,12 +27,13 @@ def square_clip(half: float, w: float = 1.0, ccw: bool = True) -> np.ndarray:
 
 def test_screen_area_of_a_centred_square():
     # NDC half-size 0.5 on a 200x100 image: 100 x 50 pixels, counter-clockwise.
-    np.testing.assert_allclose(screen_area(square_clip(0.5), 200, 100), [5000.0])
-    np.testing.assert_allclose(screen_area(square_clip(0.5, ccw=False), 200, 100), [-5000.0])
-    np.testing.assert_allclose(screen_area(square_clip(0.5, w=3.0), 200, 100), [5000.0])  # w divides out
+    np.testing.assert_allclose(screen_area(clip_components(square_clip(0.5)), 200, 100), [5000.0])
+    np.testing.assert_allclose(screen_area(clip_components(square_clip(0.5, ccw=False)), 200, 100), [-5000.0])
+    # w divides out:
+    np.testing.assert_allclose(screen_area(clip_components(square_clip(0.5, w=3.0)), 200, 100), [5000.0])
     behind = square_clip(0.5)
     behind[0, 2, 3] = -1.0
-    assert np.isnan(screen_area(behind, 200, 100)[0])
+    assert np.isnan(screen_area(clip_components(behind), 200, 100)[0])
 
 
 def test_displacement_equals_the_sampled_split_displacement_under_an_affine_camera():
@@ -43,7 +45,7 @@ def test_displacement_equals_the_sampled_split_displacement_under_an_affine_came
         screen = rng.uniform(-0.8, 0.8, size=(4, 2))
         clip = np.zeros((1, 4, 4))
         clip[0, :, :2], clip[0, :, 3] = screen, 1.0
-        pixels = displacement_pixels(uv_displacement(uv[None]), clip, 200, 100)[0]
+        pixels = displacement_pixels(uv_displacement(uv[None]), clip_components(clip), 200, 100)[0]
         uv3 = np.column_stack([uv, np.zeros(4)])
         expected = sampled_sup(uv3, screen * [100, 50], "02")
         np.testing.assert_allclose(pixels, expected, rtol=0.01)
@@ -52,7 +54,7 @@ def test_displacement_equals_the_sampled_split_displacement_under_an_affine_came
 def test_routing_sends_only_visible_displacements_to_mvc():
     # A square of 100 x 100 pixels carrying a trapezoid of uv: the split moves the texture by
     # (1 - r) / (1 + sqrt r)^2 of the quad's width along u, r = 1/2 the uv trapezoid's side ratio.
-    pixels = displacement_pixels(uv_displacement(TRAPEZOID_UV), square_clip(0.5), 200, 200)
+    pixels = displacement_pixels(uv_displacement(TRAPEZOID_UV), clip_components(square_clip(0.5)), 200, 200)
     np.testing.assert_allclose(pixels, [100 * 0.5 / (1 + np.sqrt(0.5)) ** 2], rtol=1e-9)
     clip = np.concatenate([square_clip(0.5), square_clip(0.5), square_clip(0.001), square_clip(0.5, ccw=False)])
     uv = np.concatenate([TRAPEZOID_UV, UNIT_UV, TRAPEZOID_UV, TRAPEZOID_UV])
@@ -95,4 +97,4 @@ def test_screen_area_equals_the_shoelace_sum_on_any_quad():
     clip[..., 3] = rng.uniform(0.5, 2.0, size=(200, 4))  # in front of the eye; convex, concave and bow-ties
     x, y = clip[..., 0] / clip[..., 3] * 32.0, clip[..., 1] / clip[..., 3] * 24.0
     shoelace = 0.5 * (x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y).sum(axis=1)
-    np.testing.assert_allclose(screen_area(clip, 64, 48), shoelace, rtol=1e-10, atol=1e-10)
+    np.testing.assert_allclose(screen_area(clip_components(clip), 64, 48), shoelace, rtol=1e-10, atol=1e-10)

@@ -6,7 +6,7 @@ import re
 from pathlib import Path
 
 import pytest
-from test_cli_check import run
+from helpers.cli import run
 
 from affinity.rules import RULES, SECTIONS, UNREADABLE, rule_page, rules_table
 

@@ -7,16 +7,14 @@ import json
 from pathlib import Path
 
 import pytest
-from jsonschema import Draft4Validator
-from test_cli_check import run
-from test_formats import SQUARE, UNIT_UV, hits, quad_obj, sample_run, trapezoid
+from helpers.cli import run
+from helpers.quads import SQUARE, UNIT_UV, hits, quad_obj, sample_run, trapezoid
+from helpers.sarif import assert_valid
 
 from affinity.findings import FileReport
 from affinity.output import CheckRun, sarif
 from affinity.rules import RULES, rule_page
 from affinity.settings import Settings
-
-SCHEMA = json.loads((Path(__file__).parent / "data" / "sarif" / "sarif-schema-2.1.0.json").read_text())
 
 
 def sarif_log(run_: CheckRun) -> dict:
@@ -25,10 +23,6 @@ def sarif_log(run_: CheckRun) -> dict:
     return json.loads(out.getvalue())
 
 
-def assert_valid(log: dict) -> None:
-    validator = Draft4Validator(SCHEMA, format_checker=Draft4Validator.FORMAT_CHECKER)
-    errors = sorted(validator.iter_errors(log), key=lambda e: list(e.path))
-    assert not errors, "\n".join(f"{list(e.path)}: {e.message}" for e in errors[:5])
 
 
 def test_schema_rejects_a_broken_log():

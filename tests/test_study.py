@@ -163,7 +163,12 @@ def test_on_the_trapezoid_the_split_has_the_crease_and_the_error(trapezoid_rows)
     assert split["crease_max"] > 3  # texels per pixel: the gradient jumps across the diagonal
     assert split["err_rms"] > 10 * rows["mvc"]["err_rms"]
     # Seen straight on, every corner has the same w: bilinear is exact.
-    assert rows["bilinear"]["err_rms"] < 1e-6 and rows["exact"]["err_max"] == 0
+    assert rows["bilinear"]["err_rms"] < 1e-6
+    # The split's error against exact peaks at the closed form of the trapezoid with side ratio r = 1/2
+    # carrying the unit square: (1 - r) / (1 + sqrt r)^2 of the uv width, in texels of 1024; the pixel
+    # centres sample just below that supremum.
+    sup = 1024 * 0.5 / (1 + math.sqrt(0.5)) ** 2  # 175.7 texels
+    assert 0.97 * sup < split["err_max"] <= sup * (1 + 1e-9)
     # Projective has no crease but maps the square texture as a square seen in
     # perspective: at the diagonals' crossing, a sixth of the height above the
     # trapezoid's centre, it puts the texture's centre (v = 1/2 against exact's 2/3).

@@ -21,8 +21,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_cli_check import run
-from test_sarif import assert_valid
+from helpers.cli import run
+from helpers.sarif import assert_valid
 
 import affinity.loaders.usd
 from affinity.errors import MeshError

@@ -3,7 +3,8 @@
 Without MESH it studies the built-in scenes (the paper's figures and a
 nonplanar quad strip); MESH may name files or folders of meshes. ``--quick``
 keeps three small built-in scenes at a small size and finishes in seconds (for
-CI). Writes ``study.csv``, ``summary.md`` and PNG charts into DIR.
+CI). Writes ``study.csv``, ``summary.md`` and PNG charts into DIR; ``--table`` puts the CSV elsewhere
+(the committed run writes the package's table, which the demo report reads).
 """
 
 from __future__ import annotations
@@ -23,6 +24,9 @@ def add_parser(sub) -> None:
     p.add_argument("meshes", nargs="*", metavar="MESH",
                    help="mesh files or folders to study (default: the built-in scenes)")
     p.add_argument("-o", "--output", required=True, metavar="DIR", help="folder for the CSV, summary and charts")
+    p.add_argument("--table", metavar="CSV",
+                   help="write the CSV here instead of DIR/study.csv (the committed study: --table package, the "
+                        "package's affinity/data/study/study.csv that the demo report reads)")
     p.add_argument("--quick", action="store_true", help="three small built-in scenes, small images, two repeats")
     p.add_argument("--route", choices=["view", "lint"], default="view",
                    help="lint: also sweep the lint threshold, in the error and the barycentric reading")
@@ -35,6 +39,7 @@ def add_parser(sub) -> None:
 def _command_line(args) -> str:
     """The command as it could be typed again (for the summary's header)."""
     words = ["affinity bench", *args.meshes, "-o", args.output]
+    words += ["--table", args.table] if args.table else []
     words += ["--quick"] if args.quick else []
     words += ["--route", args.route] if args.route != "view" else []
     words += [f"--size {args.size[0]}x{args.size[1]}"] if args.size else []
@@ -50,7 +55,7 @@ def run(args) -> int:
     from ..pipeline.files import collect_paths
     from ..scenes import study_scenes
     from ..study.cases import mesh_cases
-    from ..study.run import run_cases, write_outputs
+    from ..study.run import PACKAGE_TABLE, run_cases, write_outputs
     from ..study.sweep import QUICK, StudySettings
 
     settings = QUICK if args.quick else StudySettings()
@@ -74,7 +79,8 @@ def run(args) -> int:
     if not rows:
         raise UsageError("nothing could be studied" + (f": {'; '.join(skipped)}" if skipped else ""))
     try:
-        paths = write_outputs(rows, skipped, settings, args.output, _command_line(args))
+        table = PACKAGE_TABLE if args.table == "package" else args.table
+        paths = write_outputs(rows, skipped, settings, args.output, _command_line(args), table)
     except OSError as err:
         raise UsageError(f"{args.output}: cannot write ({err.strerror or err})") from None
     progress(f"wrote {', '.join(paths)}")

@@ -24,7 +24,8 @@ def show_modes() -> tuple[str, ...]:
 def add_parser(sub) -> None:
     p = sub.add_parser(
         "render", help="render a mesh with the hybrid split/mean-value rasterizer",
-        description="Render MESH (default: the built-in demo sphere) to a PNG.",
+        description="Render MESH (default: the built-in demo sphere) to a PNG. The hybrid's lint routing reads "
+                    "the configuration governing MESH (affinity.toml or [tool.affinity], as affinity check does).",
     )
     p.add_argument("mesh", nargs="?", metavar="MESH")
     p.add_argument("-o", "--output", required=True, metavar="PNG")

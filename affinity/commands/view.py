@@ -32,7 +32,7 @@ def add_parser(sub) -> None:
 
 def _scores(mesh, path: str, attribute: str | None):
     """The chosen attribute's scores under the file's configuration, None when the mesh has nothing to score."""
-    from ..config import Resolver
+    from ..config import file_settings
     from ..lint import quad_scores, scored_code_of, scored_codes
 
     if attribute is None:
@@ -43,7 +43,7 @@ def _scores(mesh, path: str, attribute: str | None):
             raise UsageError(f"{path}: the mesh has no {attribute} attribute to score")
     if code is None:
         return None
-    return quad_scores(mesh, Resolver({}).resolve(path).settings.for_file(path), code)
+    return quad_scores(mesh, file_settings(path), code)
 
 
 def run(args) -> int:

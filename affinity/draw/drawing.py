@@ -12,19 +12,61 @@ import os
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..mesh import Mesh
+from ..settings import Settings
 from .framing import camera_for
 from .quads import render_corners
 from .routing import MVC, SPLIT, route_by_view
-from .shading import OVERLAY_TINT, shade, shading_inputs
+from .shading import OVERLAY_TINT, ShadingInputs, shade, shading_inputs
+
+if TYPE_CHECKING:
+    from render.camera import Camera
 
 
 @dataclass
 class RenderOptions:
-    """How to render: see ``affinity render --help`` for each option's meaning."""
+    """How to render (``affinity render`` has a flag for each field but ``settings``).
+
+    Attributes
+    ----------
+    method : str
+        ``"hybrid"`` (split where the split is invisible, mvc elsewhere), or one
+        method for every quad: ``"split"``, ``"mvc"``, ``"bilinear"``,
+        ``"projective"``, ``"exact"`` (see ``render.rasterize_quads``).
+    route : str
+        How the hybrid decides, for uv: ``"view"`` (the split's texture
+        displacement in this view, in pixels, :mod:`.routing`) or ``"lint"``
+        (the quads the lint's uv rule flags). Colours and normals always route by
+        their lint rule.
+    pixel_tolerance : float
+        Route ``"view"``: a quad goes to mvc when the split moves its texture by
+        more than this many pixels.
+    width, height : int
+        Image size in pixels.
+    camera : ((ex, ey, ez), (tx, ty, tz), fov_deg) or None
+        Eye, target and vertical field of view in degrees; None frames the whole mesh.
+    up : ``"x"``, ``"y"``, ``"z"`` or None
+        World up axis; None: the file's (a USD stage's upAxis), else y.
+    show : ``"uv"``, ``"color"``, ``"normal"``, ``"shaded"`` or None
+        What to draw; None: uv when the mesh has it, else colours, else shading.
+    texture : str, (h, w, 3) float RGB array, or None
+        The texture for uv: an image path (its errors are fatal), an image; None:
+        the mesh's ``map_Kd`` (a missing one warns), else the checker.
+    overlay : bool
+        ``image`` is ``tinted``: the pixels of the quads sent to mvc tinted.
+    cull : bool
+        Cull back faces.
+    settings : affinity.settings.Settings or None
+        The lint settings routing reads (rule thresholds and ignores, Q301's
+        threshold for degenerate uv quads); the diagonal is always 0-2, the
+        renderer's split. None: the settings governing the mesh's file as
+        ``affinity check`` resolves them (``affinity.config.file_settings``), the
+        defaults for a mesh read from no file.
+    """
 
     method: str = "hybrid"
     route: str = "view"
@@ -34,21 +76,30 @@ class RenderOptions:
     camera: tuple | None = None
     up: str | None = None
     show: str | None = None
-    texture: str | np.ndarray | None = None  # an image path, or an (h, w, 3) float RGB image
+    texture: str | np.ndarray | None = None
     overlay: bool = False
     cull: bool = False
+    settings: Settings | None = None
 
 
 @dataclass
 class RenderResult:
-    """A finished render.
+    """A finished render, with what it was drawn from.
 
     Attributes
     ----------
-    image : (H, W, 3) float32 RGB in [0, 1]
+    mesh : the Mesh drawn
+    image : (H, W, 3) float32 RGB in [0, 1] (``tinted`` with ``RenderOptions.overlay``)
     frame : render.Frame, ``face`` indexes the render quads
     faces : (R,) int64, the mesh face of each render quad
-    methods : (R,) str, the method each render quad was drawn with
+    methods : (R,) str, the method each render quad was drawn with (the hybrid's routes)
+    method : the ``RenderOptions.method`` asked for
+    seconds : float, routing plus rasterizing time
+    camera : render.camera.Camera the quads were seen with (``matrix`` (4, 4), ``eye``, ``target``)
+    clip : (R, 4, 4) float64, the render quads' clip-space corners (x, y, z, w) as rasterized
+    inputs : affinity.draw.shading.ShadingInputs, the per-corner attributes (R, 4, K) rasterized
+    tinted : (H, W, 3) float32, the image with the pixels of the quads sent to mvc tinted
+    settings : the lint Settings the routing read
     """
 
     mesh: Mesh
@@ -58,6 +109,16 @@ class RenderResult:
     methods: np.ndarray
     method: str
     seconds: float
+    camera: Camera
+    clip: np.ndarray
+    inputs: ShadingInputs
+    tinted: np.ndarray
+    settings: Settings
+
+    @property
+    def mvc_pixels(self) -> np.ndarray:
+        """(H, W) bool: the covered pixels drawn by quads sent to mvc."""
+        return mvc_pixels(self.frame.face, self.methods)
 
     def summary(self) -> str:
         """One line: where the quads went and how long the render took."""
@@ -74,19 +135,26 @@ class RenderResult:
         write_png(path, to_pixels(self.image))
 
 
+def mvc_pixels(face: np.ndarray, methods: np.ndarray) -> np.ndarray:
+    """(H, W) bool: the pixels whose render quad (``face`` (H, W) int, -1 empty) was drawn with mvc
+    (``methods`` (R,) str)."""
+    return (face >= 0) & (methods[np.maximum(face, 0)] == MVC)
+
+
 def default_show(mesh: Mesh) -> str:
     if mesh.texcoords is not None:
         return "uv"
     return "color" if mesh.colors is not None else "shaded"
 
 
-def uv_routing_inputs(mesh: Mesh, faces: np.ndarray, uv: np.ndarray):
+def uv_routing_inputs(mesh: Mesh, faces: np.ndarray, uv: np.ndarray, settings: Settings):
     """The view-independent part of routing by view (``affinity.draw.routing``), once per mesh:
     the split's texture displacement of every render quad, and the lint's uv error
-    (along 0-2, uv units) per render quad when some uv quad is degenerate, else None."""
+    (along 0-2, uv units) per render quad when some uv quad is degenerate (Q301 at
+    the threshold of ``settings``), else None."""
     from .routing import uv_displacement
 
-    moves = uv_displacement(uv)
+    moves = uv_displacement(uv, settings.threshold("Q301"))
     uv_error = None
     if moves.degenerate.any():
         from ..lint import quad_uv_error
@@ -99,27 +167,27 @@ def uv_routing_inputs(mesh: Mesh, faces: np.ndarray, uv: np.ndarray):
 
 
 def choose_methods(mesh: Mesh, faces: np.ndarray, uv: np.ndarray | None, clip: np.ndarray,
-                   show: str, options: RenderOptions) -> np.ndarray:
+                   show: str, options: RenderOptions, settings: Settings) -> np.ndarray:
     """The method of every render quad: one name, or the hybrid's per-quad routing.
 
     ``uv`` (R, 4, 2) is the render quads' texture coordinates when the render
     shows them, else None. Routing by view projects the split's largest texture
     displacement (along the renderer's diagonal 0-2) to pixels; for colours and
-    normals, and with ``--route lint``, the lint rule of the attribute shown decides.
+    normals, and with ``--route lint``, the lint rule of the attribute shown decides, as
+    ``settings`` configure it (along 0-2).
     """
     if options.method != "hybrid":
         return np.full(len(faces), options.method)
     routes_uv = uv is not None
     if options.route == "view" and routes_uv:
-        moves, uv_error = uv_routing_inputs(mesh, faces, uv)
+        moves, uv_error = uv_routing_inputs(mesh, faces, uv, settings)
         return route_by_view(moves, uv, clip, options.width, options.height,
                              options.pixel_tolerance, options.cull, uv_error)
     from ..lint import lint_mesh, scored_code_of
-    from ..settings import Settings
 
     code = scored_code_of("uv" if routes_uv else ("color" if show == "color" else "normal"))
     flagged = np.zeros(mesh.n_faces, dtype=bool)
-    for hits in lint_mesh(mesh, Settings(select=[code], diagonal="02")):
+    for hits in lint_mesh(mesh, replace(settings, select=[code], diagonal="02")):
         flagged[hits.faces] = True
     return np.where(flagged[faces], MVC, SPLIT)
 
@@ -154,6 +222,7 @@ def render_mesh(source: str | Mesh | None, options: RenderOptions,
     """
     from render import rasterize_quads, to_clip
 
+    from ..config import file_settings
     from ..loaders import load
     from ..scenes import DEMO_SPHERE
 
@@ -162,6 +231,7 @@ def render_mesh(source: str | Mesh | None, options: RenderOptions,
         options = replace(options, camera=options.camera or view.camera, up=options.up or view.up)
     else:
         mesh = load(source) if isinstance(source, (str, os.PathLike)) else source
+    settings = options.settings or file_settings(mesh.path)
     if mesh.n_faces == 0:
         raise ValueError(f"{mesh.path}: the mesh has no faces to render")
     show = options.show or default_show(mesh)
@@ -175,7 +245,7 @@ def render_mesh(source: str | Mesh | None, options: RenderOptions,
 
     start = time.perf_counter()
     uv = None if inputs.uv is None else inputs.attrs[..., inputs.uv]
-    methods = choose_methods(mesh, faces, uv, clip, show, options)
+    methods = choose_methods(mesh, faces, uv, clip, show, options, settings)
     frame = rasterize_quads(clip, inputs.attrs, options.width, options.height, method=methods,
                             cull_backfaces=options.cull)
     seconds = time.perf_counter() - start
@@ -184,7 +254,8 @@ def render_mesh(source: str | Mesh | None, options: RenderOptions,
         warn(f"{mesh.path}: nothing is in view (try --camera)")
     direction = np.subtract(camera.eye, camera.target)
     image = shade(frame.attrs, covered, inputs, show, texture, direction / np.linalg.norm(direction))
-    if options.overlay:
-        routed = covered & (methods[np.maximum(frame.face, 0)] == MVC)
-        image[routed] = 0.55 * image[routed] + 0.45 * OVERLAY_TINT
-    return RenderResult(mesh, image, frame, faces, methods, options.method, seconds)
+    tinted = image.copy()
+    routed = mvc_pixels(frame.face, methods)
+    tinted[routed] = 0.55 * image[routed] + 0.45 * OVERLAY_TINT
+    return RenderResult(mesh, tinted if options.overlay else image, frame, faces, methods, options.method, seconds,
+                        camera, clip, inputs, tinted, settings)

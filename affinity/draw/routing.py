@@ -24,7 +24,7 @@ A quad goes to ``mvc`` when that exceeds the pixel tolerance, and also when
 - its uv triangles have opposite orientation (a fold, e.g. at a wrapped seam),
 - it is disaffine and a corner lies at or behind the near plane;
 
-a quad whose uv quad is degenerate (Q301) has no displacement and is routed by
+a quad whose uv quad is degenerate (Q301, at its configured threshold) has no displacement and is routed by
 the lint's uv error times its screen scale. Everything else -- affine quads,
 quads smaller than a pixel, quads off screen, back-facing quads when back faces
 are culled -- goes to ``split``. The decision lives here, never in ``render``.
@@ -60,7 +60,7 @@ class UvDisplacement:
     folded : (R,) bool
         The uv triangles (0, 2, 3) and (0, 1, 2) have opposite orientation.
     degenerate : (R,) bool
-        The uv quad is degenerate (Q301 at its default threshold).
+        The uv quad is degenerate (Q301 at the threshold given to ``uv_displacement``).
     """
 
     weights: np.ndarray
@@ -69,19 +69,21 @@ class UvDisplacement:
     degenerate: np.ndarray
 
 
-def uv_displacement(uv: np.ndarray) -> UvDisplacement:
+def uv_displacement(uv: np.ndarray, degenerate_at: float = RULES["Q301"].default_threshold) -> UvDisplacement:
     """Corner weights of the split's largest texture displacement along diagonal 0-2.
 
     Parameters
     ----------
     uv : (R, 4, 2) float64 texture coordinates of the render quads.
+    degenerate_at : Q301's threshold: a uv quad whose relative area is at or below it is degenerate
+        (``Settings.threshold("Q301")``; the rule's default when not given).
     """
     quads = planar_quads(uv)
     # A mirrored uv quad (clockwise) is measured as its mirror image.
     T = quads.areas * np.where(quads.areas[:, 1] + quads.areas[:, 3] < 0, -1.0, 1.0)[:, None]
     tolerance = quads.tolerance
     folded = (T[:, 1] < -tolerance) | (T[:, 3] < -tolerance)
-    degenerate = np.abs(relative_signed_area(quads)) <= RULES["Q301"].default_threshold
+    degenerate = np.abs(relative_signed_area(quads)) <= degenerate_at
     s, t = split_error_point(T[:, 1], T[:, 3])
     at = np.stack([(1 - s) * (1 - t), s * (1 - t), s * t, (1 - s) * t], axis=1)
     root = np.sqrt(np.maximum(T[:, 1], 0)) + np.sqrt(np.maximum(T[:, 3], 0))
@@ -90,18 +92,27 @@ def uv_displacement(uv: np.ndarray) -> UvDisplacement:
     return UvDisplacement(weights, at, folded, degenerate)
 
 
-def _components(clip: np.ndarray) -> np.ndarray:
-    """(R, 4, 4) clip corners -> (4, 4, R) contiguous: [component, corner], so that the
-    per-quad arithmetic below runs on contiguous rows (several times faster than on
-    the interleaved layout)."""
+def clip_components(clip: np.ndarray) -> np.ndarray:
+    """(R, 4, 4) clip corners -> (4, 4, R) contiguous: [component, corner], the layout the functions below
+    take, so that the per-quad arithmetic runs on contiguous rows (several times faster than on the
+    interleaved layout). Convert once per frame."""
     return np.ascontiguousarray(np.transpose(clip, (2, 1, 0)))
 
 
-def _screen_area(c: np.ndarray, width: int, height: int) -> np.ndarray:
-    """:func:`screen_area` of clip corners laid out by component (4, 4, R).
+def screen_area(c: np.ndarray, width: int, height: int) -> np.ndarray:
+    """Signed pixel area of each projected quad (counter-clockwise on screen is positive).
 
     The shoelace sum of a quadrilateral equals half the cross product of its
     diagonals, (p2 - p0) x (p3 - p1) / 2, for any quad (convex, concave or bow-tie).
+
+    Parameters
+    ----------
+    c : (4, 4, R) float64 clip-space corners by component (``clip_components``)
+
+    Returns
+    -------
+    (R,) float64, NaN for quads with a corner at or behind the eye (w <= 0),
+    whose projection is not a bounded quad.
     """
     w = c[3]
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -110,32 +121,13 @@ def _screen_area(c: np.ndarray, width: int, height: int) -> np.ndarray:
     return np.where((w > 0).all(axis=0), area, np.nan)
 
 
-def screen_area(clip: np.ndarray, width: int, height: int) -> np.ndarray:
-    """Signed pixel area of each projected quad (counter-clockwise on screen is positive).
-
-    Parameters
-    ----------
-    clip : (R, 4, 4) float64 clip-space corners (x, y, z, w)
-
-    Returns
-    -------
-    (R,) float64, NaN for quads with a corner at or behind the eye (w <= 0),
-    whose projection is not a bounded quad.
-    """
-    return _screen_area(_components(clip), width, height)
-
-
-def _on_screen(c: np.ndarray) -> np.ndarray:
-    """:func:`on_screen` of clip corners laid out by component (4, 4, R)."""
+def on_screen(c: np.ndarray) -> np.ndarray:
+    """(R,) bool: the quad's clip-space bounds meet the view volume (conservative); ``c`` as in
+    :func:`screen_area`."""
     x, y, z, w = c
     outside = ((x > w).all(0) | (x < -w).all(0) | (y > w).all(0) | (y < -w).all(0)
                | (z > w).all(0) | (w <= 0).all(0))
     return ~outside
-
-
-def on_screen(clip: np.ndarray) -> np.ndarray:
-    """(R,) bool: the quad's clip-space bounds meet the view volume (conservative)."""
-    return _on_screen(_components(clip))
 
 
 def _combine(weights: np.ndarray, c: np.ndarray) -> np.ndarray:
@@ -146,8 +138,20 @@ def _combine(weights: np.ndarray, c: np.ndarray) -> np.ndarray:
     return total
 
 
-def _displacement_pixels(moves: UvDisplacement, c: np.ndarray, width: int, height: int) -> np.ndarray:
-    """:func:`displacement_pixels` of clip corners laid out by component (4, 4, R)."""
+def displacement_pixels(moves: UvDisplacement, c: np.ndarray, width: int, height: int) -> np.ndarray:
+    """The split's largest texture displacement on screen, in pixels.
+
+    Parameters
+    ----------
+    moves : UvDisplacement of R quads
+    c : (4, 4, R) float64 clip-space corners by component (``clip_components``)
+
+    Returns
+    -------
+    (R,) float64; ``inf`` for a disaffine quad with a corner at or behind the
+    near plane (z < -w, or w <= 0), 0 for an affine one (a displacement below
+    ``AFFINE_DISPLACEMENT`` times the largest clip coordinate).
+    """
     X, Y, _, W = _combine(moves.at, c)
     d = _combine(moves.weights, c)
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -159,23 +163,6 @@ def _displacement_pixels(moves: UvDisplacement, c: np.ndarray, width: int, heigh
     near = ((c[2] < -c[3]) | (c[3] <= 0)).any(axis=0)
     pixels = np.where(near, np.inf, np.nan_to_num(pixels, nan=np.inf))
     return np.where(affine, 0.0, pixels)
-
-
-def displacement_pixels(moves: UvDisplacement, clip: np.ndarray, width: int, height: int) -> np.ndarray:
-    """The split's largest texture displacement on screen, in pixels.
-
-    Parameters
-    ----------
-    moves : UvDisplacement of R quads
-    clip : (R, 4, 4) float64 clip-space corners
-
-    Returns
-    -------
-    (R,) float64; ``inf`` for a disaffine quad with a corner at or behind the
-    near plane (z < -w, or w <= 0), 0 for an affine one (a displacement below
-    ``AFFINE_DISPLACEMENT`` times the largest clip coordinate).
-    """
-    return _displacement_pixels(moves, _components(clip), width, height)
 
 
 def degenerate_uv_pixels(uv_error: np.ndarray, uv: np.ndarray, area: np.ndarray) -> np.ndarray:
@@ -215,12 +202,12 @@ def route_by_view(
     -------
     (R,) array of str, ``"split"`` or ``"mvc"``.
     """
-    c = _components(clip)
-    area = _screen_area(c, width, height)
-    visible = _on_screen(c) & ~(np.abs(area) < 1.0)
+    c = clip_components(clip)
+    area = screen_area(c, width, height)
+    visible = on_screen(c) & ~(np.abs(area) < 1.0)
     if cull_backfaces:
         visible &= ~(area < 0)
-    pixels = _displacement_pixels(moves, c, width, height)
+    pixels = displacement_pixels(moves, c, width, height)
     if moves.degenerate.any():
         rows = np.flatnonzero(moves.degenerate)
         pixels[rows] = 0.0 if uv_error is None else degenerate_uv_pixels(uv_error[rows], uv[rows], area[rows])

@@ -1,13 +1,17 @@
 """Which files a run checks: the paths given, directories walked into their mesh files.
 
-A directory is walked like ruff walks a project: folders matching the
-``exclude`` globs (by default ``.git``, ``node_modules``, ``__pycache__``; the
-setting replaces them, ``extend-exclude`` adds to them) are not entered, nor
-is any virtual environment (a folder holding ``pyvenv.cfg`` or ``conda-meta/``,
-whatever its name), and files and folders that the ``.gitignore`` files
-(at every level, and those above the walk up to the repository root) or
-``.git/info/exclude`` ignore are left out. Files named explicitly are always
-checked, whatever their extension, so the loader can say what is wrong with them.
+A directory is walked like ruff walks a project: below the paths given, folders
+matching the ``exclude`` globs are not entered (by default ruff's folder names,
+``.git``, ``.venv``, ``venv``, ``site-packages``, ``build``, ``dist``, ``.tox``,
+``node_modules``, ``__pycache__`` and the like, see
+:data:`~affinity.settings.DEFAULT_EXCLUDE`; the setting replaces them,
+``extend-exclude`` adds to them), nor is any virtual environment (a folder
+holding ``pyvenv.cfg`` or ``conda-meta/``, whatever its name), and files and
+folders that the ``.gitignore`` files (at every level, and those above the walk
+up to the repository root) or ``.git/info/exclude`` ignore are left out. Files
+named explicitly are always checked, whatever their extension, so the loader can
+say what is wrong with them; a configured ``exclude`` still drops them (a
+pre-commit hook names every changed file), the default names do not.
 """
 
 from __future__ import annotations
@@ -77,9 +81,11 @@ class _Ignores:
 
 def _excluded(settings: Settings, path: str, top: str) -> bool:
     """Whether an ``exclude``/``extend-exclude`` glob matches ``path`` (relative to the configuration, else to
-    ``top``)."""
-    rel = settings.relative(path) or os.path.relpath(path, top).replace(os.sep, "/")
-    return any(glob_matches(pattern, rel) for pattern in (*settings.exclude, *settings.extend_exclude))
+    ``top``), or a default folder name matches it below ``top``, the folder the run was given."""
+    below = os.path.relpath(path, top).replace(os.sep, "/")
+    rel = settings.relative(path) or below
+    return (any(glob_matches(pattern, rel) for pattern in settings.configured_exclude)
+            or any(glob_matches(pattern, below) for pattern in settings.default_exclude))
 
 
 def walk(top: str, settings_of: Callable[[str], Settings]) -> list[str]:

@@ -4,7 +4,8 @@ The pipeline, one module per step:
 
 - :mod:`.demo` — the built-in scenes and the view each is shown from;
 - :mod:`.build` — collects, per mesh, the lint, every quad's scores
-  (:mod:`.scores`), the renders and the 3-D overview;
+  (``affinity.lint.quad_scores``), the renders and the 3-D overview;
+- :mod:`.stiffness` — the numerical stability of the hybrid's mvc pixels;
 - :mod:`.sections` — one function per section, each deciding from the
   collected data whether it appears or is left out with a one-line reason;
 - :mod:`.page` — renders the sections with the Jinja2 templates (autoescaped);

@@ -112,7 +112,7 @@ def _plain_log(axis, subs) -> None:
 def study_chart(rows: list[dict], scenes: list[str]) -> str:
     """Error against run time from the committed study, one panel per scene (2 columns), as inline SVG.
 
-    ``rows`` are the study table's rows (``reports/study/study.csv`` read as
+    ``rows`` are the study table's rows (``affinity/data/study/study.csv`` read as
     dicts of strings). Each method is its median time over the study's repeats
     with a bar from the fastest to the slowest repeat; the hybrid (routed by the
     view) is a line over its pixel tolerances. Errors of 0 are drawn at 1e-4.

@@ -16,6 +16,7 @@ import numpy as np
 
 from ..attributes import ATTRIBUTE_NAMES, ATTRIBUTES
 from ..rules import RULES, resolve_codes, with_unit
+from ..study.run import PACKAGE_TABLE
 from .build import MeshResult, ReportRun
 from .images import data_uri, heat_bar, heatmap_uri, image_uri, png_bytes
 
@@ -31,8 +32,8 @@ WORST_LISTED = 5
 #: Scores below this fraction of the threshold are affine up to rounding; they go in the first bin.
 SCORE_FLOOR = 1e-3
 MISSING_ATTRIBUTE = {field: attribute.missing for field, attribute in ATTRIBUTES.items()}
-#: The committed study (``affinity bench``'s table), shipped as package data for the demo report.
-STUDY_RESULTS = Path(__file__).resolve().parents[1] / "data" / "study" / "study.csv"
+#: The committed study (``affinity bench --table package``'s table), shipped as package data for the demo report.
+STUDY_RESULTS = Path(PACKAGE_TABLE)
 
 
 @dataclass

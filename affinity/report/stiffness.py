@@ -54,19 +54,11 @@ class SceneStability:
         return [pixel for pixel in self.checked if pixel.stiff]
 
 
-def _screen_quads(mesh, render, camera, up, size):
+def _screen_quads(render):
     """Screen corners (R, 4, 2) in NDC and w (R, 4) of the render quads, as the renderer saw them."""
-    from render import to_clip
-
-    from ..draw.framing import camera_for
-    from ..draw.quads import render_corners
-
-    _, corners = render_corners(mesh)
-    matrix = camera_for(mesh, size[0], size[1], camera, up).matrix
-    clip = to_clip(mesh.positions, matrix)[mesh.corner_vertex[corners]]
-    w = clip[..., 3]
+    w = render.clip[..., 3]
     with np.errstate(divide="ignore", invalid="ignore"):
-        return clip[..., :2] / w[..., None], w
+        return render.clip[..., :2] / w[..., None], w
 
 
 def _max_error(values, reference) -> float:
@@ -99,17 +91,20 @@ def _check(p: np.ndarray, quad: np.ndarray, w: np.ndarray, face: int, pixel) -> 
 
 
 def scene_stability(mesh, render, camera, up, size) -> SceneStability:
+    """:func:`render_stability` of ``render``, called as ``report/build.py`` calls it (the render carries
+    its own clip corners now, so the mesh, camera, up axis and size are not needed)."""
+    return render_stability(render)
+
+
+def render_stability(render) -> SceneStability:
     """Screen the mvc pixels of ``render`` (the hybrid's RenderResult) and check the worst against mpmath."""
     from render.coords import mean_value
 
-    from ..draw.routing import MVC
-
     face = render.frame.face
-    on_mvc = (face >= 0) & (render.methods[np.maximum(face, 0)] == MVC)
-    rows, cols = np.nonzero(on_mvc)
+    rows, cols = np.nonzero(render.mvc_pixels)
     if len(rows) == 0:
         return SceneStability(0, [])
-    ndc, w = _screen_quads(mesh, render, camera, up, size)
+    ndc, w = _screen_quads(render)
     quads = face[rows, cols]
     keep = (w[quads] > 0).all(axis=1)
     rows, cols, quads = rows[keep], cols[keep], quads[keep]

@@ -1,7 +1,7 @@
 """The stability table's rows and the tolerance constants they are judged by.
 
-Kept apart from the mpmath references so that reading a committed table (the
-report, ``affinity.stability.table.from_csv``) needs NumPy only.
+Kept apart from the mpmath references so that reading a committed table
+(``affinity.stability.table.from_csv``) needs NumPy only.
 """
 
 from __future__ import annotations

@@ -12,6 +12,9 @@ from .sweep import StudySettings, prepare, study_scene
 from .timing import machine_facts
 
 CSV_NAME = "study.csv"
+#: The committed study's table, package data: the demo report reads it (``affinity.report.sections``), the
+#: committed summary and charts in ``reports/study`` come from the run that wrote it.
+PACKAGE_TABLE = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "data", "study", CSV_NAME)
 SUMMARY_NAME = "summary.md"
 CHART_NAMES = ("error_vs_time.png", "hybrid_sweep.png", "relative_cost.png")
 
@@ -34,14 +37,17 @@ def run_cases(cases: list[Scene], settings: StudySettings,
 
 
 def write_outputs(rows: list[dict], skipped: list[str], settings: StudySettings, folder: str,
-                  command: str) -> list[str]:
-    """Write the CSV, the markdown summary and the charts into ``folder``; return the paths written."""
+                  command: str, table: str | None = None) -> list[str]:
+    """Write the CSV (into ``table``, default ``folder/study.csv``), the markdown summary and the charts
+    into ``folder``; return the paths written. The summary links to the table where it is."""
     from . import charts
     from .tables import summary_markdown, write_csv
 
     os.makedirs(folder, exist_ok=True)
-    paths = [os.path.join(folder, name) for name in (CSV_NAME, SUMMARY_NAME, *CHART_NAMES)]
+    paths = [table or os.path.join(folder, CSV_NAME),
+             *(os.path.join(folder, name) for name in (SUMMARY_NAME, *CHART_NAMES))]
     write_csv(rows, paths[0])
+    link = os.path.relpath(os.path.abspath(paths[0]), os.path.abspath(folder)).replace(os.sep, "/")
     when = datetime.datetime.now().astimezone().strftime("%Y-%m-%d %H:%M %Z")
     header = [
         "# Error against run time",
@@ -54,7 +60,8 @@ def write_outputs(rows: list[dict], skipped: list[str], settings: StudySettings,
         f"in texels of a {settings.texture_size}-texel texture (the checker that the PSNR/SSIM images sample); "
         "the crease is the jump of the attribute gradient across each quad's 0-2 diagonal (1-3 for split-13), "
         "in the same unit per pixel, over quads large enough to fit it. "
-        f"All rows: [{CSV_NAME}]({CSV_NAME}). Charts: " + ", ".join(f"[{n}]({n})" for n in CHART_NAMES) + ".",
+        f"All rows: [{os.path.basename(paths[0])}]({link}). "
+        "Charts: " + ", ".join(f"[{n}]({n})" for n in CHART_NAMES) + ".",
     ]
     if skipped:
         header += ["", "Not studied: " + "; ".join(skipped) + "."]

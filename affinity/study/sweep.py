@@ -32,6 +32,7 @@ import numpy as np
 
 from ..mesh import Mesh
 from ..scenes import Scene
+from ..settings import Settings
 from .metrics import crease, error_summary, psnr, ssim, texels_per_pixel
 from .timing import time_interleaved
 
@@ -74,6 +75,7 @@ class PreparedScene:
     ``faces`` (R,) the mesh face of each render quad; ``clip`` (R, 4, 4);
     ``inputs`` the attributes drawn (``affinity.draw.shading.ShadingInputs``);
     ``code`` the lint rule of the attribute shown (Q101 uv, Q102 colours);
+    ``lint`` the Settings governing the mesh's file (``affinity.config.file_settings``);
     ``routes`` maps a hybrid route name to (its per-render-quad values (R,), for
     ``"view"`` the ``affinity.draw.drawing.uv_routing_inputs``,
     the settings to sweep, the seconds the values took to compute).
@@ -88,6 +90,7 @@ class PreparedScene:
     code: str
     texture: np.ndarray | None
     light: np.ndarray
+    lint: Settings
     routes: dict = field(default_factory=dict)
 
     @property
@@ -110,15 +113,12 @@ class Config:
 
 
 def prepare(case: Scene, settings: StudySettings) -> PreparedScene:
-    """Load, frame and convert a case; compute the per-quad measures the hybrid routes on.
+    """Load, frame and convert a case (one split render gives the render quads, their clip corners and
+    attributes); compute the per-quad measures the hybrid routes on.
 
     Raises ValueError for a mesh without faces, or with neither uv nor vertex colours (nothing to compare).
     """
-    from render import to_clip
-
-    from ..draw.framing import camera_for
-    from ..draw.quads import render_corners
-    from ..draw.shading import shading_inputs
+    from ..draw.drawing import RenderOptions, render_mesh
     from ..draw.texture import checker
 
     mesh = case.mesh()
@@ -127,27 +127,31 @@ def prepare(case: Scene, settings: StudySettings) -> PreparedScene:
     show = "uv" if mesh.texcoords is not None else "color" if mesh.colors is not None else None
     if show is None:
         raise ValueError(f"{case.name}: no texture coordinates or vertex colours to compare")
-    faces, corners = render_corners(mesh)
-    camera = camera_for(mesh, settings.width, settings.height, case.view.camera, case.view.up)
-    clip = to_clip(mesh.positions, camera.matrix)[mesh.corner_vertex[corners]]
-    direction = np.subtract(camera.eye, camera.target)
-    scene = PreparedScene(case, mesh, faces, clip, shading_inputs(mesh, corners, show), show,
-                  "Q101" if show == "uv" else "Q102", checker(settings.texture_size) if show == "uv" else None,
-                  direction / np.linalg.norm(direction))
+    texture = checker(settings.texture_size) if show == "uv" else None
+    drawn = render_mesh(mesh, RenderOptions(method="split", show=show, width=settings.width, height=settings.height,
+                                            camera=case.view.camera, up=case.view.up, texture=texture))
+    direction = np.subtract(drawn.camera.eye, drawn.camera.target)
+    scene = PreparedScene(case, mesh, drawn.faces, drawn.clip, drawn.inputs, show, "Q101" if show == "uv" else "Q102",
+                          texture, direction / np.linalg.norm(direction), drawn.settings)
     scene.routes = _routes(scene, settings)
     return scene
 
 
 def _routes(scene: PreparedScene, settings: StudySettings) -> dict:
-    """Route name -> (values per render quad, settings to sweep, seconds to compute the values)."""
+    """Route name -> (values per render quad, settings to sweep, seconds to compute the values).
+
+    The lint runs with the settings governing the mesh's file (defaults for a built-in scene), in the
+    reading swept, along 0-2 and with the study's texture size.
+    """
+    from dataclasses import replace
+
     from ..draw.drawing import uv_routing_inputs
     from ..lint import quad_scores
-    from ..settings import Settings
 
     routes = {}
     if scene.show == "uv":
         start = time.perf_counter()
-        inputs = uv_routing_inputs(scene.mesh, scene.faces, scene.inputs.attrs[..., scene.inputs.uv])
+        inputs = uv_routing_inputs(scene.mesh, scene.faces, scene.inputs.attrs[..., scene.inputs.uv], scene.lint)
         routes["view"] = (inputs, settings.tolerances, time.perf_counter() - start)
     readings = [("error", settings.misplacement_thresholds)]
     if scene.show == "uv":
@@ -155,7 +159,7 @@ def _routes(scene: PreparedScene, settings: StudySettings) -> dict:
     if settings.lint_route or scene.show != "uv":
         for measure, thresholds in readings:
             start = time.perf_counter()
-            lint = Settings(measure=measure, diagonal="02", texture_size=settings.texture_size)
+            lint = replace(scene.lint, measure=measure, diagonal="02", texture_size=settings.texture_size)
             scores = quad_scores(scene.mesh, lint, scene.code)
             routes[f"lint {measure}"] = (_per_render_quad(scene, scores.faces, scores.values), thresholds,
                                          time.perf_counter() - start)

@@ -1,0 +1,58 @@
+"""The test suite's own layout: shared helpers live in ``tests/helpers/``, no test module imports another,
+and the path of the real meshes is spelled in one place (``helpers.corpus``)."""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+TESTS = Path(__file__).resolve().parent
+TEST_MODULES = sorted(TESTS.glob("test_*.py"))
+HELPERS = sorted((TESTS / "helpers").glob("*.py"))
+LOCAL_MODULES = {path.stem for path in TESTS.glob("*.py")} - {"conftest"}
+
+
+def imported_modules(path: Path) -> set[str]:
+    """Every module ``path`` imports, at any depth of the file (lazy imports included)."""
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            found |= {alias.name for alias in node.names}
+        elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
+            found.add(node.module)
+        elif isinstance(node, ast.ImportFrom):
+            found.add("." * node.level + (node.module or ""))
+    return found
+
+
+def test_the_check_sees_a_test_module_importing_another(tmp_path):
+    """The parser below is really looking: a lazy import of a sibling test module is found."""
+    module = tmp_path / "test_x.py"
+    module.write_text("def test_a():\n    from test_cli_check import run\n    import test_formats as f\n")
+    assert imported_modules(module) == {"test_cli_check", "test_formats"}
+
+
+@pytest.mark.parametrize("path", TEST_MODULES, ids=lambda p: p.name)
+def test_no_test_module_imports_another_module_of_tests(path):
+    siblings = {name for name in imported_modules(path) if name.split(".")[0] in LOCAL_MODULES or name.startswith(".")}
+    assert not siblings, f"{path.name} imports {sorted(siblings)}: move shared code into tests/helpers/"
+
+
+@pytest.mark.parametrize("path", HELPERS, ids=lambda p: p.name)
+def test_helpers_import_no_test_module(path):
+    tests = {name for name in imported_modules(path) if name.split(".")[0] in LOCAL_MODULES}
+    assert not tests, f"helpers/{path.name} imports {sorted(tests)}"
+
+
+def test_only_helpers_sit_beside_the_test_modules():
+    """Plain modules in tests/ next to test_*.py are where shared helpers used to hide."""
+    assert LOCAL_MODULES == {path.stem for path in TEST_MODULES}
+
+
+def test_the_shared_meshes_path_is_spelled_once():
+    spelling = '"shared" / ' + '"meshes"'  # in two pieces, so this file does not spell it
+    spelled = [path.relative_to(TESTS).as_posix() for path in TESTS.rglob("*.py")
+               if spelling in path.read_text(encoding="utf-8")]
+    assert spelled == ["helpers/corpus.py"]
