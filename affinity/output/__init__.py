@@ -96,7 +96,7 @@ def _rows(report: FileReport, hits: RuleHits, take: np.ndarray) -> list[tuple[in
     # Rules without a threshold (Q204, Q205, Q302) measure something else; no limit to report.
     threshold = None if rule.default_threshold is None else hits.threshold
     faces, groups, lines = hits.faces[take], hits.groups[take], hits.lines[take]
-    unit, level = hits.unit if hits.unit is not None else rule.unit, hits.level or rule.level
+    unit = hits.unit if hits.unit is not None else rule.unit
     details = [None] * len(faces) if hits.details is None else [hits.details[k] for k in np.arange(len(hits))[take]]
     usd = report.prim_face_start is not None
     if usd:  # no lines; faces count within their prim (the file-level face -1 stays -1)
@@ -117,9 +117,9 @@ def _rows(report: FileReport, hits: RuleHits, take: np.ndarray) -> list[tuple[in
             message=rule.summary if detail is None else f"{rule.summary}: {detail}",
             prim=group_name(report, g) if usd and order >= 0 else None,
         ))
-        for order, face, line, value, g, detail in zip(
+        for order, face, line, value, g, detail, level in zip(
             hits.faces[take].tolist(), faces.tolist(), lines.tolist(),
-            hits.values[take].tolist(), groups.tolist(), details,
+            hits.values[take].tolist(), groups.tolist(), details, hits.levels()[take].tolist(),
         )
     ]
 
@@ -184,16 +184,19 @@ def level_counts(reports: list[FileReport]) -> dict[str, int]:
     counts = dict.fromkeys(LEVELS, 0)
     for report in reports:
         for hits in report.hits:
-            counts[hits.level or RULES[hits.code].level] += len(hits)
+            levels, n = np.unique(hits.levels(), return_counts=True)
+            for level, count in zip(levels.tolist(), n.tolist()):
+                counts[level] += count
     return {level: n for level, n in counts.items() if n}
 
 
 def statistics(reports: list[FileReport]) -> list[dict]:
-    """Per rule with findings: ``{"code", "name", "level", "count"}`` (the level of its first file's findings)."""
+    """Per rule with findings: ``{"code", "name", "level", "count"}`` (the worst level of its findings)."""
     levels: dict[str, str] = {}
     for report in reports:
         for hits in report.hits:
-            levels.setdefault(hits.code, hits.level or RULES[hits.code].level)
+            worst = min(hits.levels().tolist(), key=LEVELS.index)
+            levels[hits.code] = min(levels.get(hits.code, worst), worst, key=LEVELS.index)
     return [{"code": code, "name": RULES[code].name, "level": levels[code], "count": n}
             for code, n in rule_counts(reports).items()]
 
