@@ -137,7 +137,7 @@ class QuadBatch:
         return planar_quads_by_component(self.uv[1])
 
 
-def _texture_size(mesh: Mesh, settings: Settings) -> tuple[tuple[int, int], bool]:
+def texture_grid(mesh: Mesh, settings: Settings) -> tuple[tuple[int, int], bool]:
     """The (w, h) texel grid of the uv: the ``map_Kd`` image's size when readable, else the
     ``texture-size`` setting; and whether it was assumed (no readable texture)."""
     size = image_size(mesh.texture_path())
@@ -157,7 +157,7 @@ def _map_quad_batches(mesh: Mesh, settings: Settings, measure, attributes=()) ->
     tables = CornerTables(mesh)
     for name in ("positions", *attributes):
         tables.prepare(name)
-    texture_size = _texture_size(mesh, settings)[0] if "texcoords" in attributes else None
+    texture_size = texture_grid(mesh, settings)[0] if "texcoords" in attributes else None
     quads = np.flatnonzero(mesh.face_sizes == 4)
 
     def run(start: int):
@@ -228,7 +228,7 @@ def lint_mesh(mesh: Mesh, settings: Settings) -> list[RuleHits]:
 def _texel_details(mesh: Mesh, settings: Settings, rule, faces: np.ndarray) -> list | None:
     """For a rule read in texels of an assumed texture: the note on the file's first finding
     (``faces`` (n,) in file order), None elsewhere; None altogether when the texture is known."""
-    if rule.unit_for(settings.measure) != "texels" or not _texture_size(mesh, settings)[1]:
+    if rule.unit_for(settings.measure) != "texels" or not texture_grid(mesh, settings)[1]:
         return None
     return [assumed_texture_note(settings.texture_size), *[None] * (len(faces) - 1)]
 
