@@ -2,7 +2,8 @@
 load, and their tables are the ones the benchmark scripts write.
 
 - Every fenced ``sh`` block runs, command by command, from a temporary directory holding what the examples
-  read of a checkout (``affinity/data/demo``); a command must exit 0, or the status its trailing ``# exit N`` comment names.
+  read of a checkout (``affinity/data/demo``); a command must exit 0, or the status its trailing
+  ``# exit N`` comment names.
   A block preceded by ``<!-- not-run: reason -->`` (installs, clusters, long runs) is not run;
   ``console`` blocks are examples of output.
 - Every ``toml`` block loads through the configuration reader as the file it is: ``pyproject.toml`` when
@@ -128,7 +129,8 @@ def table_shape(text: str) -> tuple[str, int]:
 
 @pytest.mark.parametrize("stem", sorted({b[1] for b in generated_blocks()}))
 def test_every_generating_script_runs_small(stem, tmp_path):
-    result = subprocess.run([sys.executable, str(ROOT / "benchmarks" / f"{stem}.py"), "--small", "--out", str(tmp_path)],
+    script = ROOT / "benchmarks" / f"{stem}.py"
+    result = subprocess.run([sys.executable, str(script), "--small", "--out", str(tmp_path)],
                             cwd=ROOT, capture_output=True, text=True, timeout=300)
     assert result.returncode == 0, result.stderr
     assert table_shape((tmp_path / f"{stem}.md").read_text()) == table_shape(
