@@ -8,6 +8,7 @@ from __future__ import annotations
 import io
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -19,6 +20,8 @@ from affinity.config import ConfigError, read_config
 from affinity.findings import FileReport, RuleHits
 from affinity.output import CheckRun, github, sarif
 from affinity.settings import Settings
+
+ROOT = Path(__file__).resolve().parents[1]
 
 try:
     import tomllib
@@ -183,3 +186,41 @@ def test_a_ply_with_vertices_and_no_faces_is_skipped(tmp_path):
     assert run("check", "--fail-on-skip", path).returncode == 2
     obj = str(write(tmp_path, "points.obj", "v 0 0 0\nv 1 0 0\n"))
     assert [f["code"] for f in json.loads(run("check", "--format", "json", obj).stdout)["findings"]] == ["Q205"]
+
+
+# Calibration: the default gate against the visibility line.
+
+def _calibration():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("calibration", ROOT / "benchmarks" / "calibration.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.mark.parametrize("k, exit_code", [(8, 1), (16, 0)])
+def test_a_subdivided_trapezoid_fails_only_where_its_worst_quad_shows_the_crease(k, exit_code, tmp_path):
+    """Sub-quad row j spans widths 2 - j/k to 2 - (j+1)/k under a uv square 1/k wide: an affine image of
+    the trapezoid of side ratio r = (2 - (j+1)/k) / (2 - j/k), so its error is 1024/k (1 - r) / (1 + sqrt r)^2."""
+    path = str(write(tmp_path, f"sub{k}.obj", _calibration().subdivided_trapezoid(k)))
+    result = run("check", "--format", "json", path)
+    values = [f["value"] for f in json.loads(result.stdout)["findings"]]
+    ratios = [(2 - (j + 1) / k) / (2 - j / k) for j in range(k)]
+    expected = [1024 / k * (1 - r) / (1 + math.sqrt(r)) ** 2 for r in ratios]
+    assert max(values) == pytest.approx(max(expected), rel=1e-6)
+    assert (max(expected) > 2) == bool(exit_code) and result.returncode == exit_code
+
+
+def test_the_readme_calibration_table_is_what_the_default_gate_does(shared_meshes):
+    """Each row of the generated table: exit 1 exactly where the largest uv error reaches 2 texels or another
+    rule found an error; and the shared meshes exit today as the table says."""
+    rows = json.loads((ROOT / "reports" / "bench" / "calibration.json").read_text())
+    assert len(rows) >= 10
+    for row in rows:
+        visible = row["largest"] is not None and row["largest"] > 2
+        assert row["exit"] == int(visible or row["others"] > 0), row
+        assert (row["error"] > 0) == visible, row
+    for row in rows:
+        if (shared_meshes / row["mesh"]).is_file():
+            assert run("check", "--isolated", str(shared_meshes / row["mesh"])).returncode == row["exit"], row["mesh"]
