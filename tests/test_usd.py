@@ -26,8 +26,8 @@ from test_sarif import assert_valid
 
 import affinity.loaders.usd
 from affinity.errors import MeshError
-from affinity.loaders import load
 from affinity.lint import assumed_texture_note
+from affinity.loaders import load
 from affinity.loaders.objwriter import write_obj
 from affinity.loaders.usd import UsdOptions, _Primvar, colors_per_vertex, corner_index
 from affinity.pipeline.check import check_file, check_files
