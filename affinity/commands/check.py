@@ -136,7 +136,8 @@ def add_parser(sub) -> None:
                    help="exit 2 when a file was skipped (a Git LFS pointer, a USD stage with no mesh), so a "
                         "checkout without 'git lfs pull' cannot pass with nothing checked")
     p.add_argument("--max-findings", type=_count, metavar="N",
-                   help="json/sarif: keep the worst N findings per file and rule, and say what was truncated")
+                   help="json/junit/sarif/github: keep the worst N findings per file and rule, and say what was "
+                        "truncated (without it sarif and github keep the worst 5,000 of the whole run)")
     p.add_argument("--show-files", action="store_true", help="list the files that would be checked and exit")
     p.add_argument("-o", "--output-file", metavar="PATH", help="write the output to PATH (whole or not at all)")
     p.add_argument("--scheduler", metavar="ADDRESS",
