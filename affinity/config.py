@@ -19,7 +19,8 @@ Keys (kebab-case, as in ruff)::
     [thresholds]                     # [tool.affinity.thresholds] in pyproject.toml
     Q102 = 3
     [levels]                         # [tool.affinity.levels]: error, warning or info
-    Q203 = "warning"
+    Q203 = "warning"                 # every Q203 finding is a warning
+    Q101 = {error = 3.0}             # an error above 3 texels, below it the rule's level (warning)
     [per-file-ignores]
     "scans/*" = ["Q202", "Q203"]
     "characters/*.obj::helper-*" = ["ALL"]   # path::group (OBJ g/o name, USD prim path)
@@ -52,6 +53,7 @@ from .settings import (
     measure_name,
     unknown_codes,
     unknown_levels,
+    unmeasured_codes,
     unthresholded_codes,
 )
 
@@ -135,13 +137,30 @@ def _selection(value, where: str) -> list[str]:
 
 
 def _levels(value, where: str) -> dict[str, str]:
+    """The string entries of ``[levels]`` (one level for every finding of the rule)."""
     if not isinstance(value, dict):
-        raise ConfigError(f"{where}: expected a table of rule code = \"error\" | \"warning\" | \"info\"")
-    levels = {str(code).upper(): level for code, level in value.items()}
+        raise ConfigError(f"{where}: expected a table of rule code = \"error\" | \"warning\" | \"info\" "
+                          "or {error = number}")
+    levels = {str(code).upper(): level for code, level in value.items() if not isinstance(level, dict)}
     bad = unknown_levels(levels)
     if bad:
         raise ConfigError(f"{where}: {', '.join(bad)} (expected a rule code = \"error\", \"warning\" or \"info\")")
     return levels
+
+
+def _visible(value, where: str) -> dict[str, float]:
+    """The table entries of ``[levels]``: ``Q101 = {error = 2.0}``, the visibility threshold."""
+    visible = {}
+    for code, entry in value.items() if isinstance(value, dict) else ():
+        if not isinstance(entry, dict):
+            continue
+        if set(entry) != {"error"}:
+            raise ConfigError(f"{where}.{code}: expected {{error = number}} (findings above it are errors)")
+        visible[str(code).upper()] = _number(entry["error"], f"{where}.{code}.error")
+    bad = unmeasured_codes(list(visible))
+    if bad:
+        raise ConfigError(f"{where}: {', '.join(bad)} is not a rule with a threshold to be above")
+    return visible
 
 
 def _choice(value, choices: tuple[str, ...], where: str) -> str:
@@ -231,6 +250,8 @@ def read_config(path: Path) -> dict:
             raise ConfigError(f"{prefix}unknown key {key!r} (known: threshold, {', '.join([*_KEYS, *_RUN_KEYS])})")
         name, validate = _KEYS[key]
         options[name] = validate(value, prefix + key)
+        if key == "levels":
+            options["visible"] = _visible(value, prefix + key)
     for key in _RUN_KEYS.keys() & table.keys():
         _RUN_KEYS[key](table[key], prefix + key)
     if "threshold" in table:

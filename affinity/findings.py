@@ -29,6 +29,9 @@ class RuleHits:
     level : str or None
         ``"error"``, ``"warning"`` or ``"info"`` as the file's settings set it
         (:func:`settle`); None: the rule's default.
+    error_above : float or None
+        The visibility threshold: a finding whose value is above it is an
+        ``error`` whatever ``level`` says (:meth:`levels`); None: no such threshold.
     unit : str or None
         The unit of ``values`` under the file's reading; None: the rule's unit.
     details : list of str or None
@@ -44,15 +47,25 @@ class RuleHits:
     level: str | None = None
     unit: str | None = None
     details: list[str] | None = None
+    error_above: float | None = None
 
     def __len__(self) -> int:
         return len(self.faces)
+
+    def levels(self) -> np.ndarray:
+        """(n,) str: the level of each finding (``error`` above ``error_above``, else ``level``)."""
+        from .rules import RULES
+
+        level = self.level or RULES[self.code].level
+        if self.error_above is None:
+            return np.full(len(self), level)
+        return np.where(self.values > self.error_above, "error", level)
 
     def subset(self, rows: np.ndarray) -> RuleHits:
         """The findings at ``rows`` (an index array or a boolean mask), level and unit kept."""
         details = None if self.details is None else np.asarray(self.details, dtype=object)[rows].tolist()
         return RuleHits(self.code, self.faces[rows], self.lines[rows], self.values[rows], self.threshold,
-                        self.groups[rows], self.level, self.unit, details)
+                        self.groups[rows], self.level, self.unit, details, self.error_above)
 
 
 @dataclass(eq=False)
@@ -96,7 +109,8 @@ def _matches(code: str, prefixes: list[str]) -> bool:
 
 
 def settle(hits: list[RuleHits], settings, group_names: list[str], inline=()) -> list[RuleHits]:
-    """Give lint's ``hits`` their level and unit from ``settings`` and drop the suppressed ones.
+    """Give lint's ``hits`` their level, visibility threshold and unit from ``settings`` and drop the
+    suppressed ones.
 
     Suppressed are the findings in a group that a ``path::group`` per-file
     ignore names (``settings.group_ignores``: glob over ``group_names``) and the
@@ -109,6 +123,7 @@ def settle(hits: list[RuleHits], settings, group_names: list[str], inline=()) ->
     for h in hits:
         rule = RULES[h.code]
         h.level, h.unit = settings.level(h.code), h.unit or rule.unit_for(settings.measure)
+        h.error_above = settings.error_above(h.code)
         silenced = np.zeros(len(h), dtype=bool)
         groups = [i for i, name in enumerate(group_names)
                   if any(fnmatchcase(name, glob) and _matches(h.code, codes) for glob, codes in settings.group_ignores)]
@@ -137,7 +152,7 @@ def report_to_bytes(report: FileReport) -> bytes:
 
     meta = {f.name: getattr(report, f.name) for f in fields(report) if f.name not in ("hits", "prim_face_start")}
     meta["hits"] = [{"code": h.code, "threshold": h.threshold, "level": h.level, "unit": h.unit,
-                     "details": h.details} for h in report.hits]
+                     "details": h.details, "error_above": h.error_above} for h in report.hits]
     arrays = [getattr(hits, name) for hits in report.hits for name in _HIT_ARRAYS]
     if report.prim_face_start is not None:
         arrays.append(report.prim_face_start)
@@ -169,7 +184,7 @@ def report_from_bytes(data: bytes) -> FileReport:
             raise ValueError("arrays and header disagree")
         hits = [
             RuleHits(h["code"], threshold=h["threshold"], level=h["level"], unit=h["unit"], details=h["details"],
-                     **dict(zip(_HIT_ARRAYS, arrays[4 * k : 4 * k + 4])))
+                     error_above=h["error_above"], **dict(zip(_HIT_ARRAYS, arrays[4 * k : 4 * k + 4])))
             for k, h in enumerate(meta.pop("hits"))
         ]
         prim_face_start = arrays[4 * len(hits)] if len(arrays) > 4 * len(hits) else None
@@ -179,4 +194,4 @@ def report_from_bytes(data: bytes) -> FileReport:
 
 
 _HIT_ARRAYS = ("faces", "lines", "values", "groups")
-_BLOB_MAGIC = b"QAR1"
+_BLOB_MAGIC = b"QAR2"  # QAR2: hits carry error_above

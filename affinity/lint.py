@@ -134,6 +134,19 @@ class QuadBatch:
         return planar_quads_by_component(self.uv[1])
 
 
+def texture_grid(mesh: Mesh, settings: Settings) -> tuple[tuple[int, int], bool]:
+    """The (w, h) texel grid of the uv: the ``map_Kd`` image's size when readable, else the
+    ``texture-size`` setting; and whether it was assumed (no readable texture)."""
+    size = image_size(mesh.texture_path())
+    return (size, False) if size is not None else ((settings.texture_size,) * 2, True)
+
+
+def assumed_texture_note(size: int) -> str:
+    """The remark on the first texel finding of a file whose texture is not known."""
+    return (f"no texture found, texels of an assumed {size}x{size} texture "
+            "(give the size with --texture-size or the texture-size setting)")
+
+
 def _map_quad_batches(mesh: Mesh, settings: Settings, measure, attributes=()) -> list:
     """Run ``measure(batch: QuadBatch)`` on every batch of the mesh's quads, in
     parallel threads (NumPy releases the GIL in its loops); results in file order.
@@ -141,8 +154,7 @@ def _map_quad_batches(mesh: Mesh, settings: Settings, measure, attributes=()) ->
     tables = CornerTables(mesh)
     for name in ("positions", *attributes):
         tables.prepare(name)
-    size = image_size(mesh.texture_path()) if "texcoords" in attributes else None
-    texture_size = size if size is not None else (settings.texture_size,) * 2
+    texture_size = texture_grid(mesh, settings)[0] if "texcoords" in attributes else None
     quads = np.flatnonzero(mesh.face_sizes == 4)
 
     def run(start: int):
@@ -203,10 +215,19 @@ def lint_mesh(mesh: Mesh, settings: Settings) -> list[RuleHits]:
             threshold = thresholds[rule.code]
             hits.append(
                 RuleHits(rule.code, faces, mesh.face_line[faces], values,
-                         0.0 if threshold is None else float(threshold), mesh.face_group[faces])
+                         0.0 if threshold is None else float(threshold), mesh.face_group[faces],
+                         details=_texel_details(mesh, settings, rule, faces))
             )
     order = {code: i for i, code in enumerate(RULES)}
     return sorted(hits, key=lambda h: order[h.code])
+
+
+def _texel_details(mesh: Mesh, settings: Settings, rule, faces: np.ndarray) -> list | None:
+    """For a rule read in texels of an assumed texture: the note on the file's first finding
+    (``faces`` (n,) in file order), None elsewhere; None altogether when the texture is known."""
+    if rule.unit_for(settings.measure) != "texels" or not texture_grid(mesh, settings)[1]:
+        return None
+    return [assumed_texture_note(settings.texture_size), *[None] * (len(faces) - 1)]
 
 
 def quad_uv_error(mesh: Mesh, diagonal: str = "02") -> tuple[np.ndarray, np.ndarray]:

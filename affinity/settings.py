@@ -62,8 +62,11 @@ class Settings:
     ``"path::group"`` ignores the codes only in the groups (OBJ ``g``/``o``
     names, USD prim paths) its second glob matches; :meth:`for_file` turns those
     into ``group_ignores``, (group glob, codes) pairs. ``levels`` maps rule codes
-    to the level their findings get (``error``, ``warning``, ``info``), over the
-    rule's default.
+    to the level all their findings get (``error``, ``warning``, ``info``), over the
+    rule's default. ``visible`` maps measured rules to their visibility threshold
+    (configured as ``[levels] Q101 = {error = 2.0}``): a finding above it is an
+    ``error``, one between the flag threshold and it gets the rule's level; a
+    rule in ``levels`` gets that one level whatever its values.
     """
 
     select: list[str] | None = None
@@ -75,6 +78,7 @@ class Settings:
     exclude: list[str] = field(default_factory=lambda: list(DEFAULT_EXCLUDE))
     per_file_ignores: dict[str, list[str]] = field(default_factory=dict)
     levels: dict[str, str] = field(default_factory=dict)
+    visible: dict[str, float] = field(default_factory=dict)
     extend_exclude: list[str] = field(default_factory=list)
     root: str | None = None
     group_ignores: list[tuple[str, list[str]]] = field(default_factory=list)
@@ -102,11 +106,21 @@ class Settings:
         """The level of rule ``code``'s findings: the configured one, else the rule's."""
         return self.levels.get(code, RULES[code].level)
 
+    def error_above(self, code: str) -> float | None:
+        """The visibility threshold of rule ``code``: above it a finding is an ``error``; None where
+        ``levels`` fixes the rule's level or the rule (under this reading) has none."""
+        if code in self.levels:
+            return None
+        return self.visible.get(code, RULES[code].visible_for(self.measure))
+
     def updated(self, options: dict) -> Settings:
-        """A copy with ``options`` (field name -> value) applied on top; thresholds and levels merge per rule."""
+        """A copy with ``options`` (field name -> value) applied on top; thresholds, levels and
+        visibility thresholds merge per rule (a rule given one kind of level drops the other)."""
         thresholds = {**self.thresholds, **options.get("thresholds", {})}
-        levels = {**self.levels, **options.get("levels", {})}
-        return replace(self, **{**options, "thresholds": thresholds, "levels": levels})
+        new_levels, new_visible = options.get("levels", {}), options.get("visible", {})
+        levels = {**{c: v for c, v in self.levels.items() if c not in new_visible}, **new_levels}
+        visible = {**{c: v for c, v in self.visible.items() if c not in new_levels}, **new_visible}
+        return replace(self, **{**options, "thresholds": thresholds, "levels": levels, "visible": visible})
 
     def relative(self, path: str) -> str | None:
         """``path`` relative to ``root`` with ``/`` separators, or None when it lies outside."""
@@ -187,3 +201,8 @@ def unknown_levels(levels: dict) -> list[str]:
 def unthresholded_codes(codes: list[str]) -> list[str]:
     """The entries of ``codes`` that are not rules with a threshold."""
     return [c for c in codes if c not in RULES or RULES[c].default_threshold is None]
+
+
+def unmeasured_codes(codes: list[str]) -> list[str]:
+    """The entries of ``codes`` that cannot take a visibility threshold (not rules flagging values above one)."""
+    return [c for c in codes if c not in RULES or RULES[c].default_threshold is None or RULES[c].flags != "above"]

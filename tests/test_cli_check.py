@@ -73,7 +73,7 @@ def test_barycentric_measure_uses_paper_tolerance(tmp_path):
 def test_statistics_counts_per_rule(tmp_path):
     path = str(write(tmp_path, "trapezoid.obj", TRAPEZOID))
     result = run("check", "--statistics", path)
-    assert re.search(r"^\s+1\s+Q101\s+uv-disaffine\s+\[warning\]$", result.stdout, re.M), result.stdout
+    assert re.search(r"^\s+1\s+Q101\s+uv-disaffine\s+\[error\]$", result.stdout, re.M), result.stdout
 
 
 def test_text_output_is_capped_per_rule(tmp_path):
@@ -158,8 +158,9 @@ def test_lfs_pointer_is_skipped_not_an_error(tmp_path):
 def test_vertices_without_faces_is_a_finding(tmp_path):
     path = write(tmp_path, "points.obj", "v 0 0 0\nv 1 0 0\n")
     result = run("check", "--format", "json", str(path))
-    assert result.returncode == 1
+    assert result.returncode == 0, "Q205 is a warning: the default gate fails on errors"
     assert [f["code"] for f in json.loads(result.stdout)["findings"]] == ["Q205"]
+    assert run("check", "--fail-on", "warning", str(path)).returncode == 1
 
 
 def test_demo_meshes_are_checked():

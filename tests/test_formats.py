@@ -130,8 +130,9 @@ def test_github_format_end_to_end(meshes):
     result = run("check", "--format", "github", "bad.obj", "good.obj", cwd=meshes)
     assert result.returncode == 1, result.stderr
     assert result.stdout.splitlines() == [
-        "::warning file=bad.obj,line=10,col=1,title=Q101 uv-disaffine::texture coordinates are not an affine "
-        "image of the positions (175.7 vs 0.5 texels), face 0 (line 10)",
+        "::error file=bad.obj,line=10,col=1,title=Q101 uv-disaffine::texture coordinates are not an affine "
+        "image of the positions: no texture found, texels of an assumed 1024x1024 texture (give the size with "
+        "--texture-size or the texture-size setting) (175.7 vs 0.5 texels), face 0 (line 10)",
     ]
 
 

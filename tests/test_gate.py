@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from helpers.cli import SQUARE, TRAPEZOID, run, write
+from helpers.quads import trapezoids
 from helpers.sarif import assert_valid
 
 if sys.version_info >= (3, 11):
@@ -44,14 +45,6 @@ def findings(result) -> list[dict]:
     return json.loads(result.stdout)["findings"]
 
 
-def trapezoids(widths) -> str:
-    """Separate trapezoids (bottom 2 wide, top ``w`` wide) with unit-square uv: Q101 grows as ``w`` shrinks."""
-    vertices = "".join(f"v {3 * i} 0 0\nv {3 * i + 2} 0 0\nv {3 * i + 1 + w / 2} 1 0\nv {3 * i + 1 - w / 2} 1 0\n"
-                       for i, w in enumerate(widths))
-    faces = "".join(f"f {4 * i + 1}/1 {4 * i + 2}/2 {4 * i + 3}/3 {4 * i + 4}/4\n" for i in range(len(widths)))
-    return vertices + "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n" + faces
-
-
 # 1. Levels, --fail-on, --exit-zero, the fold angle.
 
 def test_every_format_carries_the_level(tmp_path):
@@ -66,12 +59,15 @@ def test_every_format_carries_the_level(tmp_path):
 
 def test_fail_on_and_exit_zero(tmp_path):
     info = str(write(tmp_path, "mirrored.obj", MIRRORED))
-    warning = str(write(tmp_path, "trapezoid.obj", TRAPEZOID))
+    # top 1.992 of bottom 2 wide: (1 - r) / (1 + sqrt r)^2 * 1024 = 1.03 texels, a warning (under 2 texels)
+    warning = str(write(tmp_path, "mild.obj", trapezoids([1.992])))
+    error = str(write(tmp_path, "trapezoid.obj", TRAPEZOID))
     assert run("check", info).returncode == 0, "info does not fail the default gate"
     assert run("check", "--fail-on", "info", info).returncode == 1
-    assert run("check", warning).returncode == 1
-    assert run("check", "--fail-on", "error", warning).returncode == 0
-    assert run("check", "--exit-zero", warning).returncode == 0
+    assert run("check", warning).returncode == 0, "the default gate fails on errors only"
+    assert run("check", "--fail-on", "warning", warning).returncode == 1
+    assert run("check", error).returncode == 1
+    assert run("check", "--exit-zero", error).returncode == 0
     broken = str(write(tmp_path, "broken.obj", "v 0 0 0\nf 1 2 3\n"))
     assert run("check", "--exit-zero", warning, broken).returncode == 2, "unreadable input still exits 2"
     pointer = str(write(tmp_path, "pointer.obj", "version https://git-lfs.github.com/spec/v1\noid sha256:00\nsize 1\n"))
@@ -177,15 +173,15 @@ def test_max_findings_keeps_the_worst_and_json_is_compact(tmp_path):
 def test_statistics_works_with_every_format(tmp_path):
     path = str(write(tmp_path, "many.obj", trapezoids([1.0, 0.5, 0.2])))
     doc = json.loads(run("check", "--format", "json", "--statistics", path).stdout)
-    assert doc["statistics"] == [{"code": "Q101", "name": "uv-disaffine", "level": "warning", "count": 3}]
+    assert doc["statistics"] == [{"code": "Q101", "name": "uv-disaffine", "level": "error", "count": 3}]
     assert len(doc["findings"]) == 3, "statistics never remove findings"
     log = json.loads(run("check", "--format", "sarif", "--statistics", path).stdout)
     assert log["runs"][0]["properties"]["statistics"][0]["count"] == 3 and len(log["runs"][0]["results"]) == 3
     assert_valid(log)
     github = run("check", "--format", "github", "--statistics", path, cwd=tmp_path).stdout
-    assert "::notice file=.,title=statistics::3 findings of Q101 uv-disaffine (warning)" in github
+    assert "::notice file=.,title=statistics::3 findings of Q101 uv-disaffine (error)" in github
     junit = run("check", "--format", "junit", "--statistics", path).stdout
-    assert '<property name="Q101 uv-disaffine (warning)" value="3" />' in junit
+    assert '<property name="Q101 uv-disaffine (error)" value="3" />' in junit
 
 
 # 3. No silent switches.
@@ -255,7 +251,7 @@ def test_binary_ply_lines_are_zero(tmp_path):
     body = struct.pack("<12f", 0, 0, 0, 1, 0, 0, 1, 1, 3, 0, 1, 0) + struct.pack("<B4i", 4, 0, 1, 2, 3)
     path = tmp_path / "lifted.ply"
     path.write_bytes(header + body)
-    result = run("check", str(path))
+    result = run("check", "--fail-on", "warning", str(path))
     assert result.returncode == 1
     assert result.stdout.startswith(f"{path}:0:0: Q202 nonplanar-quad: ") and " degrees) [face 0]\n" in result.stdout
 

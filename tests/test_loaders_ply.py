@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from affinity.errors import MeshError
+from affinity.errors import MeshError, SkippedFile
 from affinity.loaders import load
 
 DATA = Path(__file__).parent / "data" / "loaders"
@@ -140,11 +140,13 @@ def test_binary_runs_of_mixed_face_sizes(tmp_path, fmt):
 
 
 @pytest.mark.parametrize("fmt", FORMATS)
-def test_vertices_without_faces(tmp_path, fmt):
+def test_vertices_without_faces_is_a_point_cloud_and_skipped(tmp_path, fmt):
+    """No face element, or one with no rows: a point cloud, not a mesh (skipped as ``no-mesh``)."""
     points = [("vertex", VERTEX[:3], [r[:3] for r in VERTEX_ROWS])]
     for elements in (points, points + [("face", FACE, [])]):
-        mesh = load(write_ply(tmp_path / "points.ply", fmt, elements))
-        assert mesh.n_faces == 0 and len(mesh.positions) == 5
+        with pytest.raises(SkippedFile) as skip:
+            load(write_ply(tmp_path / "points.ply", fmt, elements))
+        assert skip.value.reason == "no-mesh"
 
 
 def test_fixture():

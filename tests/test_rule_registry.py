@@ -32,7 +32,9 @@ def test_each_rules_example_triggers_that_rule_and_only_it(code, tmp_path, monke
     assert status == 1, err
     findings = json.loads(out)["findings"]
     assert {f["code"] for f in findings} == {code}
-    assert {f["level"] for f in findings} == {rule.level} and {f["unit"] for f in findings} == {rule.unit}
+    visible = rule.visible_threshold
+    expected = {"error" if visible is not None and f["value"] > visible else rule.level for f in findings}
+    assert {f["level"] for f in findings} == expected and {f["unit"] for f in findings} == {rule.unit}
     status, out, _ = check(["check", "--select", "ALL", "example.obj"], capsys)
     lines = [line for line in out.splitlines() if not line.startswith("Found ")]
     assert rule.example_output, f"{code}: the page shows what affinity check prints for its example"
@@ -69,7 +71,8 @@ def test_a_rule_registered_at_run_time_is_everywhere(synthetic_rule, tmp_path, m
     assert "| Q999 | `synthetic-rule` | warning | 3 corners |" in rules_table()
 
     monkeypatch.chdir(tmp_path)
-    status, out, _ = check(["check", "--select", "Q999", "--format", "sarif", "square.obj"], capsys)
+    status, out, _ = check(["check", "--select", "Q999", "--fail-on", "warning", "--format", "sarif", "square.obj"],
+                           capsys)
     sarif = json.loads(out)
     driver_rules = sarif["runs"][0]["tool"]["driver"]["rules"]
     assert "Q999" in [r["id"] for r in driver_rules]

@@ -26,6 +26,7 @@ from helpers.sarif import assert_valid
 
 import affinity.loaders.usd
 from affinity.errors import MeshError
+from affinity.lint import assumed_texture_note
 from affinity.loaders import load
 from affinity.loaders.objwriter import write_obj
 from affinity.loaders.usd import UsdOptions, _Primvar, colors_per_vertex, corner_index
@@ -307,7 +308,8 @@ def test_text_output_names_prim_and_face_within_it():
     assert result.returncode == 1
     assert result.stdout.splitlines()[:3] == [
         f"{SCENE}:/World/Panel:face 0: Q102 color-disaffine: {RULES['Q102'].summary} (127.5 vs 2/255)",
-        f"{SCENE}:/World/Panel:face 1: Q101 uv-disaffine: {RULES['Q101'].summary} (175.7 vs 0.5 texels)",
+        f"{SCENE}:/World/Panel:face 1: Q101 uv-disaffine: {RULES['Q101'].summary}: {assumed_texture_note(1024)} "
+        "(175.7 vs 0.5 texels)",
         f"{SCENE}:/World/Panel:face 1: Q103 normal-disaffine: {RULES['Q103'].summary} (6.525 vs 2 degrees)",
     ]
     assert result.stderr.splitlines() == [f"{SCENE}: note: {note}" for note in load(SCENE).notes]
@@ -355,7 +357,8 @@ def test_sarif_locates_by_prim_without_a_region():
 def test_github_and_junit_name_the_prim():
     github = check("--format", "github", str(SCENE)).stdout.splitlines()
     (colour,) = [line for line in github if "title=Q102" in line]
-    assert colour.startswith(f"::warning file={SCENE.relative_to(ROOT)},title=Q102 color-disaffine::")
+    # 127.5/255 is far past the 8/255 visibility threshold: an error
+    assert colour.startswith(f"::error file={SCENE.relative_to(ROOT)},title=Q102 color-disaffine::")
     assert colour.endswith(", /World/Panel face 0")
     junit = check("--format", "junit", str(SCENE)).stdout
     assert 'name="Q102 color-disaffine /World/Panel face 0"' in junit

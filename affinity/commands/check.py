@@ -128,15 +128,17 @@ def add_parser(sub) -> None:
                        help="record every current finding in FILE (counts per file, group and rule) and exit")
     p.add_argument("-j", "--jobs", type=_jobs, metavar="N",
                    help="check files in N processes (default: all CPUs, fewer when the files are small)")
-    p.add_argument("--fail-on", choices=LEVELS, default="warning",
-                   help="the lowest level whose findings make exit 1 (default: warning)")
+    p.add_argument("--fail-on", choices=LEVELS, default="error",
+                   help="the lowest level whose findings make exit 1 (default: error, a plainly visible "
+                        "crease; warning also fails on the milder ones)")
     p.add_argument("--exit-zero", action="store_true",
                    help="exit 0 even with findings (unreadable input and --fail-on-skip still exit 2)")
     p.add_argument("--fail-on-skip", action="store_true",
                    help="exit 2 when a file was skipped (a Git LFS pointer, a USD stage with no mesh), so a "
                         "checkout without 'git lfs pull' cannot pass with nothing checked")
     p.add_argument("--max-findings", type=_count, metavar="N",
-                   help="json/sarif: keep the worst N findings per file and rule, and say what was truncated")
+                   help="json/junit/sarif/github: keep the worst N findings per file and rule, and say what was "
+                        "truncated (without it sarif and github keep the worst 5,000 of the whole run)")
     p.add_argument("--show-files", action="store_true", help="list the files that would be checked and exit")
     p.add_argument("-o", "--output-file", metavar="PATH", help="write the output to PATH (whole or not at all)")
     p.add_argument("--scheduler", metavar="ADDRESS",
@@ -324,10 +326,10 @@ def run(args) -> int:
 
 def _fails(reports, fail_on: str) -> bool:
     """Whether any finding is at level ``fail_on`` or above (error > warning > info)."""
-    from ..rules import LEVELS, RULES
+    from ..rules import LEVELS
 
-    worse = LEVELS[: LEVELS.index(fail_on) + 1]
-    return any((h.level or RULES[h.code].level) in worse for r in reports for h in r.hits)
+    worse = set(LEVELS[: LEVELS.index(fail_on) + 1])
+    return any(not worse.isdisjoint(h.levels().tolist()) for r in reports for h in r.hits)
 
 
 def _write_output_file(path: str | None, write) -> None:

@@ -10,7 +10,10 @@ offsets are found in runs of rows of equal size (see :func:`_row_starts`).
 Used: vertex ``x y z``, ``nx ny nz``, ``red green blue`` (integer types scaled
 to [0, 1]), texture coordinates (``s t``, ``u v``, ``texture_u texture_v``,
 ``texture_s texture_t``); face ``vertex_indices``/``vertex_index`` and per-face
-``texcoord`` lists (two numbers per corner). Everything else is skipped.
+``texcoord`` lists (two numbers per corner). Everything else is skipped. A file
+with vertices and neither faces nor triangle strips is a point cloud, not a mesh:
+it is skipped (``no-mesh``, :class:`~affinity.errors.SkippedFile`), as a USD
+stage without a mesh is; OBJ and OFF files without faces get Q205 instead.
 """
 
 from __future__ import annotations
@@ -19,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import MeshError
+from ..errors import MeshError, SkippedFile
 from ..mesh import Mesh
 from .faces import check_indices, polygon_mesh, ragged_positions, unit_colors, whole_indices
 from .text import read_rows
@@ -308,6 +311,8 @@ def _mesh(path, elements, columns) -> Mesh:
         notes.append(f"{len(sizes)} triangles read from {len(strips[0])} triangle strip list"
                      f"{'s' * (len(strips[0]) != 1)}"
                      + (f" ({dropped} degenerate joining triangles left out)" if dropped else ""))
+    if len(sizes) == 0 and len(positions):
+        raise SkippedFile(path, "no-mesh")  # a point cloud: vertices, no faces, no strips
     texcoords = corner_texcoord = normals = colors = None
     if all(k in vertex for k in ("nx", "ny", "nz")):
         normals = np.stack([vertex[k] for k in ("nx", "ny", "nz")], axis=1).astype(np.float64)

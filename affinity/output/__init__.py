@@ -19,6 +19,8 @@ from ..rules import LEVELS, RULES, with_unit
 from ..settings import Settings
 
 FORMATS = ("text", "json", "sarif", "github", "junit")
+#: SARIF results / GitHub annotations per run without ``--max-findings``: code scanning takes at most 25,000.
+RUN_CAP = 5000
 
 
 @dataclass
@@ -29,7 +31,8 @@ class CheckRun:
     governed by another configuration file have their own); ``baselined`` maps a
     path to the number of its findings a baseline hid (None: no baseline was used).
     ``max_findings`` caps the findings the structured formats keep per file and
-    rule (the worst; ``--max-findings``); ``statistics`` asks for per-rule counts.
+    rule (the worst; ``--max-findings``); without it SARIF and GitHub output keep
+    at most ``run_cap`` per run (:meth:`capped`). ``statistics`` asks for per-rule counts.
     """
 
     reports: list[FileReport]
@@ -37,6 +40,7 @@ class CheckRun:
     baselined: dict[str, int] | None = None
     max_findings: int | None = None
     statistics: bool = False
+    run_cap: int = RUN_CAP
 
     def tally(self) -> dict[str, int]:
         """Counts for a summary: ``files``, ``checked``, ``unreadable``, ``skipped``, ``findings``, ``baselined``."""
@@ -54,6 +58,21 @@ class CheckRun:
     def kept(self, report: FileReport) -> list[Finding]:
         """The findings of ``report`` a structured format writes: all, or the worst ``max_findings`` per rule."""
         return file_findings(report, self.max_findings, worst=True)[0]
+
+    def capped(self, findings: list[Finding]) -> list[int]:
+        """Indices (rising) of the ``findings`` (of the whole run) a capped format keeps: all with
+        ``--max-findings`` or up to ``run_cap`` of them, else the ``run_cap`` worst (:func:`severity`)."""
+        if self.max_findings is not None or len(findings) <= self.run_cap:
+            return list(range(len(findings)))
+        keys = np.array([severity(f) for f in findings], dtype=float)  # (n, 2)
+        return np.sort(np.lexsort((keys[:, 1], keys[:, 0]))[: self.run_cap]).tolist()
+
+    def cap_notice(self, kept: int, total: int, what: str) -> str | None:
+        """The truncation line (notification and stderr) when the cap left findings out, else None."""
+        if kept == total:
+            return None
+        return (f"{what} truncated: the worst {kept:,} of {total:,} findings are kept (at most {self.run_cap:,} "
+                "per run by default; --max-findings N keeps the worst N per file and rule instead)")
 
 
 @dataclass(slots=True)
@@ -96,7 +115,7 @@ def _rows(report: FileReport, hits: RuleHits, take: np.ndarray) -> list[tuple[in
     # Rules without a threshold (Q204, Q205, Q302) measure something else; no limit to report.
     threshold = None if rule.default_threshold is None else hits.threshold
     faces, groups, lines = hits.faces[take], hits.groups[take], hits.lines[take]
-    unit, level = hits.unit if hits.unit is not None else rule.unit, hits.level or rule.level
+    unit = hits.unit if hits.unit is not None else rule.unit
     details = [None] * len(faces) if hits.details is None else [hits.details[k] for k in np.arange(len(hits))[take]]
     usd = report.prim_face_start is not None
     if usd:  # no lines; faces count within their prim (the file-level face -1 stays -1)
@@ -117,11 +136,19 @@ def _rows(report: FileReport, hits: RuleHits, take: np.ndarray) -> list[tuple[in
             message=rule.summary if detail is None else f"{rule.summary}: {detail}",
             prim=group_name(report, g) if usd and order >= 0 else None,
         ))
-        for order, face, line, value, g, detail in zip(
+        for order, face, line, value, g, detail, level in zip(
             hits.faces[take].tolist(), faces.tolist(), lines.tolist(),
-            hits.values[take].tolist(), groups.tolist(), details,
+            hits.values[take].tolist(), groups.tolist(), details, hits.levels()[take].tolist(),
         )
     ]
+
+
+def severity(f: Finding) -> tuple[int, float]:
+    """A sort key, lowest the worst: (level rank, error first; minus how far the value is beyond the
+    threshold, as a ratio; findings without a measured ratio (Q204, Q205, ...) first within their level)."""
+    rule = RULES[f.code]
+    measured = f.threshold is not None and f.threshold > 0 and rule.flags == "above"
+    return LEVELS.index(f.level), -(f.value / f.threshold) if measured else -np.inf
 
 
 def _worst_first(hits: RuleHits) -> np.ndarray:
@@ -184,16 +211,19 @@ def level_counts(reports: list[FileReport]) -> dict[str, int]:
     counts = dict.fromkeys(LEVELS, 0)
     for report in reports:
         for hits in report.hits:
-            counts[hits.level or RULES[hits.code].level] += len(hits)
+            levels, n = np.unique(hits.levels(), return_counts=True)
+            for level, count in zip(levels.tolist(), n.tolist()):
+                counts[level] += count
     return {level: n for level, n in counts.items() if n}
 
 
 def statistics(reports: list[FileReport]) -> list[dict]:
-    """Per rule with findings: ``{"code", "name", "level", "count"}`` (the level of its first file's findings)."""
+    """Per rule with findings: ``{"code", "name", "level", "count"}`` (the worst level of its findings)."""
     levels: dict[str, str] = {}
     for report in reports:
         for hits in report.hits:
-            levels.setdefault(hits.code, hits.level or RULES[hits.code].level)
+            worst = min(hits.levels().tolist(), key=LEVELS.index)
+            levels[hits.code] = min(levels.get(hits.code, worst), worst, key=LEVELS.index)
     return [{"code": code, "name": RULES[code].name, "level": levels[code], "count": n}
             for code, n in rule_counts(reports).items()]
 

@@ -2,8 +2,11 @@
 
 At most one annotation per file and rule (GitHub shows only a handful per step
 anyway): it stands on the worst finding's line and gives the count, the worst
-value and the first few faces with their lines. Its level is the findings'
-(``error`` -> ``::error``, ``warning`` -> ``::warning``, ``info`` -> ``::notice``);
+value and the first few faces with their lines. Its level is the worst finding's
+(``error`` -> ``::error``, ``warning`` -> ``::warning``, ``info`` -> ``::notice``).
+Without ``--max-findings`` a run writes at most 5,000 of them, those of the worst
+findings (:meth:`affinity.output.CheckRun.capped`), and says what it cut in a
+``::warning`` and one line on stderr;
 unreadable files are ``::error`` with title ``Q901 unreadable``, skipped files
 ``::notice``. ``--statistics`` adds one ``::notice`` per rule with its count. Paths are
 relative to the working directory (the checkout in a workflow step). Escaping
@@ -13,6 +16,7 @@ values also ``:`` and ``,``.
 
 from __future__ import annotations
 
+import sys
 from typing import TextIO
 
 from ..rules import UNREADABLE
@@ -48,6 +52,8 @@ def annotation(level: str, message: str, file: str, line: int = 0, col: int = 0,
 
 
 def write(run: CheckRun, out: TextIO) -> None:
+    rules = [(report, hits, worst_findings(report, hits, 1)[0]) for report in run.reports for hits in report.hits]
+    kept = {id(rules[i][1]): rules[i][2] for i in run.capped([worst for _, _, worst in rules])}
     for report in run.reports:
         path = working_relative(report.path) or report.path
         if report.error is not None:
@@ -56,16 +62,20 @@ def write(run: CheckRun, out: TextIO) -> None:
         elif report.skipped is not None:
             out.write(annotation("notice", f"skipped ({report.skipped})", path, title="skipped") + "\n")
         for hits in report.hits:
-            out.write(_rule_annotation(report, hits, path) + "\n")
+            if id(hits) in kept:
+                out.write(_rule_annotation(report, hits, kept[id(hits)], path) + "\n")
+    truncated = run.cap_notice(len(kept), len(rules), "GitHub annotations (one per file and rule)")
+    if truncated is not None:
+        out.write(annotation("warning", truncated, ".", title="truncated") + "\n")
+        sys.stderr.write(f"affinity: {truncated}\n")
     if run.statistics:
         for row in statistics(run.reports):
             out.write(annotation("notice", f"{row['count']} findings of {row['code']} {row['name']} ({row['level']})",
                                  ".", title="statistics") + "\n")
 
 
-def _rule_annotation(report, hits, path: str) -> str:
-    """The one annotation of a rule in a file."""
-    worst = worst_findings(report, hits, 1)[0]
+def _rule_annotation(report, hits, worst, path: str) -> str:
+    """The one annotation of a rule in a file, standing on its ``worst`` finding."""
     first = first_findings(report, hits, FIRST_FACES)
 
     def where(f) -> str:

@@ -18,9 +18,13 @@ findings that share all four, in file order. It changes when the quad itself
 changes, which makes it a new finding.
 
 Each result's ``level`` is the finding's (SARIF's ``note`` for ``info``).
-With ``--max-findings N`` each file keeps the worst N results per rule, and
-the run's ``properties.truncated`` lists, per file and rule cut, how many were
-kept of the total; ``--statistics`` adds ``properties.statistics`` (per-rule
+Without ``--max-findings`` the run keeps at most 5,000 results (code scanning
+accepts 25,000), the worst (errors first, then by how far beyond the threshold;
+:meth:`affinity.output.CheckRun.capped`), in file order, and says so in a tool
+execution notification and one line on stderr. With ``--max-findings N`` each
+file keeps the worst N results per rule instead, and the run's
+``properties.truncated`` lists, per file and rule cut, how many were kept of
+the total; ``--statistics`` adds ``properties.statistics`` (per-rule
 counts). The log is written compact.
 
 Unreadable (Q901) and skipped files are not results: they are tool execution
@@ -32,6 +36,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import sys
 from pathlib import Path
 from typing import TextIO
 from urllib.parse import quote
@@ -85,30 +90,44 @@ def fingerprint(code: str, uri: str, group: str, value: float, ordinal: int) -> 
     return hashlib.sha256(text.encode("utf-8")).hexdigest()[:32]
 
 
-def _results(run: CheckRun, report: FileReport) -> list[dict]:
-    location = artifact_location(report.path)
+def _numbered(run: CheckRun, report: FileReport) -> list[tuple[Finding, int]]:
+    """The file's findings, each with its ordinal among those of the same rule, group and value."""
     seen: dict[tuple, int] = {}
-    rule_index = {code: i for i, code in enumerate(RULES)}  # registered rules, as the driver lists them
-    results = []
+    numbered = []
     for f in run.kept(report):
         identity = (f.code, f.group, value_token(f.value))
-        seen[identity] = ordinal = seen.get(identity, -1) + 1
-        result_location: dict = {"physicalLocation": _physical(location, f.line, f.column)}
-        logical = _logical_location(f)
-        if logical:
-            result_location["logicalLocations"] = [logical]
-        results.append({
-            "ruleId": f.code,
-            "ruleIndex": rule_index[f.code],
-            "level": sarif_level(f.level),
-            "message": {"text": located(f)},
-            "locations": [result_location],
-            "partialFingerprints": {FINGERPRINT: fingerprint(f.code, location["uri"], f.group, f.value, ordinal)},
-            "properties": {"name": f.name, "face": f.face, "value": f.value,
-                           "threshold": f.threshold, "unit": f.unit, "level": f.level, "group": f.group,
-                           **({} if f.prim is None else {"prim": f.prim})},
-        })
-    return results
+        seen[identity] = seen.get(identity, -1) + 1
+        numbered.append((f, seen[identity]))
+    return numbered
+
+
+def _result(f: Finding, ordinal: int, location: dict, rule_index: int) -> dict:
+    result_location: dict = {"physicalLocation": _physical(location, f.line, f.column)}
+    logical = _logical_location(f)
+    if logical:
+        result_location["logicalLocations"] = [logical]
+    return {
+        "ruleId": f.code,
+        "ruleIndex": rule_index,
+        "level": sarif_level(f.level),
+        "message": {"text": located(f)},
+        "locations": [result_location],
+        "partialFingerprints": {FINGERPRINT: fingerprint(f.code, location["uri"], f.group, f.value, ordinal)},
+        "properties": {"name": f.name, "face": f.face, "value": f.value,
+                       "threshold": f.threshold, "unit": f.unit, "level": f.level, "group": f.group,
+                       **({} if f.prim is None else {"prim": f.prim})},
+    }
+
+
+def _results(run: CheckRun) -> tuple[list[dict], str | None]:
+    """The run's results (capped, :meth:`CheckRun.capped`) and the truncation notice (None: nothing cut)."""
+    rows = [(f, ordinal, report.path) for report in run.reports for f, ordinal in _numbered(run, report)]
+    kept = run.capped([f for f, _, _ in rows])
+    rule_index = {code: i for i, code in enumerate(RULES)}  # registered rules, as the driver lists them
+    locations = {report.path: artifact_location(report.path) for report in run.reports}
+    results = [_result(f, ordinal, locations[path], rule_index[f.code])
+               for f, ordinal, path in (rows[i] for i in kept)]
+    return results, run.cap_notice(len(kept), len(rows), "SARIF results")
 
 
 def _logical_location(f: Finding) -> dict | None:
@@ -121,8 +140,8 @@ def _logical_location(f: Finding) -> dict | None:
     return {"name": face_label(f), "fullyQualifiedName": qualified, "kind": "element"}
 
 
-def _notifications(reports: list[FileReport]) -> list[dict]:
-    notes = []
+def _notifications(reports: list[FileReport], truncated: str | None) -> list[dict]:
+    notes = [] if truncated is None else [{"level": "warning", "message": {"text": truncated}}]
     for report in reports:
         if report.error is not None:
             notes.append({
@@ -152,6 +171,9 @@ def document(run: CheckRun) -> dict:
         properties["truncated"] = truncation(run, run.max_findings)
     if run.statistics:
         properties["statistics"] = statistics(run.reports)
+    results, truncated = _results(run)
+    if truncated is not None:
+        sys.stderr.write(f"affinity: {truncated}\n")
     return {
         "$schema": SARIF_SCHEMA,
         "version": SARIF_VERSION,
@@ -167,11 +189,11 @@ def document(run: CheckRun) -> dict:
             }},
             "invocations": [{
                 "executionSuccessful": all(r.error is None for r in run.reports),
-                "toolExecutionNotifications": _notifications(run.reports),
+                "toolExecutionNotifications": _notifications(run.reports, truncated),
             }],
             "originalUriBaseIds": {SRCROOT: {"uri": _folder_uri(Path.cwd())}},
             "columnKind": "unicodeCodePoints",
-            "results": [result for report in run.reports for result in _results(run, report)],
+            "results": results,
             **({"properties": properties} if properties else {}),
         }],
     }

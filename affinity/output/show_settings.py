@@ -35,8 +35,14 @@ def _comment(text: str) -> str:
     return "# " + text.replace("\r", " ").replace("\n", " ")
 
 
+def _level(settings: Settings, code: str) -> str:
+    """A ``[levels]`` value: ``"warning"``, or ``{error = 2.0}`` for a rule with a visibility threshold."""
+    above = settings.error_above(code)
+    return _toml(settings.level(code)) if above is None else f"{{error = {_toml(float(above))}}}"
+
+
 def settings_toml(settings: Settings) -> list[str]:
-    """The settings as ``affinity.toml`` lines, every rule's effective threshold included."""
+    """The settings as ``affinity.toml`` lines, every rule's effective thresholds (flag and visibility) included."""
     lines = [
         f"select = {_toml(settings.select if settings.select is not None else ['ALL'])}",
         f"ignore = {_toml(settings.ignore or [])}",
@@ -51,7 +57,7 @@ def settings_toml(settings: Settings) -> list[str]:
     lines += [f"{code} = {_toml(float(settings.threshold(code)))}"
               for code, rule in RULES.items() if rule.default_threshold is not None]
     lines += ["", "[levels]"]
-    lines += [f"{code} = {_toml(settings.level(code))}" for code in RULES]
+    lines += [f"{code} = {_level(settings, code)}" for code in RULES]
     lines += ["", "[per-file-ignores]"]
     lines += [f"{_toml(glob)} = {_toml(codes)}" for glob, codes in settings.per_file_ignores.items()]
     return lines

@@ -26,7 +26,7 @@ REFERENCES = (
 )
 
 
-@rule(code="Q101", name="uv-disaffine", unit="texels", default_threshold=0.5, attribute="texcoords", scored=True,
+@rule(code="Q101", name="uv-disaffine", unit="texels", default_threshold=0.5, visible_threshold=2.0, attribute="texcoords", scored=True,
       readings={"barycentric": ("barycentric score", BARYCENTRIC_TOLERANCE)}, why=CREASE, references=REFERENCES)
 def uv_disaffinity(quads) -> tuple:
     """Texture coordinates are not an affine image of the positions.
@@ -35,7 +35,9 @@ def uv_disaffinity(quads) -> tuple:
         Measures, per quad, the largest difference between the two-triangle split
         and the quad's own bilinear interpolation of its texture coordinates, in
         texels (texture size from the material's map_Kd image, else the
-        texture-size setting), and flags quads above the threshold. With --measure
+        texture-size setting; the first finding of a file says when the size was
+        assumed), and flags quads above the threshold: a warning up to 2 texels,
+        an error above, where the crease is plainly visible. With --measure
         centre it takes the split's shift at the quad's centre instead, with
         --measure barycentric the paper's dimensionless score at .01. On the
         example's trapezoid (side ratio r = 1/2) the split shifts the texture at
@@ -56,7 +58,7 @@ def uv_disaffinity(quads) -> tuple:
         f 1/1 2/2 3/3 4/4
 
     Prints:
-        example.obj:10:1: Q101 uv-disaffine: texture coordinates are not an affine image of the positions (175.7 vs 0.5 texels) [face 0]
+        example.obj:10:1: Q101 uv-disaffine: texture coordinates are not an affine image of the positions: no texture found, texels of an assumed 1024x1024 texture (give the size with --texture-size or the texture-size setting) (175.7 vs 0.5 texels) [face 0]
 
     How to fix:
         Re-UV the quad as a parallelogram matching its shape (Blender: UV > Follow
@@ -71,14 +73,15 @@ def uv_disaffinity(quads) -> tuple:
     return rows, texels(quads.split_error(rows, uv).T, quads.texture_size)
 
 
-@rule(code="Q102", name="color-disaffine", unit="1/255", default_threshold=2.0, attribute="colors", scored=True,
+@rule(code="Q102", name="color-disaffine", unit="1/255", default_threshold=2.0, visible_threshold=8.0, attribute="colors", scored=True,
       why=CREASE, references=REFERENCES)
 def color_disaffinity(quads) -> tuple:
     """Vertex colours are not an affine image of the positions.
 
     What it does:
         Measures the largest difference between the split's and the quad's bilinear
-        vertex colour, in 1/255 steps, and flags quads above the threshold.
+        vertex colour, in 1/255 steps, and flags quads above the threshold: a
+        warning up to 8/255, an error above, where the seam is plainly visible.
 
     Example:
         # a unit square with corner colours blue, red, green, black: no parallelogram in colour space
@@ -99,7 +102,7 @@ def color_disaffinity(quads) -> tuple:
     return rows, color_steps(quads.split_error(rows, colors).T)
 
 
-@rule(code="Q103", name="normal-disaffine", unit="degrees", default_threshold=2.0, attribute="normals", scored=True,
+@rule(code="Q103", name="normal-disaffine", unit="degrees", default_threshold=2.0, visible_threshold=8.0, attribute="normals", scored=True,
       why=CREASE, references=REFERENCES)
 def normal_disaffinity(quads) -> tuple:
     """Normals are not an affine image of the positions.
@@ -107,7 +110,8 @@ def normal_disaffinity(quads) -> tuple:
     What it does:
         Measures how far the split turns the interpolated normal at its worst point,
         atan2(|split - bilinear|, |mean corner normal|) in degrees, and flags quads
-        above the threshold.
+        above the threshold: a warning up to 8 degrees, an error above, where the
+        bend in the shading is plainly visible.
 
     Example:
         # a flat square whose corner normals lean out unevenly: the lighting bends along the diagonal

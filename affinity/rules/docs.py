@@ -27,6 +27,13 @@ def threshold_text(rule: Rule) -> str:
     return "" if rule.default_threshold is None else with_unit(f"{rule.default_threshold:g}", rule.unit)
 
 
+def level_text(rule: Rule) -> str:
+    """``"warning"``, or ``"warning; error above 2 texels"`` for a rule with a visibility threshold."""
+    if rule.visible_threshold is None:
+        return rule.level
+    return f"{rule.level}; error above {with_unit(f'{rule.visible_threshold:g}', rule.unit)}"
+
+
 def with_unit(number: str, unit: str) -> str:
     """``"0.5 texels"``; a unit ``1/N`` reads as a fraction (``"2/255"``, not ``"2 1/255"``)."""
     if unit.startswith("1/"):
@@ -50,7 +57,10 @@ def rule_page(rule: Rule, markdown: bool = False) -> str:
     Plain text for ``affinity rule``, Markdown for SARIF ``help.markdown``.
     Sections a rule leaves empty (References on Q205) are left out.
     """
-    facts = f"Level: {rule.level}."
+    facts = f"Level: {level_text(rule)}"
+    if rule.visible_threshold is not None:
+        facts += f", where it is plainly visible (setting levels.{rule.code} = {{error = {rule.visible_threshold:g}}})"
+    facts += "."
     if threshold_text(rule):
         facts += f" Default threshold: {threshold_text(rule)} (setting thresholds.{rule.code})."
     sections = [(title, getattr(rule, attr)) for title, attr in SECTIONS if getattr(rule, attr)]
@@ -77,7 +87,7 @@ def rules_table() -> str:
     ]
     for rule in (*RULES.values(), UNREADABLE):
         rows.append(
-            f"| {rule.code} | `{rule.name}` | {rule.level} | {threshold_text(rule) or '-'} "
+            f"| {rule.code} | `{rule.name}` | {level_text(rule)} | {threshold_text(rule) or '-'} "
             f"| {rule.summary} | {rule.fix} |"
         )
     return "\n".join(rows) + "\n"

@@ -49,6 +49,9 @@ class Rule:
     level : ``"error"``, ``"warning"`` or ``"info"`` (overridable per rule)
     unit : the unit of the measured values (``"texels"``, ``"1/255"``, ``"degrees"``)
     default_threshold : the threshold in ``unit``; None for a rule without one
+    visible_threshold : the visibility threshold in ``unit``: a finding above it is an ``error``
+        (the crease is plainly visible), one between ``default_threshold`` and it gets ``level``;
+        None: every finding gets ``level``
     flags : ``"above"`` (values above the threshold are flagged) or ``"at-or-below"``
     worst : ``"highest"`` or ``"lowest"``: which end of the values is the worst
     attribute : the Mesh field read besides the positions (``"texcoords"``,
@@ -74,6 +77,7 @@ class Rule:
     level: str = "warning"
     unit: str = ""
     default_threshold: float | None = None
+    visible_threshold: float | None = None
     flags: str = "above"
     worst: str = "highest"
     attribute: str | None = None
@@ -99,6 +103,11 @@ class Rule:
     def default_for(self, measure: str) -> float | None:
         """The default threshold under the ``measure`` reading."""
         return self.readings.get(measure, (None, self.default_threshold))[1]
+
+    def visible_for(self, measure: str) -> float | None:
+        """The default visibility threshold under the ``measure`` reading (None where the reading
+        changes the unit: the barycentric score has no calibrated visibility threshold)."""
+        return None if measure in self.readings else self.visible_threshold
 
     def flagged(self, values: np.ndarray, threshold: float) -> np.ndarray:
         """(n,) bool: which of ``values`` (n,) the rule flags at ``threshold``."""

@@ -49,3 +49,11 @@ def sample_run() -> CheckRun:
         ],
         Settings(),
     )
+
+
+def trapezoids(widths) -> str:
+    """Separate trapezoids (bottom 2 wide, top ``w`` wide) with unit-square uv: Q101 grows as ``w`` shrinks."""
+    vertices = "".join(f"v {3 * i} 0 0\nv {3 * i + 2} 0 0\nv {3 * i + 1 + w / 2} 1 0\nv {3 * i + 1 - w / 2} 1 0\n"
+                       for i, w in enumerate(widths))
+    faces = "".join(f"f {4 * i + 1}/1 {4 * i + 2}/2 {4 * i + 3}/3 {4 * i + 4}/4\n" for i in range(len(widths)))
+    return vertices + "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n" + faces
