@@ -33,8 +33,8 @@ def add_parser(sub) -> None:
     p.add_argument("-o", "--output", default="report.html", metavar="HTML",
                    help="where to write the report (default: report.html)")
     p.add_argument("--up", choices=["x", "y", "z"], default=None,
-                   help="world up axis (default: the stage's upAxis for USD, else guessed: z for a surface of "
-                        "revolution standing on z, else y)")
+                   help="world up axis (default: the stage's upAxis for USD, else guessed from the shape: z for a "
+                        "surface of revolution standing on z or a shape lying on z (a car, a terrain), else y)")
     p.add_argument("--size", type=image_size, default=RENDER_SIZE, metavar="WxH",
                    help=f"size of the renders and the 3-D overview (default: {RENDER_SIZE[0]}x{RENDER_SIZE[1]})")
     p.add_argument("--camera", type=camera, metavar="EX,EY,EZ,TX,TY,TZ,FOV",
