@@ -228,7 +228,11 @@ def test_surfaces_of_revolution_stand_on_their_axis_and_everything_else_is_y_up(
     tile = grid_mesh(3)  # a square tile in the z = 0 plane lies flat: z up, seen from above
     assert guess_up_axis(tile) == "z"
     wall = mesh_from_polygons("wall", tile.positions * [1.0, 2.0, 1.0], tile.corner_vertex.reshape(-1, 4))
-    assert guess_up_axis(wall) == "y"  # no two equal extents: the OBJ convention
+    # Issue 25: a sheet thinnest along z whose faces all face z reads as ground (a heightfield), z up; a
+    # standing sheet, facing y, stays with the OBJ convention.
+    assert guess_up_axis(wall) == "z"
+    standing = mesh_from_polygons("standing", wall.positions[:, [0, 2, 1]], tile.corner_vertex.reshape(-1, 4))
+    assert guess_up_axis(standing) == "y"
 
 
 @needs_meshes

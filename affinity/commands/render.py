@@ -37,7 +37,8 @@ def add_parser(sub) -> None:
     p.add_argument("--size", type=image_size, default=(800, 600), metavar="WxH")
     p.add_argument("--camera", type=camera, metavar="EX,EY,EZ,TX,TY,TZ,FOV")
     p.add_argument("--up", choices=["x", "y", "z"], default=None,
-                   help="world up axis (default: the stage's upAxis for USD, else y; z for the demo)")
+                   help="world up axis (default: the stage's upAxis for USD, else guessed from the shape: z for a "
+                        "surface of revolution standing on z or a shape lying on z (a car, a terrain), else y)")
     p.add_argument("--show", choices=show_modes(), type=spelling,
                    help="what to draw (default: uv when the mesh has it, else color, else shaded)")
     p.add_argument("--texture", metavar="IMAGE", help="texture image for uv (default: map_Kd, else a checker)")

@@ -34,8 +34,8 @@ def add_parser(sub) -> None:
     p.add_argument("-o", "--output", default="report.html", metavar="HTML",
                    help="where to write the report (default: report.html)")
     p.add_argument("--up", choices=["x", "y", "z"], default=None,
-                   help="world up axis (default: the stage's upAxis for USD, else guessed: z for a surface of "
-                        "revolution standing on z, else y)")
+                   help="world up axis (default: the stage's upAxis for USD, else guessed from the shape: z for a "
+                        "surface of revolution standing on z or a shape lying on z (a car, a terrain), else y)")
     p.add_argument("--size", type=image_size, default=RENDER_SIZE, metavar="WxH",
                    help=f"size of the renders and the 3-D overview (default: {RENDER_SIZE[0]}x{RENDER_SIZE[1]})")
     p.add_argument("--camera", type=camera, metavar="EX,EY,EZ,TX,TY,TZ,FOV",
@@ -97,12 +97,15 @@ def _write(path: str, html: str) -> None:
 
 
 def run(args) -> int:
+    import time
+
     from tqdm import tqdm
 
     from ..config import Resolver
     from ..report.build import ReportOptions, collect_run
     from ..report.page import render_page
 
+    start = time.perf_counter()
     require(("PIL", "jinja2", "matplotlib", "mpmath"), "report")
     _check_writable(args.output)
     if args.texture:
@@ -124,8 +127,10 @@ def run(args) -> int:
         if len(inputs) == 1 and skipped:  # a report of nothing: say so, write nothing
             raise UsageError(f"{skipped[0].path}: skipped ({skipped[0].skipped}): nothing to report")
         bar.set_postfix_str("writing the page")
+        collected = time.perf_counter()
         html = render_page(report)
     _write(args.output, html)
+    finished = time.perf_counter()
 
     failed = [result.file for result in report.meshes if result.file.error is not None]
     for file in failed:
@@ -137,5 +142,6 @@ def run(args) -> int:
         unreadable += f", {len(skipped)} skipped" if skipped else ""
         sys.stderr.write(f"affinity report: wrote {args.output} "
                          f"({len(inputs)} file{'s' * (len(inputs) != 1)}{unreadable}, "
-                         f"{len(html.encode()) / 1e6:.1f} MB, {report.seconds:.1f} s)\n")
+                         f"{len(html.encode()) / 1e6:.1f} MB, {finished - start:.1f} s wall: "
+                         f"{report.seconds:.1f} s collecting, {finished - collected:.1f} s writing the page)\n")
     return EXIT_ERROR if failed or skipped else EXIT_CLEAN

@@ -1,15 +1,20 @@
 """Close-ups: a camera on a few faces of a mesh and the neighbourhood it needs to draw.
 
-A close-up looks at a place (one or more neighbouring faces) along its mean
-normal, tilted a little, from the distance that fits the place and its ring of
-neighbouring faces in the picture. Only the faces near the place are drawn
-(within a few radii, and nothing more than a radius in front of it), so the place
-shows whether or not the rest of the mesh hides it from the overview's camera.
+A close-up looks at a place (one or more neighbouring faces) from the side it is
+seen from, from the distance that fits the place and its ring of neighbouring
+faces in the picture. The side is chosen by visibility, never by the stored
+winding alone: a few candidate directions (the mean normal and its opposite, each
+tilted a little three ways) are drawn at low resolution with the depth test, and
+the one where the place's own faces cover the most pixels wins (a left-handed
+file, whose normals point inward, is seen from outside all the same). Only the
+faces near the place are drawn (within a few radii, and nothing more than a radius
+in front of it), so the place shows whether or not the rest of the mesh hides it
+from the overview's camera.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -23,6 +28,8 @@ TILT_DEGREES = 20.0
 FILL = 0.85
 #: Faces whose centroid is within this many ring radii of the place are drawn.
 DRAWN_RADII = 2.5
+#: Side of the visibility pre-pass that picks the view direction, pixels.
+PREPASS_SIZE = 64
 #: A ring reaching farther than this many place radii (long neighbours, a pole) is framed at that distance.
 RING_RADII = 3.0
 
@@ -35,12 +42,14 @@ class CloseupView:
     up : the world axis name (``"x"``, ``"y"``, ``"z"``) least aligned with the view direction
     drawn : (D,) int64, the mesh faces to draw (the place, its ring and what lies around them)
     ring : (N,) int64, the place's faces and every face sharing a vertex with them
+    visible : the fraction of the pre-pass picture (``PREPASS_SIZE`` squared) the place's faces cover
     """
 
     camera: tuple
     up: str
     drawn: np.ndarray
     ring: np.ndarray
+    visible: float = 0.0
 
 
 def face_vertices(mesh: Mesh, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -68,40 +77,52 @@ def face_centroids(mesh: Mesh) -> np.ndarray:
     return total / mesh.face_sizes[:, None]
 
 
-def mean_normal(mesh: Mesh, faces: np.ndarray) -> np.ndarray:
-    """(3,) unit area-weighted normal of ``faces`` (Newell's vector area of each polygon), or +z if they cancel."""
+def vector_areas(mesh: Mesh, faces: np.ndarray) -> np.ndarray:
+    """(F, 3) float64: twice each polygon's vector area (Newell: sum of p_k x p_k+1 over its corners)."""
     vertices, _ = face_vertices(mesh, faces)
     p = mesh.positions[vertices]
     sizes = mesh.face_sizes[faces]
     first = np.repeat(np.cumsum(sizes) - sizes, sizes)
     following = np.arange(len(p)) + 1
     following = np.where(following - first >= np.repeat(sizes, sizes), first, following)  # wrap within the face
-    area = np.cross(p, p[following]).sum(axis=0)
+    total = np.zeros((len(faces), 3))
+    np.add.at(total, np.repeat(np.arange(len(faces)), sizes), np.cross(p, p[following]))
+    return total
+
+
+def mean_normal(mesh: Mesh, faces: np.ndarray) -> np.ndarray:
+    """(3,) unit area-weighted normal of ``faces`` (Newell's vector area of each polygon), or +z if they cancel."""
+    area = vector_areas(mesh, faces).sum(axis=0)
     length = np.linalg.norm(area)
     return area / length if length > 0 else np.array([0.0, 0.0, 1.0])
 
 
-def closeup_view(mesh: Mesh, place: np.ndarray, aspect: float = 1.0) -> CloseupView:
-    """Frame a camera on ``place`` (P,) int64 mesh faces: along their mean normal, tilted by ``TILT_DEGREES``.
+def candidate_directions(normal: np.ndarray) -> np.ndarray:
+    """(6, 3) unit view directions (target toward eye): ``normal`` (3,) and its opposite, each tilted by
+    ``TILT_DEGREES`` toward the world axis least aligned with it, away from it, and across both.
 
-    The distance fits the bounding sphere of the place's ring (:func:`ring_of`),
-    at most ``RING_RADII`` times the place's own, into ``FILL`` of the narrower
-    half field of view.
+    The first is the preferred one (toward the stored normal, tilted toward that axis): ties in
+    visibility keep it, so a right-handed file's close-ups look as they always did.
     """
-    ring = ring_of(mesh, place)
+    side_axis = int(np.argmin(np.abs(normal)))
+    side = np.eye(3)[side_axis] - normal * normal[side_axis]
+    side /= np.linalg.norm(side)
+    across = np.cross(normal, side)
+    tilt = np.radians(TILT_DEGREES)
+    directions = [np.cos(tilt) * facing + np.sin(tilt) * lean
+                  for facing in (normal, -normal) for lean in (side, -side, across)]
+    return np.array(directions)
+
+
+def _view_along(mesh: Mesh, place: np.ndarray, ring: np.ndarray, direction: np.ndarray, aspect: float,
+                centroids: np.ndarray) -> CloseupView:
+    """The close-up of ``place`` seen along unit ``direction`` (3,), framed on its ring."""
     ring_points = mesh.positions[face_vertices(mesh, ring)[0]]
     place_points = mesh.positions[face_vertices(mesh, place)[0]]
     target = place_points.mean(axis=0)
     own = float(np.linalg.norm(place_points - target, axis=1).max())
     radius = min(float(np.linalg.norm(ring_points - target, axis=1).max()), RING_RADII * own)
     radius = radius if radius > 0 else 1.0
-    normal = mean_normal(mesh, place)
-    # Tilt toward the world axis least aligned with the normal: a fixed, reproducible side.
-    side_axis = int(np.argmin(np.abs(normal)))
-    side = np.eye(3)[side_axis] - normal * normal[side_axis]
-    side /= np.linalg.norm(side)
-    tilt = np.radians(TILT_DEGREES)
-    direction = np.cos(tilt) * normal + np.sin(tilt) * side
     half = np.radians(CLOSEUP_FOV) / 2
     narrow = min(half, np.arctan(np.tan(half) * aspect))
     distance = radius / (FILL * np.sin(narrow))
@@ -109,10 +130,45 @@ def closeup_view(mesh: Mesh, place: np.ndarray, aspect: float = 1.0) -> CloseupV
     up = "xyz"[int(np.argmin(np.abs(direction)))]
     # Draw what lies around the place, but nothing more than a radius in front of it: an occluder (an eyelid,
     # a helper cube inside the body, the other side of a thin part) would hide the place.
-    offset = face_centroids(mesh) - target
+    offset = centroids - target
     drawn = np.flatnonzero((np.linalg.norm(offset, axis=1) <= DRAWN_RADII * radius) & (offset @ direction <= radius))
     drawn = np.union1d(drawn, ring)
     return CloseupView((tuple(eye.tolist()), tuple(target.tolist()), CLOSEUP_FOV), up, drawn, ring)
+
+
+def place_pixels(mesh: Mesh, view: CloseupView, place: np.ndarray, width: int, height: int) -> np.ndarray:
+    """(H, W) bool: the pixels where ``place``'s faces are the nearest of ``view.drawn`` (a depth-tested render)."""
+    from .drawing import RenderOptions, render_mesh
+
+    drawn = render_mesh(face_subset(mesh, view.drawn), RenderOptions(
+        method="split", show="shaded", width=width, height=height, camera=view.camera, up=view.up))
+    face = drawn.frame.face
+    covered = face >= 0
+    own = np.isin(view.drawn, place)
+    return covered & own[drawn.faces[np.maximum(face, 0)]]
+
+
+def closeup_view(mesh: Mesh, place: np.ndarray, aspect: float = 1.0) -> CloseupView:
+    """Frame a camera on ``place`` (P,) int64 mesh faces from the side it is seen from.
+
+    Each of :func:`candidate_directions` of the place's mean normal is drawn at
+    ``PREPASS_SIZE`` pixels (:func:`place_pixels`); the direction where the place
+    covers the most pixels wins, the first on a tie. The distance fits the
+    bounding sphere of the place's ring (:func:`ring_of`), at most ``RING_RADII``
+    times the place's own, into ``FILL`` of the narrower half field of view.
+    """
+    ring = ring_of(mesh, place)
+    centroids = face_centroids(mesh)
+    views = [_view_along(mesh, place, ring, direction, aspect, centroids)
+             for direction in candidate_directions(mean_normal(mesh, place))]
+    height = max(1, round(PREPASS_SIZE / aspect))
+    for k, view in enumerate(views):
+        try:
+            seen = place_pixels(mesh, view, place, PREPASS_SIZE, height)
+        except ValueError:  # everything is behind this camera: it sees nothing
+            continue
+        views[k] = replace(view, visible=float(seen.mean()))
+    return max(views, key=lambda view: view.visible)  # max keeps the first of equals
 
 
 def face_subset(mesh: Mesh, faces: np.ndarray) -> Mesh:
@@ -122,8 +178,6 @@ def face_subset(mesh: Mesh, faces: np.ndarray) -> Mesh:
     so attributes, seams and scores are unchanged; face ``i`` of the result is
     face ``faces[i]`` of ``mesh``.
     """
-    from dataclasses import replace
-
     sizes = mesh.face_sizes[faces]
     corners = np.repeat(mesh.face_start[faces], sizes) + (np.arange(sizes.sum())
                                                            - np.repeat(np.cumsum(sizes) - sizes, sizes))

@@ -20,6 +20,9 @@ EQUAL_EXTENT = 0.01
 EQUAL_FACING = 0.01
 #: The third extent must differ from the two equal ones by more than this (relative).
 DISTINCT_EXTENT = 0.05
+#: A lying shape (a vehicle on its wheels, a heightfield terrain) is thinnest along up, and the faces facing
+#: along that axis (roof, hood, ground) carry at least this many times the area of those facing either other axis.
+LYING_FACING = 1.8
 #: An overview looks down on the mesh from this far above the horizon (tan of the elevation).
 OVERVIEW_ELEVATION = 0.45
 
@@ -30,15 +33,17 @@ def _used_points(mesh: Mesh) -> np.ndarray:
 
 
 def guess_up_axis(mesh: Mesh) -> str:
-    """The up axis of a file that does not name one: ``"z"`` for a shape standing on z, else ``"y"``.
+    """The up axis of a file that does not name one: ``"z"`` for a shape standing or lying on z, else ``"y"``.
 
     A surface of revolution (a vase, a chess piece, a torus) stands on its axis:
     when two of the bounding box's extents agree within ``EQUAL_EXTENT`` and the
     area of faces facing along those two axes (normal within ~25 degrees of the
     axis) agrees within ``EQUAL_FACING``, while the third extent differs by more
-    than ``DISTINCT_EXTENT``, the third axis is up. Everything else gets y, the
-    OBJ convention (Maya, Blender's OBJ export, MakeHuman); pass ``--up z`` for a
-    z-up file that is not a surface of revolution (the OpenSubdiv car).
+    than ``DISTINCT_EXTENT``, the third axis is up. A lying shape (a car on its
+    wheels, a heightfield terrain) is thinnest along z and its faces face mostly
+    along z (``LYING_FACING`` times the area facing x or y): z is up. Everything
+    else gets y, the OBJ convention (Maya, Blender's OBJ export, MakeHuman: a
+    standing figure faces front and back more than up, but not by that margin).
     """
     from ..geometry import quad_normals
     from .quads import render_corners
@@ -57,6 +62,9 @@ def guess_up_axis(mesh: Mesh) -> str:
         if (abs(extent[a] - extent[b]) <= EQUAL_EXTENT * scale and abs(facing[a] - facing[b]) <= EQUAL_FACING
                 and abs(extent[up] - scale) > DISTINCT_EXTENT * scale):
             return "xyz"[up]
+    along = np.abs(normals).sum(axis=0)  # the area facing along each axis, both ways
+    if int(np.argmin(extent)) == 2 and along[2] >= LYING_FACING * max(along[0], along[1]):
+        return "z"
     return "y"
 
 

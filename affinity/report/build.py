@@ -59,7 +59,8 @@ class MeshResult:
     (H, W, 3) uint8, else ``overview_note`` says why there is none. ``camera``
     and ``up`` are the view of the renders and the overview. ``places`` are every
     flagged place, ranked (:func:`affinity.report.places.choose_places` with no
-    limit); ``closeups`` the pictures of the first ``options.max_views``.
+    limit); ``closeups`` the pictures of the first ``options.max_views`` whose place can be seen, ``dropped``
+    a line for each place skipped because it covers too few pixels from every side.
     ``stability`` is the scene's :class:`affinity.report.stiffness.SceneStability`.
     """
 
@@ -83,6 +84,7 @@ class MeshResult:
     up: str | None = None
     places: list = field(default_factory=list)
     closeups: list = field(default_factory=list)
+    dropped: list[str] = field(default_factory=list)
     closeup_seconds: float = 0.0
     stability: object | None = None
 
@@ -188,10 +190,20 @@ def _closeups(result: MeshResult, step: Callable[[str], None]) -> None:
     by_rule = {hits.code: places_of(result.mesh, hits) for hits in result.file.hits}
     result.places = choose_places(by_rule, sum(len(p) for p in by_rule.values()))
     start = time.perf_counter()
-    for k, place in enumerate(result.places[:result.options.max_views]):
-        step(f"close-up {k + 1}")
-        result.closeups.append(closeup(result.mesh, place, result.settings, CLOSEUP_SIZE,
-                                       result.options.pixel_tolerance, result.options.texture))
+    shown = np.zeros(result.mesh.n_faces, dtype=bool)  # no two close-ups share a face
+    for place in result.places:
+        if len(result.closeups) == result.options.max_views:
+            break
+        if shown[place.faces].any():
+            continue
+        step(f"close-up {len(result.closeups) + 1}")
+        drawn = closeup(result.mesh, place, result.settings, CLOSEUP_SIZE, result.options.pixel_tolerance,
+                        result.options.texture)
+        if drawn.dropped:
+            result.dropped.append(drawn.dropped)
+        else:
+            result.closeups.append(drawn)
+            shown[place.faces] = True
     result.closeup_seconds = time.perf_counter() - start
 
 

@@ -23,8 +23,12 @@ from .places import Place
 
 #: Methods of a close-up, left to right.
 CLOSEUP_METHODS = ("split", "hybrid", "exact")
-#: A place with more faces than this is framed on its worst face and that face's ring.
-FRAMED_FACES = 12
+#: A close-up whose place covers fewer pixels than this fraction of the picture (300 pixels of 240 x 240) is
+#: re-framed on its worst face, and dropped with a line saying why when that covers too few as well.
+PLACE_FLOOR = 300 / 240**2
+#: A place whose faces' area is below this fraction of its ring's is a sliver (a collapsed quad): it covers
+#: no pixels from any side, so the floor does not apply and its outline's halo marks it.
+SLIVER_AREA = 1e-3
 PLAIN = np.ones((1, 1, 3), dtype=np.float32)
 #: Attribute shown for each scored rule; the geometric rules show uv when the mesh has it.
 SHOW_FOR = ATTRIBUTE_NAMES
@@ -37,6 +41,9 @@ class Closeup:
     images : method -> (S, S, 3) float RGB, the place outlined in the flag colour
     error : (S, S) float64 split error against exact in ``unit`` (None without an attribute or exact)
     covered : (S, S) bool, the pixels where split and exact show the same face
+    view : the :class:`affinity.draw.closeup.CloseupView` drawn (camera, up, drawn faces)
+    place_pixels : the pixels the place's faces cover in the split picture
+    dropped : why the close-up is not shown (its place covers too few pixels from every side), else None
     """
 
     place: Place
@@ -48,6 +55,9 @@ class Closeup:
     covered: np.ndarray | None = None
     unit: str = ""
     missing: dict = field(default_factory=dict)
+    view: object = None
+    place_pixels: int = 0
+    dropped: str | None = None
 
 
 def _show_for(mesh: Mesh, code: str) -> str:
@@ -72,20 +82,39 @@ def _face_uv(mesh: Mesh, face: int) -> np.ndarray:
     return np.nan_to_num(mesh.corner_attribute("texcoords", corners)[0])
 
 
+def _area(mesh: Mesh, faces: np.ndarray) -> float:
+    """The total area of ``faces`` (F,) int64."""
+    from ..draw.closeup import vector_areas
+
+    return float(np.linalg.norm(vector_areas(mesh, faces), axis=1).sum() / 2)
+
+
+def _framed_view(mesh: Mesh, place: Place, size: int):
+    """The view of ``place`` and the faces it is framed on: the whole place, else (it covers less than
+    ``PLACE_FLOOR`` of the pre-pass from every side) its worst face alone."""
+    from ..draw.closeup import closeup_view
+
+    view = closeup_view(mesh, place.faces)
+    if view.visible >= PLACE_FLOOR or len(place.faces) == 1:
+        return view, place.faces
+    worst = np.array([place.worst])
+    tighter = closeup_view(mesh, worst)
+    return (tighter, worst) if tighter.visible > view.visible else (view, place.faces)
+
+
 def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_tolerance: float,
             texture: str | None = None) -> Closeup:
     """Draw one place (see the module docstring); ``texture`` is ``--texture``, overriding map_Kd."""
     import os
 
-    from ..draw.closeup import closeup_view, face_subset, outline
+    from ..draw.closeup import face_subset, outline
     from ..draw.drawing import RenderOptions, render_mesh
     from ..draw.shading import OVERLAY_TINT
     from ..draw.texture import grid_cell, grid_colours
     from ..loaders.imagesize import image_size
     from ..measures import pixel_error
 
-    framed_faces = place.faces if len(place.faces) <= FRAMED_FACES else np.array([place.worst])
-    view = closeup_view(mesh, framed_faces)
+    view, framed_faces = _framed_view(mesh, place, size)
     sub = face_subset(mesh, view.drawn)
     show = _show_for(mesh, place.code)
     image_file = texture or _map_kd(mesh)
@@ -100,7 +129,7 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
     framed = (f"the {len(place.faces)} flagged faces and their neighbours" if len(framed_faces) > 1
               else f"face {place.worst} and its neighbours" + (f" (of a place of {len(place.faces)} flagged faces)"
                                                               if len(place.faces) > 1 else ""))
-    result = Closeup(place, show, label, framed)
+    result = Closeup(place, show, label, framed, view=view)
     in_place = np.isin(view.drawn, place.faces)
     frames = {}
     for method in CLOSEUP_METHODS:
@@ -118,7 +147,10 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
         sub_face = np.where(covered, drawn.faces[np.maximum(face, 0)], -1)
         if cell is not None:
             image[covered] = grid_colours(drawn.frame.attrs[covered], cell)
-        image[outline(covered & in_place[np.maximum(sub_face, 0)])] = OVERLAY_TINT
+        own = covered & in_place[np.maximum(sub_face, 0)]
+        if method == "split":
+            result.place_pixels = int(own.sum())
+        image[outline(own)] = OVERLAY_TINT
         result.images[method] = image
         frames[method] = (drawn.frame, sub_face)
     if show != "shaded" and {"split", "exact"} <= frames.keys():
@@ -130,4 +162,9 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
         error[covered] = pixel_error(split.attrs[covered], exact.attrs[covered], attribute, texture_size)
         code = next(code for code, rule in RULES.items() if rule.scored and rule.attribute == attribute)
         result.error, result.covered, result.unit = error, covered, RULES[code].unit_for(settings.measure)
+    sliver = _area(mesh, place.faces) < SLIVER_AREA * _area(mesh, view.ring)
+    if "split" in result.images and result.place_pixels < PLACE_FLOOR * size * size and not sliver:
+        result.dropped = (f"{place.code} at face {place.worst}: its faces cover {result.place_pixels} pixels of "
+                          f"the close-up from every side tried (fewer than {PLACE_FLOOR * size * size:.0f}), "
+                          "so it is not drawn")
     return result

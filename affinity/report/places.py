@@ -18,6 +18,15 @@ from ..mesh import Mesh
 from ..rules import RULES
 
 LEVEL_ORDER = {"error": 0, "warning": 1, "info": 2}
+#: A place holds at most this many faces (``affinity report --place-faces``): an eye takes in a few dozen.
+PLACE_FACES = 64
+#: A bigger group is carved into this many places around its successive worst faces (the ones a close-up
+#: may show); the rest of it is cut into shells of ``PLACE_FACES`` by distance, so every place stays small.
+CARVED = 6
+#: Two places are mirror twins when their worst values agree to this relative tolerance and their worst
+#: faces' centroids are mirror images across a bounding-box mid-plane within this fraction of its diagonal.
+TWIN_VALUE = 1e-6
+TWIN_DISTANCE = 1e-3
 
 
 @dataclass(frozen=True)
@@ -90,15 +99,72 @@ def group_faces(mesh: Mesh, faces: np.ndarray) -> list[np.ndarray]:
     return np.split(order, np.flatnonzero(np.diff(inverse[order])) + 1)
 
 
-def places_of(mesh: Mesh, hits: RuleHits) -> list[Place]:
-    """Every place of one rule's hits, worst first (quads with the rule's ``faces`` >= 0 only)."""
+def carve(values: np.ndarray, centroids: np.ndarray, lowest: bool, limit: int = PLACE_FACES,
+          carved: int = CARVED) -> list[np.ndarray]:
+    """Cut one group of ``values`` (n,) and face ``centroids`` (n, 3) into parts of at most ``limit`` items.
+
+    Up to ``carved`` parts are the ``limit`` items nearest (by centroid) the worst item left; the rest
+    is cut into shells of ``limit`` by distance from the last worst one. Returns (k,) int64 positions per
+    part. A group of ``limit`` or fewer items stays whole.
+    """
+    left = np.arange(len(values))
+    parts = []
+    while len(left) > limit and len(parts) < carved:
+        worst = left[np.argmin(values[left]) if lowest else np.argmax(values[left])]
+        order = np.argsort(np.linalg.norm(centroids[left] - centroids[worst], axis=1), kind="stable")
+        parts.append(np.sort(left[order[:limit]]))
+        left = np.sort(left[order[limit:]])
+    if len(left) > limit:
+        order = left[np.argsort(np.linalg.norm(centroids[left] - centroids[parts[-1][0]], axis=1), kind="stable")]
+        parts.extend(np.sort(shell) for shell in np.array_split(order, -(-len(order) // limit)))
+    elif len(left):
+        parts.append(left)
+    return parts
+
+
+def mirror_twins(places: list[Place], centroids: np.ndarray, low: np.ndarray, high: np.ndarray) -> np.ndarray:
+    """(P,) bool: the places that are the mirror twin of an earlier one (see :data:`TWIN_VALUE`).
+
+    ``centroids`` (F, 3) of the mesh's faces, ``low``/``high`` (3,) its bounding box. A symmetric model
+    (a face, a car, a cow) flags its two halves alike: a second close-up of the mirror image shows nothing
+    new. Only the first ``4 * CARVED`` places are compared (the ones a close-up may show): O(P^2) stays small.
+    """
+    twin = np.zeros(len(places), dtype=bool)
+    head = places[:4 * CARVED]
+    if len(head) < 2:
+        return twin
+    value = np.array([p.value for p in head])
+    at = centroids[[p.worst for p in head]]
+    tolerance = TWIN_DISTANCE * max(float(np.linalg.norm(high - low)), 1e-300)
+    same = np.abs(value[:, None] - value[None]) <= TWIN_VALUE * np.maximum(np.abs(value[:, None]), 1e-300)
+    for axis in range(3):
+        mirrored = at.copy()
+        mirrored[:, axis] = low[axis] + high[axis] - at[:, axis]
+        close = np.linalg.norm(mirrored[:, None] - at[None], axis=2) <= tolerance
+        earlier = np.tril(same & close & (np.abs(at[:, axis] - (low[axis] + high[axis]) / 2) > tolerance)[:, None],
+                          k=-1)
+        twin[:len(head)] |= earlier.any(axis=1)
+    return twin
+
+
+def places_of(mesh: Mesh, hits: RuleHits, limit: int = PLACE_FACES) -> list[Place]:
+    """Every place of one rule's hits, worst first, mirror twins left out (quads with ``faces`` >= 0 only).
+
+    A group of neighbours bigger than ``limit`` faces is :func:`carve`d into places of at most ``limit``.
+    """
+    from ..draw.closeup import face_centroids
+
     rule = RULES[hits.code]
     keep = hits.faces >= 0
     faces, values = hits.faces[keep], hits.values[keep]
     order = np.argsort(faces)
     faces, values = faces[order], values[order]
+    centroids = face_centroids(mesh)
     places = []
-    for members in group_faces(mesh, faces):  # one pass per place, not per face
+    groups = group_faces(mesh, faces)
+    parts = [members[part] for members in groups  # one pass per place, not per face
+             for part in carve(values[members], centroids[faces[members]], rule.worst == "lowest", limit)]
+    for members in parts:
         group, vals = faces[members], values[members]
         k = int(np.argmin(vals) if rule.worst == "lowest" else np.argmax(vals))
         value = float(vals[k])
@@ -107,7 +173,9 @@ def places_of(mesh: Mesh, hits: RuleHits) -> list[Place]:
                 value / hits.threshold if hits.threshold > 0 else np.inf)
         places.append(Place(hits.code, group, vals, int(group[k]), value, float(beyond)))
     places.sort(key=lambda p: (-p.beyond, p.worst))
-    return places
+    used = mesh.positions[np.unique(mesh.corner_vertex)] if mesh.n_faces else np.zeros((1, 3))
+    twin = mirror_twins(places, centroids, used.min(axis=0), used.max(axis=0))
+    return [place for place, is_twin in zip(places, twin) if not is_twin]
 
 
 def choose_places(by_rule: dict[str, list[Place]], limit: int) -> list[Place]:

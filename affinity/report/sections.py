@@ -304,6 +304,16 @@ def score_histograms_section(result: MeshResult) -> Section:
     return Section("scores", title, {"charts": charts}, ["left out: " + "; ".join(skipped)] if skipped else [])
 
 
+def face_ranges(faces) -> str:
+    """``faces`` (N,) int sorted unique as ranges, ``"0-4,7,9-12"``: the drawn faces of a close-up, for tests."""
+    faces = np.asarray(faces)
+    if len(faces) == 0:
+        return ""
+    breaks = np.flatnonzero(np.diff(faces) != 1)
+    starts, ends = faces[np.r_[0, breaks + 1]], faces[np.r_[breaks, len(faces) - 1]]
+    return ",".join(f"{a}" if a == b else f"{a}-{b}" for a, b in zip(starts.tolist(), ends.tolist()))
+
+
 def closeups_section(result: MeshResult) -> Section:
     """One close-up per flagged place, worst first: split | hybrid | exact with the place outlined, and the
     split's error against exact with its colour bar."""
@@ -316,6 +326,7 @@ def closeups_section(result: MeshResult) -> Section:
     figures = []
     for view in result.closeups:
         place, mesh = view.place, result.mesh
+        eye, target, fov = view.view.camera
         rule = RULES[place.code]
         unit = rule.unit_for(result.settings.measure)
         error = None
@@ -329,9 +340,11 @@ def closeups_section(result: MeshResult) -> Section:
             "line": int(mesh.face_line[place.worst]), "group": mesh.group_names[mesh.face_group[place.worst]],
             "texture": view.texture, "framed": view.framed, "error": error,
             "images": [(method, image_uri(image)) for method, image in view.images.items()],
-            "missing": view.missing,
+            "missing": view.missing, "camera": ",".join(f"{x:.9g}" for x in (*eye, *target, fov)),
+            "up": view.view.up, "place": ",".join(map(str, place.faces.tolist())),
+            "drawn": face_ranges(view.view.drawn), "place_pixels": view.place_pixels,
         })
-    notes = []
+    notes = list(result.dropped)
     if len(result.places) > len(figures):
         notes.append(f"{len(result.places) - len(figures)} more flagged places not drawn (--max-views "
                      f"{result.options.max_views}); the UV layout marks every flagged face")
