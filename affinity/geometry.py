@@ -172,10 +172,26 @@ def _edges(p: np.ndarray) -> np.ndarray:
 
 def squared_lengths(v: np.ndarray) -> np.ndarray:
     """(D, ...) vectors laid out by component -> (...) squared Euclidean lengths."""
-    total = v[0] * v[0]
-    for component in v[1:]:
-        total += component * component
+    return dot_by_component(v, v)
+
+
+def dot_by_component(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(D, ...), (D, ...) vectors laid out by component -> (...) float64 dot products."""
+    total = a[0] * b[0]
+    for u, v in zip(a[1:], b[1:]):
+        total += u * v
     return total
+
+
+def cross_by_component(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(3, ...) cross products a x b of vectors laid out by component (3, ...) float64
+    (``np.cross(a, b, axis=0)`` without its axis moves and copies)."""
+    out = np.empty_like(a)
+    for d in range(3):
+        u, v = (d + 1) % 3, (d + 2) % 3
+        np.multiply(a[u], b[v], out=out[d])
+        out[d] -= a[v] * b[u]
+    return out
 
 
 def _corner_turns(e: np.ndarray) -> np.ndarray:
@@ -185,12 +201,7 @@ def _corner_turns(e: np.ndarray) -> np.ndarray:
     following = np.roll(e, -1, axis=1)
     if len(e) == 2:
         return e[0] * following[1] - e[1] * following[0]
-    turns = np.empty_like(e)
-    for d in range(3):
-        u, v = (d + 1) % 3, (d + 2) % 3
-        np.multiply(e[u], following[v], out=turns[d])
-        turns[d] -= e[v] * following[u]
-    return turns
+    return cross_by_component(e, following)
 
 
 @dataclass(frozen=True)

@@ -19,7 +19,13 @@ def keep_freed_memory() -> None:
     system time for a 166 MB OBJ, 70k and 0.3 s with these settings). Peak
     memory is unchanged; at most 256 MB of freed heap stays with the process.
     A no-op where glibc's ``mallopt`` is not available.
+
+    It also turns off NumPy's transparent-huge-page advice for big arrays: on a
+    kernel that compacts memory to back such a fault (``defrag`` = ``madvise``,
+    the default), a busy machine's faults then stall; measured on the 166 MB OBJ:
+    0.2-0.3 s of system time instead of 0.3-0.7 s, and the load 10-30% faster.
     """
+    _ordinary_pages_for_numpy()
     try:
         libc = ctypes.CDLL(None)
         mallopt = libc.mallopt
@@ -28,3 +34,14 @@ def keep_freed_memory() -> None:
     m_trim_threshold, m_mmap_threshold = -1, -3
     mallopt(m_mmap_threshold, 32 << 20)
     mallopt(m_trim_threshold, 256 << 20)
+
+
+def _ordinary_pages_for_numpy() -> None:
+    """NumPy's big allocations without ``madvise(MADV_HUGEPAGE)`` (a no-op where NumPy lacks the switch)."""
+    try:
+        from numpy._core import multiarray
+    except ImportError:  # NumPy 1.x
+        from numpy.core import multiarray
+    switch = getattr(multiarray, "_set_madvise_hugepage", None)
+    if switch is not None:
+        switch(False)

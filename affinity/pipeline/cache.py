@@ -8,8 +8,11 @@ A report is stored under a key made of
   references and payloads), read by the loaders' own readers;
 - the path as given (reports name it) and the resolved settings of the file,
   and the USD reading options;
-- the tool: its version and a hash of the installed package's source files,
-  since the version string does not change between commits.
+- the tool: its version and the names, sizes and modification times of the
+  installed package's source files, since the version string does not change
+  between commits (the signature Python's own bytecode cache trusts to tell
+  whether a module changed; hashing the sources on every start cost more than
+  the rest of a small check's cache look-up).
 
 Content hashes are remembered per file under a pre-key (path, size, mtime_ns,
 inode), so an unchanged file costs one ``stat`` and is not read; its list of
@@ -19,8 +22,9 @@ modified in the last :data:`RACY_SECONDS` gets no pre-key (its mtime may not
 yet tell two versions apart, as in git's "racy" index entries): it is hashed
 again next time.
 
-The cache is one SQLite file in the user cache folder (``platformdirs``), or in
-``AFFINITY_CACHE_DIR``. It is an optimisation only: a folder that cannot be
+The cache is one SQLite file in the user cache folder (``platformdirs``' choice,
+worked out here on Linux and other XDG systems, where importing it is most of
+the cost), or in ``AFFINITY_CACHE_DIR``. It is an optimisation only: a folder that cannot be
 written or a damaged database gives one warning line on stderr and the run goes
 on (a damaged database is replaced by a new one). Reports that say more about
 the run than about the file (``FileReport.transient``: an internal error, a
@@ -32,7 +36,6 @@ Dask worker that cannot see the path) are never stored. Entries unused for
 from __future__ import annotations
 
 import dataclasses
-import hashlib
 import json
 import os
 import sqlite3
@@ -43,6 +46,11 @@ from ..errors import MeshError
 from ..findings import FileReport, report_from_bytes, report_to_bytes
 from ..loaders.formats import format_named
 from ..settings import Settings
+
+try:  # the BLAKE2 module itself: hashlib would load OpenSSL first, a few ms of every start
+    from _blake2 import blake2b
+except ImportError:  # an interpreter built without it
+    from hashlib import blake2b
 
 #: Bump when the key or the stored report changes meaning.
 SCHEMA = 1
@@ -68,30 +76,44 @@ def cache_folder() -> str:
     folder = os.environ.get("AFFINITY_CACHE_DIR")
     if folder:
         return folder
+    if os.name == "posix" and sys.platform != "darwin":  # platformdirs' XDG rule
+        return os.path.join(os.environ.get("XDG_CACHE_HOME", "").strip() or os.path.expanduser("~/.cache"),
+                            "quad-affinity")
     import platformdirs
 
     return platformdirs.user_cache_dir("quad-affinity", appauthor=False)
 
 
 def tool_fingerprint() -> str:
-    """The version, NumPy's version and a hash of every ``.py`` file of the ``affinity`` and ``render`` packages.
+    """The version, NumPy's version and the relative path, size and mtime_ns of every ``.py`` file
+    of the ``affinity`` and ``render`` packages (an edit, a checkout or a reinstall changes them).
 
     ``render`` is found, not imported: ``affinity check`` never loads the renderer.
     """
     from importlib.util import find_spec
-    from pathlib import Path
 
     import numpy as np
 
     from .. import __version__
 
-    digest = hashlib.blake2b(f"{__version__} numpy {np.__version__}".encode(), digest_size=20)
+    sources = []
     for package in ("affinity", "render"):
-        for root in map(Path, find_spec(package).submodule_search_locations):
-            for source in sorted(root.rglob("*.py")):
-                digest.update(f"{package}/{source.relative_to(root).as_posix()}".encode() + b"\0")
-                digest.update(source.read_bytes())
-    return digest.hexdigest()
+        for root in find_spec(package).submodule_search_locations:
+            sources += [(f"{package}/{name}", *stat) for name, stat in _python_files(root)]
+    signature = _json([__version__, np.__version__, sorted(sources)])
+    return blake2b(signature.encode(), digest_size=20).hexdigest()
+
+
+def _python_files(root: str, prefix: str = ""):
+    """``(path relative to root, (size, mtime_ns))`` of every ``.py`` file under ``root``."""
+    with os.scandir(root) as entries:
+        for entry in entries:
+            name = prefix + entry.name
+            if entry.is_dir():
+                yield from _python_files(entry.path, name + "/")
+            elif entry.name.endswith(".py"):
+                stat = entry.stat()
+                yield name, (stat.st_size, stat.st_mtime_ns)
 
 
 def _json(value) -> str:
@@ -182,7 +204,7 @@ class ResultCache:
         if id(settings) not in self._settings:  # files share a few Settings objects: describe each once
             self._settings[id(settings)] = (settings, dataclasses.asdict(settings))
         payload = _json([SCHEMA, self.tool, path, tree, self._settings[id(settings)][1], usd_key])
-        return hashlib.blake2b(payload.encode(), digest_size=20).hexdigest()
+        return blake2b(payload.encode(), digest_size=20).hexdigest()
 
     def _tree(self, path: str, seen: set[str], source=None) -> list | None:
         """``[path, digest, dependency trees...]``; None when ``path`` is not a readable file."""
@@ -298,9 +320,9 @@ def _hash_file(path: str, data: bytes | None = None) -> tuple[str, list[str]]:
         with open(path, "rb") as fh:
             data = fh.read()
     if data is not None:
-        digest = hashlib.blake2b(data, digest_size=20)
+        digest = blake2b(data, digest_size=20)
     else:
-        digest = hashlib.blake2b(digest_size=20)
+        digest = blake2b(digest_size=20)
         with open(path, "rb") as fh:
             while chunk := fh.read(_CHUNK):
                 digest.update(chunk)

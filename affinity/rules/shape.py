@@ -4,7 +4,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..geometry import degeneracy, folded_fraction, interior_angles, is_bowtie, squared_lengths
+from ..geometry import (
+    cross_by_component,
+    degeneracy,
+    dot_by_component,
+    folded_fraction,
+    interior_angles,
+    is_bowtie,
+    squared_lengths,
+)
 from .registry import rule
 
 REFERENCES = ("Bloomenthal 2022, §3.4 (nonplanar and degenerate quads); "
@@ -52,11 +60,11 @@ def _fold(p: np.ndarray, normal: np.ndarray, a: int, b: int, c: int, d: int) -> 
     area has no normal and folds nothing either: that quad is Q201's.
     """
     e1, e2, e3 = p[:, b] - p[:, a], p[:, c] - p[:, a], p[:, d] - p[:, a]
-    n1, n2 = np.cross(e1, e2, axis=0), np.cross(e2, e3, axis=0)
-    n1 *= np.sign((n1 * normal).sum(axis=0))
-    n2 *= np.sign((n2 * normal).sum(axis=0))
-    sine = np.sqrt(squared_lengths(np.cross(n1, n2, axis=0)))
-    cosine = (n1 * n2).sum(axis=0)
+    n1, n2 = cross_by_component(e1, e2), cross_by_component(e2, e3)
+    n1 *= np.sign(dot_by_component(n1, normal))
+    n2 *= np.sign(dot_by_component(n2, normal))
+    sine = np.sqrt(squared_lengths(cross_by_component(n1, n2)))
+    cosine = dot_by_component(n1, n2) + 0.0  # a zeroed normal gives -0: atan2(0, -0) would be 180
     return np.degrees(np.arctan2(sine, cosine))
 
 
@@ -70,7 +78,7 @@ def fold_degrees(p: np.ndarray, diagonal: str, diagonals: np.ndarray | None = No
     two) or ``"shortest"`` (the diagonal shorter in 3-D; ``diagonals`` (Q, 2)
     holds the lengths of 0-2 and 1-3).
     """
-    normal = np.cross(p[:, 2] - p[:, 0], p[:, 3] - p[:, 1], axis=0)
+    normal = cross_by_component(p[:, 2] - p[:, 0], p[:, 3] - p[:, 1])
     if diagonal == "02":
         return _fold(p, normal, 0, 1, 2, 3)
     if diagonal == "13":
