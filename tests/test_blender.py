@@ -98,7 +98,11 @@ def test_uv_sphere_gives_the_same_findings_as_its_obj_export_checked_by_the_cli(
     in_memory = by_code_and_face(rows)
     document = cli_json(exported)
     assert set(document["findings"][0]) <= set(rows[0])  # every key of a JSON finding, and more
-    assert {rows[0]["unit"], rows[0]["level"], rows[0]["group"]} == {"texels", "warning", sphere.name}
+    assert {rows[0]["unit"], rows[0]["group"]} == {"texels", sphere.name}
+    # Severity by visibility: an error above the documented 2 texels, a warning between 0.5 and 2, as the CLI says.
+    assert all(r["level"] == ("error" if r["value"] > 2.0 else "warning") for r in rows)
+    assert ({(r["face"], r["level"]) for r in rows}
+            == {(f["face"], f["level"]) for f in document["findings"]})
     on_file = by_code_and_face(document["findings"])
     assert document["files"][0]["faces"] == len(sphere.data.polygons)
     assert {code for code, _ in in_memory} == {"Q101"}
