@@ -84,11 +84,26 @@ def test_faces_sharing_a_vertex_are_one_place_and_separated_patches_are_two():
     assert sorted(sorted(p.faces.tolist()) for p in places) == [[22, 33], [77]]
 
 
+def test_a_place_has_the_level_of_its_worst_finding(tmp_path):
+    """Severity by visibility reaches the report: above 2 texels a place is an error, below a warning."""
+    from affinity.pipeline.check import load_and_check
+    from affinity.report.places import places_of
+    from affinity.settings import Settings
+
+    path = tmp_path / "two.obj"
+    path.write_text(quad_obj([(trapezoid(1.0), UNIT_UV), (trapezoid(1.992, x=5.0), UNIT_UV)]))
+    file, mesh = load_and_check(str(path), Settings(select=["Q101"]))
+    places = places_of(mesh, file.hits[0])
+    assert len(places) == 2 and min(p.value for p in places) < 2.0 < max(p.value for p in places)
+    assert all(p.level == ("error" if p.value > 2.0 else "warning") for p in places)
+
+
 def test_places_take_turns_between_rules_worst_first():
     from affinity.report.places import Place, choose_places
 
     def place(code, beyond, face):
-        return Place(code, np.array([face]), np.array([beyond]), face, beyond, beyond)
+        return Place(code, np.array([face]), np.array([beyond]), face, beyond, beyond,
+                     "error" if code == "Q204" else "warning")
 
     by_rule = {"Q101": [place("Q101", 9.0, 1), place("Q101", 5.0, 2), place("Q101", 4.0, 3)],
                "Q202": [place("Q202", 2.0, 4)], "Q204": [place("Q204", 1.5, 5)]}  # Q204 is an error

@@ -39,6 +39,7 @@ class Place:
     worst : the face with the worst value (the one the close-up is named by)
     value : its value
     beyond : how far beyond the threshold it is, as a ratio >= 1 (inf at a zero value of a lowest-is-worst rule)
+    level : the level of the worst face's finding (``error`` above the rule's visibility threshold)
     """
 
     code: str
@@ -47,10 +48,7 @@ class Place:
     worst: int
     value: float
     beyond: float
-
-    @property
-    def level(self) -> str:
-        return RULES[self.code].level
+    level: str
 
 
 def connected_components(n_items: int, a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -156,9 +154,9 @@ def places_of(mesh: Mesh, hits: RuleHits, limit: int = PLACE_FACES) -> list[Plac
 
     rule = RULES[hits.code]
     keep = hits.faces >= 0
-    faces, values = hits.faces[keep], hits.values[keep]
+    faces, values, levels = hits.faces[keep], hits.values[keep], hits.levels()[keep]
     order = np.argsort(faces)
-    faces, values = faces[order], values[order]
+    faces, values, levels = faces[order], values[order], levels[order]
     centroids = face_centroids(mesh)
     places = []
     groups = group_faces(mesh, faces)
@@ -171,7 +169,7 @@ def places_of(mesh: Mesh, hits: RuleHits, limit: int = PLACE_FACES) -> list[Plac
         with np.errstate(divide="ignore", invalid="ignore"):
             beyond = (hits.threshold / value if value > 0 else np.inf) if rule.worst == "lowest" else (
                 value / hits.threshold if hits.threshold > 0 else np.inf)
-        places.append(Place(hits.code, group, vals, int(group[k]), value, float(beyond)))
+        places.append(Place(hits.code, group, vals, int(group[k]), value, float(beyond), str(levels[members][k])))
     places.sort(key=lambda p: (-p.beyond, p.worst))
     used = mesh.positions[np.unique(mesh.corner_vertex)] if mesh.n_faces else np.zeros((1, 3))
     twin = mirror_twins(places, centroids, used.min(axis=0), used.max(axis=0))
@@ -181,12 +179,12 @@ def places_of(mesh: Mesh, hits: RuleHits, limit: int = PLACE_FACES) -> list[Plac
 def choose_places(by_rule: dict[str, list[Place]], limit: int) -> list[Place]:
     """Up to ``limit`` places, taking turns between rules.
 
-    Rules go in order of level (errors first), then of their worst place; round
+    Rules go in order of their worst place's level (errors first), then of how far beyond the threshold it is; round
     ``k`` takes each rule's ``k``-th place, so each flagged rule has a close-up
     when ``limit`` is at least the number of rules.
     """
     rules = sorted((code for code in by_rule if by_rule[code]),
-                   key=lambda code: (LEVEL_ORDER[RULES[code].level], -by_rule[code][0].beyond, code))
+                   key=lambda code: (LEVEL_ORDER[by_rule[code][0].level], -by_rule[code][0].beyond, code))
     chosen: list[Place] = []
     rounds = max((len(by_rule[code]) for code in rules), default=0)
     for k in range(rounds):

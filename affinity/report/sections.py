@@ -335,7 +335,7 @@ def closeups_section(result: MeshResult) -> Section:
             error = {"src": heatmap_uri(view.error, view.covered, scale),
                      "bar": heat_bar(scale, f"split error against exact ({view.unit})")}
         figures.append({
-            "face": place.worst, "code": place.code, "name": rule.name, "level": rule.level,
+            "face": place.worst, "code": place.code, "name": rule.name, "level": place.level,
             "value": with_unit(number(place.value), unit), "faces": len(place.faces),
             "line": int(mesh.face_line[place.worst]), "group": mesh.group_names[mesh.face_group[place.worst]],
             "texture": view.texture, "framed": view.framed, "error": error,
