@@ -227,11 +227,10 @@ def collect_mesh(item: MeshInput, settings: Settings, step: Callable[[str], None
         texture = options.texture or (checker(512, item.view.checks) if item.view.checks and has_uv else None)
         _render(result, texture, step)
         if "hybrid" in result.renders:
-            from .stiffness import scene_stability
+            from .stiffness import render_stability
 
             step("stability")
-            result.stability = scene_stability(result.mesh, result.renders["hybrid"], result.camera, result.up,
-                                               options.size)
+            result.stability = render_stability(result.renders["hybrid"])
         _overview(result, step)
         if result.mesh.n_faces:
             _closeups(result, step)

@@ -90,12 +90,6 @@ def _check(p: np.ndarray, quad: np.ndarray, w: np.ndarray, face: int, pixel) -> 
     return StiffPixel(face, pixel, kappa, e64, t64, e32, t32)
 
 
-def scene_stability(mesh, render, camera, up, size) -> SceneStability:
-    """:func:`render_stability` of ``render``, called as ``report/build.py`` calls it (the render carries
-    its own clip corners now, so the mesh, camera, up axis and size are not needed)."""
-    return render_stability(render)
-
-
 def render_stability(render) -> SceneStability:
     """Screen the mvc pixels of ``render`` (the hybrid's RenderResult) and check the worst against mpmath."""
     from render.coords import mean_value
