@@ -34,9 +34,9 @@ import subprocess
 import sys
 import tempfile
 import time
-from pathlib import Path
 
 from bench_load import write_grid_obj
+from common import parse_with_output, write_table
 
 #: name -> (module that must be importable, Python statement run in the child)
 READERS = {
@@ -105,7 +105,6 @@ def check_command() -> list[str] | None:
 
 CHECK = "affinity check --no-cache --format json"
 REFERENCE = "pyvista.read"
-OUT = Path(__file__).resolve().parents[1] / "reports" / "bench"
 
 
 def table(results: dict, phases: list, header: list[str]) -> list[str]:
@@ -137,9 +136,8 @@ def main(argv=None) -> None:
     parser.add_argument("--path", help="OBJ to use; generated there when missing (default: a temp file)")
     parser.add_argument("--rounds", type=int, default=5, help="runs of every case, taking turns (default 5)")
     parser.add_argument("--trimesh", action="store_true", help="also time trimesh.load (slow: about 10 s a run)")
-    parser.add_argument("--small", action="store_true", help="2,000 quads, one round: the test's case")
-    parser.add_argument("--out", type=Path, default=OUT, help="folder of bench_check.md and .json (reports/bench)")
-    args = parser.parse_args(argv)
+    args = parse_with_output(parser, "2,000 quads, one round: the test's case",
+                             "folder of bench_check.md and .json (reports/bench)", argv)
     if args.small:
         args.quads, args.rounds = 2_000, 1
 
@@ -172,9 +170,7 @@ def main(argv=None) -> None:
                     phases.append([float(x) for x in out.split()])
         header[-1] += f" After: {' '.join(f'{x:.2f}' for x in os.getloadavg())}."
         lines = table(results, phases, header)
-    print("\n".join(lines))
-    args.out.mkdir(parents=True, exist_ok=True)
-    (args.out / "bench_check.md").write_text("\n".join(lines) + "\n")
+    write_table(lines, args.out, "bench_check.md")
     (args.out / "bench_check.json").write_text(json.dumps(
         {"quads": args.quads, "rounds": args.rounds, "cases": results, "phases": phases}, indent=1) + "\n")
 

@@ -27,6 +27,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from common import parse_with_output, write_table
 
 from affinity.commands.allocator import keep_freed_memory
 from affinity.draw.drawing import RenderOptions, render_mesh
@@ -34,7 +35,6 @@ from affinity.loaders import load
 from affinity.scenes import demo_sphere
 
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "meshes"
-OUT = Path(__file__).resolve().parents[1] / "reports" / "bench"
 METHODS = ("split", "hybrid", "mvc")
 
 
@@ -68,9 +68,7 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--pixel-tolerance", type=float, default=0.5)
     parser.add_argument("--no-demo", action="store_true", help="leave out the demo sphere")
-    parser.add_argument("--small", action="store_true", help="the demo sphere only, 128x128, best of 2")
-    parser.add_argument("--out", type=Path, default=OUT, help="folder for bench_hybrid.md")
-    args = parser.parse_args()
+    args = parse_with_output(parser, "the demo sphere only, 128x128, best of 2", "folder for bench_hybrid.md")
     if args.small:
         args.size, args.repeat, args.meshes, args.no_demo = 128, 2, [], False
     keep_freed_memory()
@@ -100,10 +98,7 @@ def main() -> None:
         lines.append(f"| {name} | {mesh.counts()['quads']:,} | {share:.1%} | {fragments:,} | {times['split']:.3f} | "
                      f"{times['hybrid']:.3f} | {times['mvc']:.3f} | {times['hybrid'] / times['split']:.2f} | "
                      f"{times['nothing routed'] / times['split']:.2f} |")
-    table = "\n".join(lines) + "\n"
-    args.out.mkdir(parents=True, exist_ok=True)
-    (args.out / "bench_hybrid.md").write_text(table)
-    print(table, end="")
+    write_table(lines, args.out, "bench_hybrid.md")
 
 
 if __name__ == "__main__":

@@ -28,14 +28,12 @@ import functools
 import os
 import time
 import tracemalloc
-from pathlib import Path
 
 import numpy as np
+from common import parse_with_output, write_table
 
 from affinity.commands.allocator import keep_freed_memory
 from render import frame_bounds, rasterize_quads, to_clip
-
-OUT = Path(__file__).resolve().parents[1] / "reports" / "bench"
 
 METHODS = ("split", "mvc", "bilinear", "hybrid")
 
@@ -154,9 +152,7 @@ def main(argv=None):
     parser.add_argument("--scene", choices=[*SCENES, "all"], default="all")
     parser.add_argument("--repeat", type=int, default=5, help="runs per measurement, best is kept")
     parser.add_argument("--memory", action="store_true", help="also render 4096x4096 with 1M quads")
-    parser.add_argument("--small", action="store_true", help="a quick run: 128x128, best of 2, no --memory")
-    parser.add_argument("--out", type=Path, default=OUT, help="folder for bench_render.md")
-    args = parser.parse_args(argv)
+    args = parse_with_output(parser, "a quick run: 128x128, best of 2, no --memory", "folder for bench_render.md", argv)
     if args.small:
         args.size, args.repeat, args.memory = 128, min(args.repeat, 2), False
     keep_freed_memory()
@@ -182,10 +178,7 @@ def main(argv=None):
             "|---:|---:|---:|---:|---:|",
             f"| {quads} | {fragments} | {seconds:.1f} | {peak / 2**30:.2f} | {inputs / 2**30:.2f} |",
         ]
-    table = "\n".join(lines) + "\n"
-    args.out.mkdir(parents=True, exist_ok=True)
-    (args.out / "bench_render.md").write_text(table)
-    print(table, end="")
+    write_table(lines, args.out, "bench_render.md")
 
 
 if __name__ == "__main__":
