@@ -14,7 +14,6 @@ statement, the cache hashes its files and Q902 reports them missing.
 from __future__ import annotations
 
 import os
-import re
 from dataclasses import dataclass
 
 
@@ -93,8 +92,8 @@ def roles_named_in(kind: str) -> list[ResourceRole]:
     return [role for role in ROLES.values() if role.named_in == kind]
 
 
-#: Starts with its literal, so ``re`` skips ahead to each "mtllib" (a ``^`` anchor made it try every byte).
-_MTLLIB = re.compile(rb"mtllib[^\n]*")
+#: The statement's keyword, found by :func:`affinity.loaders.text.find_word` at its 'b'.
+_MTLLIB = b"mtllib"
 
 
 def uncommented(words: list[bytes]) -> list[bytes]:
@@ -112,11 +111,17 @@ def mtllib_statements(data) -> list[tuple[int, str]]:
     them. ``data`` is bytes-like; a line is 1-based; a '\\' line continuation is not
     followed (a library name never spans lines).
     """
+    from .text import find_word
+
     found, last_line = [], -1
     counted, line = 0, 1  # lines are counted from the previous statement on, not from the start each time
-    for match in _MTLLIB.finditer(data):
-        line_start = data.rfind(b"\n", 0, match.start()) + 1
-        words = uncommented(bytes(data[line_start : match.end()]).split())
+    start = find_word(data, _MTLLIB, len(_MTLLIB) - 1)
+    while start >= 0:
+        end = data.find(b"\n", start)
+        end = len(data) if end < 0 else end
+        line_start = data.rfind(b"\n", 0, start) + 1
+        words = uncommented(bytes(data[line_start:end]).split())
+        start = find_word(data, _MTLLIB, len(_MTLLIB) - 1, end)
         if line_start == last_line or words[:1] != [b"mtllib"]:  # said again on its line, or another statement
             continue
         last_line = line_start

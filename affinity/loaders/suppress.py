@@ -4,7 +4,7 @@ The OBJ reader drops comments; this pass looks for the directive only. On a
 face line it silences that face; on a ``g`` or ``o`` line it silences every
 face up to the next ``g``/``o`` line (like ruff's ``noqa``, per group). Codes
 are rule codes or prefixes, comma-separated; ``ignore`` without brackets
-silences every rule. Files without the word ``affinity:`` cost one ``bytes.find``.
+silences every rule. Files without the word ``affinity:`` cost one one-byte find (its ':').
 """
 
 from __future__ import annotations
@@ -12,6 +12,8 @@ from __future__ import annotations
 import re
 
 import numpy as np
+
+from .text import find_word
 
 _DIRECTIVE = re.compile(rb"#[^\n]*?affinity:[ \t]*ignore(?:\[([A-Za-z0-9_, \t]*)\])?")
 _GROUP_LINE = re.compile(rb"^[ \t]*[go](?=[ \t\r\n]|$)", re.MULTILINE)
@@ -28,7 +30,7 @@ def inline_ignores(data: bytes, face_line: np.ndarray) -> list[tuple[list[str], 
     silences and the (k,) int64 faces it covers. ``data`` is the OBJ file's bytes, as its
     loader read them (:func:`affinity.loaders.read_source`); ``face_line`` (F,) int64 is the
     1-based source line of every face, ascending (OBJ file order)."""
-    if data.find(_MARKER) < 0:
+    if find_word(data, _MARKER, len(_MARKER) - 1) < 0:
         return []
     found = list(_DIRECTIVE.finditer(data))
     if not found:

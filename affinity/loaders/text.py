@@ -121,6 +121,26 @@ def _join_continuations(buf: np.ndarray, last: int) -> np.ndarray:
     return newline[joined]
 
 
+def find_word(data, word: bytes, anchor: int, start: int = 0) -> int:
+    """Offset of the first ``word`` in the bytes-like ``data`` at or after ``start`` (-1: none).
+
+    ``word[anchor]`` is a byte mesh data seldom holds (no digit, sign, dot, space or
+    keyword letter: the ':' of ``affinity:``, the 'b' of ``mtllib``): the search jumps
+    between its occurrences with a one-byte find (``memchr``, several times faster
+    than a multi-byte find over a big file) and checks the word around each; past
+    a few dozen false hits it hands over to the plain find.
+    """
+    byte = word[anchor : anchor + 1]
+    at = data.find(byte, start + anchor)
+    for _ in range(64):
+        if at < 0:
+            return -1
+        if data[at - anchor : at - anchor + len(word)] == word:
+            return at - anchor
+        at = data.find(byte, at + 1)
+    return -1 if at < 0 else data.find(word, at - anchor)
+
+
 class _Ragged:
     """Rows stored as offsets ``first`` (R + 1,) into a flat array."""
 
