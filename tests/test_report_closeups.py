@@ -221,7 +221,8 @@ def test_uv_layout_fills_the_flagged_faces_in_the_flag_colour():
     mesh = grid_mesh(4)
     flagged = np.zeros(mesh.n_faces, dtype=bool)
     flagged[5] = True  # row 1, col 1: uv [0.25, 0.5]^2
-    image, low, side = layout_image(mesh, flagged, 64)
+    layout = layout_image(mesh, flagged, 64)
+    image, low, side = layout.image, layout.low, layout.side
     assert side == 1.0 and tuple(low) == (0.0, 0.0)
     tinted = np.all(np.isclose(image, OVERLAY_TINT, atol=1e-6), axis=2)
     rows, cols = np.nonzero(tinted)
@@ -323,23 +324,25 @@ def test_report_options_max_views_and_a_bad_texture(tmp_path):
 
 def test_uv_layout_labels_places_at_one_uv_spot_once(tmp_path):
     """Per-face unit uv (every face on the whole texture): one ring, one label naming every labelled face."""
-    from affinity.report.uvlayout import layout_svg
+    from affinity.report.uvlayout import layout_image, layout_svg
 
     path = tmp_path / "tiles.obj"
     path.write_text(quad_obj([(trapezoid(0.2 + 0.1 * k, 3 * k), UNIT_UV) for k in range(4)]))
-    svg = layout_svg(load(str(path)), np.ones(4, bool), [(3, "Q101"), (0, "Q101"), (2, "Q202")])
+    mesh = load(str(path))
+    svg = layout_svg(mesh, layout_image(mesh, np.ones(4, bool), 640), [(3, "Q101"), (0, "Q101"), (2, "Q202")])
     assert svg.count("<circle") == 1
     assert re.findall(r"<text[^>]*>([^<]*)</text>", svg) == ["faces 3, 0 (Q101)", "face 2 (Q202)"]
 
 
 def test_uv_layout_labels_crowded_at_the_bottom_stay_inside_the_picture(tmp_path):
-    from affinity.report.uvlayout import layout_svg
+    from affinity.report.uvlayout import layout_image, layout_svg
 
     # five small uv squares in a row at the bottom edge, 19 px apart: rings apart, labels colliding
     tiles = [[(0.05 + 0.03 * k + 0.004 * du, 0.003 + 0.004 * dv) for du, dv in UNIT_UV] for k in range(5)]
     path = tmp_path / "crowded.obj"
     path.write_text(quad_obj([(trapezoid(0.5, 3 * k), uv) for k, uv in enumerate(tiles)]))
-    svg = layout_svg(load(str(path)), np.ones(5, bool), [(k, "Q101") for k in range(5)], size=640)
+    mesh = load(str(path))
+    svg = layout_svg(mesh, layout_image(mesh, np.ones(5, bool), 640), [(k, "Q101") for k in range(5)])
     baselines = sorted(float(y) for y in re.findall(r'<text x="[^"]+" y="([^"]+)"', svg))
     assert len(baselines) == 5 and svg.count("<circle") == 5
     assert 12 <= baselines[0] and baselines[-1] <= 640 - 3  # none below the picture's edge

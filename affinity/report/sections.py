@@ -351,9 +351,22 @@ def closeups_section(result: MeshResult) -> Section:
     return Section("closeups", title, {"figures": figures, "places": len(result.places)}, notes)
 
 
+def _layout_notes(layout) -> list[str]:
+    """What the layout picture does not show one quad at a time: uv shared by several faces, quads left out."""
+    notes = []
+    if layout.distinct < layout.quads:
+        notes.append(f"{layout.quads:,} faces draw {layout.distinct:,} distinct uv quads: faces with the same uv "
+                     "overlap in texture space (per-face unit squares, mirrored halves) and are drawn once, "
+                     "filled toward magenta by the share of them that is flagged")
+    if layout.left_out:
+        notes.append(f"{layout.left_out:,} distinct uv quads not drawn: the faces pile up in texture space beyond "
+                     "the picture's budget (flagged ones are drawn first)")
+    return notes
+
+
 def uv_layout_section(result: MeshResult) -> Section:
     """Every face in texture space, flagged faces in the flag colour, the worst places labelled."""
-    from .uvlayout import layout_svg
+    from .uvlayout import LABELLED, LAYOUT_SIZE, layout_image, layout_svg
 
     title = "UV layout"
     if result.mesh.texcoords is None:
@@ -362,10 +375,12 @@ def uv_layout_section(result: MeshResult) -> Section:
     for hits in result.file.hits:
         flagged[hits.faces[hits.faces >= 0]] = True
     labelled = list(dict.fromkeys((place.worst, place.code) for place in result.places))
-    svg = layout_svg(result.mesh, flagged, labelled)
-    if svg is None:
+    layout = layout_image(result.mesh, flagged, LAYOUT_SIZE)
+    if layout is None:
         return leave_out("uv-layout", title, "no face has texture coordinates at every corner")
-    return Section("uv-layout", title, {"svg": svg, "flagged": int(flagged.sum()), "labelled": min(len(labelled), 8)})
+    return Section("uv-layout", title, {"svg": layout_svg(result.mesh, layout, labelled),
+                                        "flagged": int(flagged.sum()), "labelled": min(len(labelled), LABELLED)},
+                   _layout_notes(layout))
 
 
 def stability_section(result: MeshResult) -> Section:

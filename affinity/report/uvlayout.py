@@ -1,15 +1,19 @@
 """The UV layout: every face drawn in texture space, flagged ones filled in the flag colour, the worst labelled.
 
-The faces are rasterized with the project's own renderer, uv taken as screen
-positions (an orthographic view of the texture square), so a layout of a
-million quads costs one render. Edges are the pixels where the face changes.
-Faces too small to cover a pixel centre still mark the pixel under their
-centroid, and flagged faces are drawn over the others where faces overlap in uv,
-so no flagged face vanishes from the picture.
+The faces are drawn flat in one render (:func:`affinity.draw.flat.face_ids`),
+uv taken as picture positions, so a layout of a million quads costs one pass.
+Faces with the same uv quad (per-face unit squares, mirrored halves) are drawn
+once, and their count is said; distinct quads together cover at most
+``FRAGMENT_BUDGET`` pictures, so faces piled up in texture space cannot make the
+pass cost a fragment per face per pixel. Edges are the pixels where the quad
+changes. Faces too small to cover a pixel centre still mark the pixel under
+their centroid, and flagged faces are drawn over the others where faces overlap
+in uv, so no flagged face vanishes from the picture.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from html import escape
 
 import numpy as np
@@ -19,6 +23,8 @@ from .images import image_uri
 
 FACE_FILL = np.array([0.86, 0.89, 0.93])
 EDGE = np.array([0.42, 0.45, 0.50])
+#: Side of the layout picture, pixels.
+LAYOUT_SIZE = 640
 #: Labelled faces per layout.
 LABELLED = 8
 #: The ring around a labelled face, the gap to its label, and the label's line height and (12 px
@@ -28,6 +34,9 @@ LABEL_GAP = 10
 LABEL_LINE = 15
 LABEL_CHAR_WIDTH = 6.8
 FACES_PER_LINE = 4
+#: The distinct uv quads drawn cover at most this many times the picture's pixels together (a layout whose
+#: faces pile up in texture space would otherwise cost a fragment per face per pixel).
+FRAGMENT_BUDGET = 24
 
 
 def uv_bounds(uv: np.ndarray) -> tuple[np.ndarray, float]:
@@ -37,13 +46,41 @@ def uv_bounds(uv: np.ndarray) -> tuple[np.ndarray, float]:
     return low, float((high - low).max())
 
 
-def layout_image(mesh: Mesh, flagged: np.ndarray, size: int) -> tuple[np.ndarray, np.ndarray, float] | None:
-    """(size, size, 3) float RGB of the layout, with the drawn square's corner and side; None without uv.
+@dataclass(frozen=True)
+class Layout:
+    """The layout picture and what it drew.
 
-    ``flagged`` (F,) bool over the mesh's faces.
+    image : (S, S, 3) float64 RGB
+    low, side : (2,) lower-left corner and side of the uv square drawn (:func:`uv_bounds`)
+    quads : render quads with uv at every corner (a triangle is one, an n-gon its fan)
+    distinct : the distinct uv quads among them (quads with the same uv, to an eighth of a pixel, draw once)
+    left_out : distinct quads not drawn, beyond :data:`FRAGMENT_BUDGET` (flagged ones are drawn first)
     """
-    from render import rasterize_quads
 
+    image: np.ndarray
+    low: np.ndarray
+    side: float
+    quads: int
+    distinct: int
+    left_out: int
+
+
+def _pixel_areas(points: np.ndarray, size: int) -> np.ndarray:
+    """(R,) the shoelace area in pixels of quads ``points`` (R, 4, 2) in [-1, 1]^2."""
+    x, y = points[..., 0], points[..., 1]
+    twice = (x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y).sum(axis=1)
+    return np.abs(twice) / 2 * (size / 2) ** 2
+
+
+def layout_image(mesh: Mesh, flagged: np.ndarray, size: int) -> Layout | None:
+    """The layout picture (see the module docstring); None without uv.
+
+    ``flagged`` (F,) bool over the mesh's faces. Quads sharing their uv (per-face
+    unit squares, mirrored halves) are drawn once, filled toward the flag colour by
+    the share of them that is flagged; where distinct quads overlap, flagged ones
+    are drawn over the others.
+    """
+    from ..draw.flat import face_ids
     from ..draw.quads import render_corners
     from ..draw.shading import OVERLAY_TINT
 
@@ -57,23 +94,27 @@ def layout_image(mesh: Mesh, flagged: np.ndarray, size: int) -> tuple[np.ndarray
         return None
     low, side = uv_bounds(uv.reshape(-1, 2))
     ndc = (uv - low) / side * 2.0 - 1.0
-    # Flagged faces are nearer, so where faces overlap in uv (per-face unit squares, mirrored halves) they show.
-    depth = np.repeat(np.where(flagged[faces], -0.5, 0.0)[:, None, None], 4, axis=1)
-    clip = np.concatenate([ndc, depth, np.ones(ndc.shape[:2] + (1,))], axis=-1)
-    frame = rasterize_quads(clip, np.zeros(ndc.shape[:2] + (1,)), size, size, method="split")
-    face = np.where(frame.face >= 0, faces[np.maximum(frame.face, 0)], -1)
+    key = np.round(ndc * (4 * size)).astype(np.int64).reshape(len(ndc), 8)  # eighths of a pixel
+    _, first, group = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    group = group.ravel()
+    share = np.bincount(group, weights=flagged[faces], minlength=len(first)) / np.bincount(group)
+    order = np.lexsort((first, share == 0))  # flagged first, then file order
+    drawn = order[np.cumsum(_pixel_areas(ndc[first[order]], size)) <= FRAGMENT_BUDGET * size * size]
+    drawn.sort()
+    ids = face_ids(ndc[first[drawn]], share[drawn] > 0, size)
+    covered = ids >= 0
+    fill = FACE_FILL + share[drawn, None] * (OVERLAY_TINT - FACE_FILL)
     image = np.ones((size, size, 3))
-    image[face >= 0] = FACE_FILL
-    image[(face >= 0) & flagged[np.maximum(face, 0)]] = OVERLAY_TINT
-    edge = np.zeros_like(face, dtype=bool)
-    edge[:, :-1] |= face[:, :-1] != face[:, 1:]
-    edge[:-1] |= face[:-1] != face[1:]
+    image[covered] = fill[ids[covered]]
+    edge = np.zeros_like(covered)
+    edge[:, :-1] |= ids[:, :-1] != ids[:, 1:]
+    edge[:-1] |= ids[:-1] != ids[1:]
     image[edge] = EDGE
     centre = ndc[flagged[faces]].mean(axis=1)
     col = np.clip(((centre[:, 0] + 1) / 2 * size).astype(int), 0, size - 1)
     row = np.clip(((1 - centre[:, 1]) / 2 * size).astype(int), 0, size - 1)
     image[row, col] = OVERLAY_TINT
-    return image, low, side
+    return Layout(image, low, side, len(faces), len(first), len(first) - len(drawn))
 
 
 def face_uv_centre(mesh: Mesh, face: int) -> np.ndarray:
@@ -104,19 +145,17 @@ def _free_baseline(baseline: float, left: float, width: float, boxes: list, size
     return baseline
 
 
-def layout_svg(mesh: Mesh, flagged: np.ndarray, labelled: list[tuple[int, str]], size: int = 640) -> str | None:
-    """The layout as inline SVG: the raster picture, and a ringed label ``face F (CODE)`` at each labelled face.
+def layout_svg(mesh: Mesh, layout: Layout, labelled: list[tuple[int, str]]) -> str:
+    """The layout as inline SVG: the picture of :func:`layout_image`, and a ringed label ``face F (CODE)`` at
+    each labelled face.
 
-    ``labelled`` is (face, rule code) of the worst places. None without uv.
+    ``labelled`` is (face, rule code) of the worst places.
     Places whose uv centres fall within a ring of each other (e.g. every face
     mapped onto the whole texture) share one ring, labelled a line per rule
     (``faces 3, 7 (Q101)``); a line goes to the side of its ring with room,
     moved down (at the bottom, up) until it covers no other line and no ring.
     """
-    drawn = layout_image(mesh, flagged, size)
-    if drawn is None:
-        return None
-    image, low, side = drawn
+    image, low, side, size = layout.image, layout.low, layout.side, len(layout.image)
     rings: list[tuple[float, float, dict[str, list[int]]]] = []
     for face, code in labelled[:LABELLED]:
         u, v = (face_uv_centre(mesh, face) - low) / side
