@@ -1,0 +1,121 @@
+"""``affinity report`` on a car-sized mesh: the whole command's wall time and peak memory, and the UV layout's share.
+
+The mesh is the shared OpenSubdiv car (``../shared/meshes/osd_catmark_car.obj``,
+1,575 quads with per-face unit uv) subdivided linearly three times: 100,800 quads,
+every one of them mapping the whole texture square, as the issue's car did. When
+the shared meshes are absent the built-in demo sphere is subdivided instead (said
+in the table). Each round runs ``affinity report -q`` in a fresh process; the UV
+layout (:func:`affinity.report.uvlayout.layout_image` and its SVG) is timed in one
+more process on the same file and the lint's flags.
+
+    python benchmarks/bench_report.py                 # 100,800 quads, 3 rounds
+    python benchmarks/bench_report.py --small --out /tmp/bench   # 6,300 quads, 1 round (the test's case)
+
+The table goes to ``<out>/bench_report.md`` (default ``reports/bench/``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+from common import parse_with_output, write_table
+
+CAR = Path(__file__).resolve().parents[2] / "shared" / "meshes" / "osd_catmark_car.obj"
+LAYOUT_CHILD = """
+import sys, time
+import numpy as np
+from affinity.pipeline.check import load_and_check
+from affinity.report.uvlayout import LAYOUT_SIZE, layout_image, layout_svg
+from affinity.settings import Settings
+file, mesh = load_and_check(sys.argv[1], Settings())
+flagged = np.zeros(mesh.n_faces, dtype=bool)
+for hits in file.hits:
+    flagged[hits.faces[hits.faces >= 0]] = True
+start = time.perf_counter()
+layout_svg(mesh, layout_image(mesh, flagged, LAYOUT_SIZE), [])
+print(time.perf_counter() - start)
+"""
+
+
+def subdivide(positions: np.ndarray, quads: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """One linear subdivision: each quad (Q, 4) int64 into four, edge midpoints shared between neighbours.
+
+    Returns the positions (V + E + Q, 3) float64 and the quads (4Q, 4) int64, wound as their parents.
+    """
+    edges = np.sort(np.stack([quads, np.roll(quads, -1, axis=1)], axis=2).reshape(-1, 2), axis=1)
+    unique, edge = np.unique(edges, axis=0, return_inverse=True)
+    mid = len(positions) + edge.reshape(-1, 4)
+    centre = len(positions) + len(unique) + np.arange(len(quads))
+    positions = np.concatenate([positions, positions[unique].mean(axis=1), positions[quads].mean(axis=1)])
+    (a, b, c, d), (ab, bc, cd, da) = quads.T, mid.T
+    children = [(a, ab, centre, da), (ab, b, bc, centre), (centre, bc, c, cd), (da, centre, cd, d)]
+    return positions, np.stack([np.stack(child, axis=1) for child in children], axis=1).reshape(-1, 4)
+
+
+def write_car(path: str, levels: int) -> str:
+    """Write the subdivided car (or demo sphere) with per-face unit uv to ``path``; return what it came from."""
+    from affinity.loaders import load
+    from affinity.scenes import DEMO_SPHERE
+
+    source = load(str(CAR)) if CAR.exists() else DEMO_SPHERE.mesh()
+    positions, quads = source.positions, source.corner_vertex.reshape(-1, 4)
+    for _ in range(levels):
+        positions, quads = subdivide(positions, quads)
+    with open(path, "w") as out:
+        np.savetxt(out, positions, fmt="v %.6f %.6f %.6f")
+        out.write("vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n")
+        corners = np.stack([quads + 1, np.tile(np.arange(1, 5), (len(quads), 1))], axis=2).reshape(-1, 8)
+        np.savetxt(out, corners, fmt="f" + " %d/%d" * 4)
+    return f"{'the shared car' if CAR.exists() else 'the demo sphere (no shared car)'}, subdivided {levels}x"
+
+
+def timed_process(command: list[str]) -> tuple[float, float, str]:
+    """Run ``command`` (whose output is a few lines); its wall time (s), peak resident memory (MiB), stdout."""
+    start = time.perf_counter()
+    child = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    _, status, usage = os.wait4(child.pid, 0)
+    wall = time.perf_counter() - start
+    child.returncode = os.waitstatus_to_exitcode(status)
+    out, err = child.stdout.read(), child.stderr.read()
+    child.stdout.close(), child.stderr.close()
+    if child.returncode:
+        sys.exit(f"{' '.join(command)} failed:\n{err}")
+    return wall, usage.ru_maxrss / 1024, out
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--rounds", type=int, default=3)
+    args = parse_with_output(parser, "6,300 quads, 1 round", "folder of bench_report.md", argv)
+    levels, rounds = (1, 1) if args.small else (3, args.rounds)
+    with tempfile.TemporaryDirectory() as folder:
+        mesh = os.path.join(folder, "car.obj")
+        source = write_car(mesh, levels)
+        quads = sum(1 for line in open(mesh) if line.startswith("f "))
+        load = os.getloadavg()[0]
+        runs = [timed_process([sys.executable, "-m", "affinity.cli", "report", "-q", mesh,
+                               "-o", os.path.join(folder, "report.html")]) for _ in range(rounds)]
+        layout = float(timed_process([sys.executable, "-c", LAYOUT_CHILD, mesh])[2])
+    wall = statistics.median(run[0] for run in runs)
+    memory = max(run[1] for run in runs)
+    write_table([
+        f"{quads:,} quads ({source}, per-face unit uv), {platform.processor() or platform.machine()}, "
+        f"{os.cpu_count()} CPUs, load {load:.2f} before, median of {rounds} round{'s' * (rounds > 1)}:",
+        "",
+        "| `affinity report -q` | wall (s) | peak memory (MiB) | UV layout (s) | UV layout share |",
+        "|---|---:|---:|---:|---:|",
+        f"| {quads:,} quads | {wall:.2f} | {memory:.0f} | {layout:.2f} | {layout / wall:.1%} |",
+    ], args.out, "bench_report.md")
+
+
+if __name__ == "__main__":
+    main()
