@@ -18,6 +18,7 @@ import sys
 from ..errors import UsageError
 from ..loaders.formats import described
 from ..report import MAX_VIEWS, RENDER_SIZE
+from ..report.places import PLACE_FACES
 from . import EXIT_CLEAN, EXIT_ERROR, camera, image_size, pixel_tolerance, require
 
 
@@ -45,6 +46,9 @@ def add_parser(sub) -> None:
                    help="the hybrid routes a quad to mvc when the split moves its texture by more than PX pixels")
     p.add_argument("--max-views", type=_count, default=MAX_VIEWS, metavar="N",
                    help=f"close-ups per mesh, worst flagged places first (default: {MAX_VIEWS}; 0: none)")
+    p.add_argument("--place-faces", type=_positive, default=PLACE_FACES, metavar="N",
+                   help=f"the most faces a close-up's place holds: a bigger group of flagged faces is cut into "
+                        f"places around its worst faces (default: {PLACE_FACES})")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no result line")
     p.set_defaults(run=run)
 
@@ -56,6 +60,13 @@ def _count(text: str) -> int:
         value = -1
     if value < 0:
         raise argparse.ArgumentTypeError(f"not a count: {text!r} (use 0 or more)")
+    return value
+
+
+def _positive(text: str) -> int:
+    value = _count(text)
+    if value == 0:
+        raise argparse.ArgumentTypeError(f"not a positive count: {text!r} (use 1 or more)")
     return value
 
 
@@ -116,7 +127,8 @@ def run(args) -> int:
         except TextureError as err:
             raise UsageError(str(err)) from None
     options = ReportOptions(up=args.up, size=args.size, camera=args.camera, texture=args.texture,
-                            pixel_tolerance=args.pixel_tolerance, max_views=args.max_views)
+                            pixel_tolerance=args.pixel_tolerance, max_views=args.max_views,
+                            place_faces=args.place_faces)
     resolver = Resolver({})
     inputs = _inputs(args.meshes, resolver)
     with tqdm(total=len(inputs), unit="file", file=sys.stderr, leave=False, delay=1.0,

@@ -23,6 +23,7 @@ from ..scenes import View
 from ..settings import Settings
 from . import MAX_VIEWS, RENDER_SIZE
 from .demo import MeshInput
+from .places import PLACE_FACES
 
 #: Methods drawn beside the hybrid when it sent quads to mvc (``exact``: the ray / bilinear-patch reference).
 COMPARED_METHODS = ("split", "mvc", "exact")
@@ -35,7 +36,8 @@ class ReportOptions:
     """The render options ``affinity report`` takes (None: the mesh's own or the default).
 
     ``camera`` and ``up`` replace every mesh's view; ``size`` is the overview and
-    render size (width, height); ``texture`` replaces map_Kd and the grid.
+    render size (width, height); ``texture`` replaces map_Kd and the grid;
+    ``place_faces`` is the most faces a close-up's place holds.
     """
 
     up: str | None = None
@@ -44,6 +46,7 @@ class ReportOptions:
     texture: str | None = None
     pixel_tolerance: float = 0.5
     max_views: int = MAX_VIEWS
+    place_faces: int = PLACE_FACES
 
 
 @dataclass(eq=False)
@@ -53,9 +56,8 @@ class MeshResult:
     ``file`` is the lint outcome (with ``error`` or ``skipped`` set, nothing
     else is collected). ``shown`` is the rule code of the attribute the renders
     show (None: plain shading). ``renders`` maps a method (``hybrid`` and, when
-    it sent quads to mvc, ``split``, ``mvc``, ``exact``) to its render;
-    ``missing`` a method that could not be drawn to the reason. ``overlay`` is
-    the hybrid with the mvc quads tinted. ``overview`` is the pyvista picture
+    it sent quads to mvc, ``split``, ``mvc``, ``exact``) to its render (the
+    hybrid's ``tinted`` image is the overlay of the quads it sent to mvc). ``overview`` is the pyvista picture
     (H, W, 3) uint8, else ``overview_note`` says why there is none. ``camera``
     and ``up`` are the view of the renders and the overview. ``places`` are every
     flagged place, ranked (:func:`affinity.report.places.choose_places` with no
@@ -73,9 +75,7 @@ class MeshResult:
     shown: str | None = None
     texture: str = ""
     renders: dict = field(default_factory=dict)
-    missing: dict[str, str] = field(default_factory=dict)
     render_error: str | None = None
-    overlay: object | None = None
     overview: np.ndarray | None = None
     overview_note: str | None = None
     warnings: list[str] = field(default_factory=list)
@@ -121,7 +121,7 @@ def _texture_label(mesh: Mesh, view: View, texture: str | None = None) -> str:
 
 
 def _render(result: MeshResult, texture: np.ndarray | None, step: Callable[[str], None]) -> None:
-    """The hybrid render; when it sent quads to mvc, the compared methods and the overlay too."""
+    """The hybrid render; when it sent quads to mvc, the compared methods too."""
     from ..draw.drawing import RenderOptions, render_mesh
     from ..draw.routing import MVC
     from ..draw.texture import TextureError
@@ -144,12 +144,7 @@ def _render(result: MeshResult, texture: np.ndarray | None, step: Callable[[str]
         return
     for method in COMPARED_METHODS:
         step(f"render {method}")
-        try:
-            result.renders[method] = draw(method=method)
-        except NotImplementedError as err:
-            result.missing[method] = str(err)
-    step("render overlay")
-    result.overlay = draw(method="hybrid", overlay=True)
+        result.renders[method] = draw(method=method)
 
 
 def _overview(result: MeshResult, step: Callable[[str], None]) -> None:
@@ -187,7 +182,7 @@ def _closeups(result: MeshResult, step: Callable[[str], None]) -> None:
     from .closeups import closeup
     from .places import choose_places, places_of
 
-    by_rule = {hits.code: places_of(result.mesh, hits) for hits in result.file.hits}
+    by_rule = {hits.code: places_of(result.mesh, hits, result.options.place_faces) for hits in result.file.hits}
     result.places = choose_places(by_rule, sum(len(p) for p in by_rule.values()))
     start = time.perf_counter()
     shown = np.zeros(result.mesh.n_faces, dtype=bool)  # no two close-ups share a face

@@ -193,7 +193,6 @@ def renders_section(result: MeshResult) -> Section:
     if routed == 0:
         notes.append(f"nothing needed mvc: the hybrid drew all {len(hybrid.methods)} quads as split (no split error "
                      "reaches the pixel tolerance in this view), so the comparison with mvc is left out")
-    notes += [f"{method} left out: {reason}" for method, reason in result.missing.items()]
     figures = [
         {"method": method, "src": image_uri(result.renders[method].image), "what": METHOD_CAPTIONS[method],
          "seconds": result.renders[method].seconds}
@@ -208,25 +207,23 @@ def renders_section(result: MeshResult) -> Section:
 def overlay_section(result: MeshResult) -> Section:
     """The hybrid render with the quads it sent to mvc tinted."""
     title = "Quads sent to mvc"
-    if result.overlay is None:
-        reason = (f"cannot render: {result.render_error}" if result.render_error
-                  else "nothing was sent to mvc in this view, so there is nothing to tint")
-        return leave_out("overlay", title, reason)
-    from ..draw.drawing import RenderOptions
+    if result.render_error:
+        return leave_out("overlay", title, f"cannot render: {result.render_error}")
     from ..draw.routing import MVC
 
-    overlay = result.overlay
+    hybrid = result.renders["hybrid"]
+    routed = int(np.count_nonzero(hybrid.methods == MVC))
+    if routed == 0:
+        return leave_out("overlay", title, "nothing was sent to mvc in this view, so there is nothing to tint")
     return Section("overlay", title, {
-        "src": image_uri(overlay.image), "routed": int(np.count_nonzero(overlay.methods == MVC)),
-        "quads": len(overlay.methods), "tolerance": RenderOptions.pixel_tolerance,
+        "src": image_uri(hybrid.tinted), "routed": routed, "quads": len(hybrid.methods),
+        "tolerance": result.options.pixel_tolerance,
     })
 
 
 def _why_no_exact(result: MeshResult) -> str:
     if result.render_error:
         return f"cannot render: {result.render_error}"
-    if "exact" in result.missing:
-        return f"render has no exact reference yet ({result.missing['exact']})"
     return "nothing needed mvc in this view, so there is no comparison to map"
 
 

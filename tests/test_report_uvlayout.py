@@ -1,0 +1,69 @@
+"""The UV layout draws faces that share their uv once, says so, and keeps piled-up layouts cheap."""
+
+from __future__ import annotations
+
+import numpy as np
+from helpers.quads import UNIT_UV, quad_obj, trapezoid
+
+from affinity.loaders import load
+
+
+def test_per_face_unit_uv_is_one_square_filled_by_its_flagged_share(tmp_path):
+    """Reproduces the issue: per-face unit uv was a plain magenta square and cost a fragment per face per pixel."""
+    from affinity.draw.shading import OVERLAY_TINT
+    from affinity.report.sections import _layout_notes
+    from affinity.report.uvlayout import FACE_FILL, layout_image
+
+    path = tmp_path / "tiles.obj"
+    path.write_text(quad_obj([(trapezoid(0.2 + 0.1 * k, 3 * k), UNIT_UV) for k in range(4)]))
+    flagged = np.array([True, False, False, False])
+    layout = layout_image(load(str(path)), flagged, 64)
+    assert (layout.quads, layout.distinct, layout.left_out) == (4, 1, 0)
+    # a pixel away from the edges and the flagged face's centre mark: a quarter of the way to the flag colour
+    assert np.allclose(layout.image[10, 50], FACE_FILL + 0.25 * (OVERLAY_TINT - FACE_FILL))
+    assert "4 faces draw 1 distinct uv quads" in _layout_notes(layout)[0]
+
+
+def test_piled_up_distinct_quads_stay_within_the_budget_and_flagged_ones_are_drawn(tmp_path):
+    from affinity.draw.shading import OVERLAY_TINT
+    from affinity.report.uvlayout import FRAGMENT_BUDGET, layout_image
+
+    # 3 * budget quads, each covering nearly the whole square, none sharing its uv with another
+    count = 3 * FRAGMENT_BUDGET
+    uvs = [[(u * (1 - 0.005 * k), v * (1 - 0.005 * k)) for u, v in UNIT_UV] for k in range(count)]
+    path = tmp_path / "piled.obj"
+    path.write_text(quad_obj([(trapezoid(1.0, 3 * k), uv) for k, uv in enumerate(uvs)]))
+    flagged = np.zeros(count, dtype=bool)
+    flagged[-1] = True  # the last in file order: beyond the budget unless flagged quads go first
+    layout = layout_image(load(str(path)), flagged, 64)
+    area = (1 - 0.005 * np.arange(count)) ** 2 * 64 * 64  # each quad's pixels, by its closed form
+    drawn_first = np.r_[area[-1], area[:-1]]  # the flagged quad, then file order
+    assert layout.distinct == count
+    assert layout.left_out == count - np.searchsorted(np.cumsum(drawn_first), FRAGMENT_BUDGET * 64 * 64,
+                                                      side="right")
+    assert np.allclose(layout.image[40, 20], OVERLAY_TINT)  # drawn over the others
+
+
+def test_place_faces_caps_every_closeup_and_no_two_share_a_face(tmp_path):
+    """``--place-faces``: one connected group of 144 flagged faces is cut into places of at most N faces."""
+    import re
+    import subprocess
+    import sys
+
+    n = 12
+    x, y = np.meshgrid(np.arange(n + 1.0), np.arange(n + 1.0))
+    x, y = x.ravel(), y.ravel()
+    u, v = (x + 0.5 * x * y) / (n + 0.5 * n * n), y / n  # the x*y term: no quad's uv is affine in its positions
+    corner = (np.arange(n)[None, :] + (n + 1) * np.arange(n)[:, None]).ravel() + 1
+    quads = np.stack([corner, corner + 1, corner + n + 2, corner + n + 1], axis=1)
+    path = tmp_path / "bent.obj"
+    path.write_text("".join(f"v {a} {b} 0\n" for a, b in zip(x, y)) + "".join(f"vt {a} {b}\n" for a, b in zip(u, v))
+                    + "".join("f " + " ".join(f"{k}/{k}" for k in quad) + "\n" for quad in quads.tolist()))
+    for most in (64, 10):
+        html = tmp_path / f"report{most}.html"
+        done = subprocess.run([sys.executable, "-m", "affinity.cli", "report", "-q", str(path), "-o", str(html),
+                               "--place-faces", str(most)], capture_output=True, text=True, timeout=300)
+        assert done.returncode == 0, done.stderr
+        places = [set(map(int, found.split(","))) for found in re.findall(r'data-place="([^"]*)"', html.read_text())]
+        assert len(places) >= 2 and all(len(place) <= most for place in places)
+        assert sum(map(len, places)) == len(set().union(*places))  # no face in two close-ups
