@@ -24,32 +24,27 @@ def error_of(tmp_path, content, name="mesh.obj") -> MeshError:
     return caught.value
 
 
-@pytest.mark.parametrize(
-    "body, line, words",
-    [
-        (SQUARE + "f 1 2\n", 5, "corners"),
-        (SQUARE + "f\n", 5, "corners"),
-        (SQUARE + "f 1 0 2\n", 5, "index"),
-        (SQUARE + "f 1 2 9\n", 5, "out of range"),
-        (SQUARE + "f 1 2 3\nf -5 1 2\n", 6, "out of range"),
-        (SQUARE + "f 1/1 2/1 3/1\n", 5, "texture coordinate index out of range"),
-        (SQUARE + "vt 0 0\nf 1//1 2//1 3//1\n", 6, "normal index out of range"),
-        ("v 0 0 0\nv 1 nan 0\nv 1 1 0\nf 1 2 3\n", 2, "finite"),
-        ("v 0 0 0\nv 1 0 inf\nv 1 1 0\nf 1 2 3\n", 2, "finite"),
-        ("v 0 0 0\nv 1 0 1e999\nv 1 1 0\nf 1 2 3\n", 2, "finite"),
-        ("v 0 0 0\nv 1 0 x\nv 1 1 0\nf 1 2 3\n", 2, "not a number"),
-        ("v 0 0\n", 1, "numbers"),
-        (SQUARE + "vn 0 1\n", 5, "numbers"),
-        (SQUARE + "f 1/1/1/1 2 3\n", 5, "malformed"),
-        (SQUARE + "f 1/1// 2 3\n", 5, "malformed"),
-        (SQUARE + "f /1 2 3\n", 5, "malformed"),
-        (SQUARE + "f 1///2 2 3\n", 5, "malformed"),
-        (SQUARE + "vt 0 0\nf 1/1 2 3\n", 6, "mix"),
-        (SQUARE + "f 1 2 3.5\n", 5, "index"),
-        ("v 0 0 0 2 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n", 1, "colour"),
-        (SQUARE + "1.0 2.0 3.0\n", 5, "statement"),
-    ],
-)
+#: Statements after the square's four vertices that are wrong on their own line (5), by the words of the error.
+BAD_FIFTH_LINE = {
+    "corners": ["f 1 2", "f"], "index": ["f 1 0 2", "f 1 2 3.5"], "out of range": ["f 1 2 9"],
+    "texture coordinate index out of range": ["f 1/1 2/1 3/1"], "numbers": ["vn 0 1"],
+    "malformed": ["f 1/1/1/1 2 3", "f 1/1// 2 3", "f /1 2 3", "f 1///2 2 3"], "statement": ["1.0 2.0 3.0"],
+}
+#: Whole files whose error is on a later or an earlier line: (text, line, words).
+BAD_OTHER_LINE = [
+    (SQUARE + "f 1 2 3\nf -5 1 2\n", 6, "out of range"), (SQUARE + "vt 0 0\nf 1/1 2 3\n", 6, "mix"),
+    (SQUARE + "vt 0 0\nf 1//1 2//1 3//1\n", 6, "normal index out of range"), ("v 0 0\n", 1, "numbers"),
+    *((f"v 0 0 0\nv 1 0 {bad}\nv 1 1 0\nf 1 2 3\n", 2, "finite") for bad in ("nan", "inf", "1e999")),
+    ("v 0 0 0\nv 1 0 x\nv 1 1 0\nf 1 2 3\n", 2, "not a number"),
+    ("v 0 0 0 2 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n", 1, "colour"),
+]
+
+
+@pytest.mark.parametrize("body, line, words", [
+    *((SQUARE + statement + "\n", 5, words) for words, statements in BAD_FIFTH_LINE.items()
+      for statement in statements),
+    *BAD_OTHER_LINE,
+])
 def test_obj_errors_name_the_line(tmp_path, body, line, words):
     error = error_of(tmp_path, body)
     assert error.line == line
