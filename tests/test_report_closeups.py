@@ -133,16 +133,18 @@ def test_closeup_camera_looks_at_the_place_along_its_normal_and_fits_its_ring():
     assert view.ring.tolist() == [44, 45, 46, 54, 55, 56, 64, 65, 66]  # the quad and its eight neighbours
 
 
-def test_grid_cell_puts_eight_cells_across_the_quad_and_the_grid_is_a_checker():
-    from affinity.draw.texture import grid_cell, grid_colours
+def test_line_pattern_inks_each_pixel_by_its_coverage_of_a_line():
+    """A u ramp of one footprint per pixel: the ink of a 1.5 px box-filtered line, from its closed form."""
+    from affinity.draw.texture import LINE_SPACING, LINE_WIDTH, PAPER, U_INK, line_colours, pixel_footprint
 
-    uv = np.array([[0.1, 0.2], [0.1016, 0.2], [0.1016, 0.2008], [0.1, 0.2008]])
-    assert grid_cell(uv) == pytest.approx(0.0016 / 8)
-    cell = 0.5
-    centres = np.array([[0.25, 0.25], [0.75, 0.25], [0.75, 0.75], [0.01, 0.25]])
-    colours = grid_colours(centres, cell)
-    assert np.allclose(colours[0], colours[2]) and not np.allclose(colours[0], colours[1])
-    assert np.allclose(colours[3], [0.85, 0.25, 0.15], atol=1e-6)  # on a cell edge: the line
+    footprint = 1e-4
+    columns = np.arange(64) + 0.5  # pixel centres
+    uv = np.stack([columns * footprint, np.full(64, 0.5 * LINE_SPACING * footprint)], axis=1)  # v between lines
+    assert pixel_footprint(uv.reshape(1, 64, 2)) == pytest.approx(footprint)
+    ink = (line_colours(uv, footprint) - PAPER)[:, 0] / (U_INK - PAPER)[0]
+    distance = np.abs(columns - LINE_SPACING * np.round(columns / LINE_SPACING))  # pixels to the nearest u line
+    coverage = np.clip(np.minimum(distance + LINE_WIDTH / 2, 0.5) - np.maximum(distance - LINE_WIDTH / 2, -0.5), 0, 1)
+    assert np.allclose(ink, coverage, atol=1e-6)
 
 
 def test_outline_is_the_border_of_the_mask():

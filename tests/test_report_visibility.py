@@ -106,16 +106,10 @@ def test_a_left_handed_mesh_is_seen_from_outside(shared_meshes, tmp_path):
     check_figures(flipped, figures)
 
 
-#: The UV grid of today's close-ups is still a checker at 8 cells a face: on these meshes split and exact
-#: differ on fewer than 1 % of a close-up's pixels (0.3 % on the non-quads' face 14). Lines at the place's
-#: texel scale (issue 25) are still to do; strict, so the day they pass the mark must go.
-PATTERN_TODO = pytest.mark.xfail(strict=True, reason="split | exact differ on < 1 % of pixels: pattern not done")
-
-
 @pytest.mark.parametrize("name", ["spot_control_mesh.obj", "osd_catmark_bishop.obj", "osd_catmark_torus.obj",
-                                  "osd_catmark_car.obj", pytest.param("gen_vase_revolution.obj", marks=PATTERN_TODO),
+                                  "osd_catmark_car.obj", "gen_vase_revolution.obj",
                                   "tinyobjloader_cube_vertexcol.obj", "gen_uv_sphere_64x32.obj",
-                                  pytest.param("osd_catmark_nonquads.obj", marks=PATTERN_TODO),
+                                  "osd_catmark_nonquads.obj",
                                   "makehuman_base_hm08.obj", "gen_spot_cc4.obj"])
 def test_every_closeup_of_a_shared_mesh_shows_its_place(shared_meshes, tmp_path, name):
     path = shared_meshes / name

@@ -75,42 +75,48 @@ def sample_bilinear(image: np.ndarray, uv: np.ndarray) -> np.ndarray:
     return (top * (1 - fy) + bottom * fy).astype(np.float32)
 
 
-#: Cells of the close-up grid across the largest uv extent of the quad it is about.
-GRID_CELLS = 8
+#: Lines of the close-up pattern are this many pixels apart on screen, and this many pixels wide.
+LINE_SPACING = 6.0
+LINE_WIDTH = 1.5
+PAPER = np.array([0.96, 0.94, 0.88])
+U_INK = np.array([0.12, 0.28, 0.62])
+V_INK = np.array([0.80, 0.18, 0.12])
 
 
-def grid_cell(uv: np.ndarray, cells: int = GRID_CELLS) -> float:
-    """The grid cell (uv units) that puts ``cells`` cells across a quad's largest uv extent.
+def pixel_footprint(uv: np.ndarray) -> float:
+    """The median uv distance between neighbouring pixels of a frame's uv (H, W, 2) float (NaN where empty).
 
-    ``uv`` (4, 2) float64: the quad's corner texture coordinates. A quad with no
-    uv extent gets cells of 1/``cells``.
+    The scale at which a close-up's pattern is drawn: lines ``LINE_SPACING`` pixels
+    apart are ``LINE_SPACING`` footprints apart in uv. 1.0 when no two neighbours are covered.
     """
-    extent = float(np.ptp(uv, axis=0).max())
-    return (extent if extent > 0 else 1.0) / cells
+    steps = np.concatenate([np.linalg.norm(np.diff(uv, axis=0), axis=-1).ravel(),
+                            np.linalg.norm(np.diff(uv, axis=1), axis=-1).ravel()])
+    steps = steps[np.isfinite(steps) & (steps > 0)]
+    return float(np.median(steps)) if len(steps) else 1.0
 
 
-def grid_colours(uv: np.ndarray, cell: float) -> np.ndarray:
-    """A procedural UV grid, a checker of ``cell``-sized squares with lines on the cell edges.
+def line_colours(uv: np.ndarray, footprint: float) -> np.ndarray:
+    """Antialiased lines of constant u (blue) and constant v (red), ``LINE_SPACING`` footprints apart.
 
-    Computed from the coordinates themselves rather than sampled from an image, so
-    it stays sharp at any scale: a close-up on a quad a thousandth of the atlas
-    wide still shows eight cells across it, and a bent diagonal bends the lines.
+    Computed from each pixel's coordinates: a pixel's ink is its coverage by a line
+    ``LINE_WIDTH`` pixels wide (a box filter: ``clip(w / 2 + 1 / 2 - d, 0, 1)`` at a
+    distance of ``d`` pixels from the line's centre), so lines stay thin and smooth at
+    any scale. Both families cross the split's diagonal, so where the split moves the
+    texture they kink at it and the split and exact panels differ.
 
     Parameters
     ----------
     uv : (N, 2) float, texture coordinates
-    cell : the side of one square, in uv units
+    footprint : the uv distance between neighbouring pixels (:func:`pixel_footprint`)
 
     Returns
     -------
-    (N, 3) float32 RGB: the checker's two colours, grid lines (1/12 of a cell wide) in red.
+    (N, 3) float32 RGB.
     """
-    scaled = np.asarray(uv, dtype=np.float64) / cell
-    whole = np.floor(scaled)
-    parity = (whole[:, 0] + whole[:, 1]) % 2
-    light, dark, line = np.array([0.93, 0.90, 0.82]), np.array([0.22, 0.36, 0.55]), np.array([0.85, 0.25, 0.15])
-    colour = np.where(parity[:, None] == 0, light, dark)
-    fraction = scaled - whole
-    near_edge = (np.minimum(fraction, 1.0 - fraction) < 1.0 / 24).any(axis=1)
-    colour[near_edge] = line
+    spacing = LINE_SPACING * footprint
+    scaled = np.asarray(uv, dtype=np.float64) / spacing
+    distance = np.abs(scaled - np.round(scaled)) * LINE_SPACING  # pixels from the nearest line of each family
+    ink = np.clip(LINE_WIDTH / 2 + 0.5 - distance, 0.0, 1.0)
+    colour = PAPER + ink[:, :1] * (U_INK - PAPER)
+    colour += ink[:, 1:] * (V_INK - colour)
     return colour.astype(np.float32)

@@ -4,9 +4,9 @@ For each place chosen by :func:`affinity.report.places.choose_places`, a camera
 is framed on it (:func:`affinity.draw.closeup.closeup_view`) and only the faces
 around it are drawn, so a place the overview cannot see still gets its picture.
 The texture is the mesh's own ``map_Kd`` when it can be read; otherwise a
-procedural UV grid of about eight cells across the worst quad's uv extent
-(:func:`affinity.draw.texture.grid_colours`), so the split's crease shows at
-the scale of the quad whatever the atlas.
+procedural pattern of antialiased lines of constant u and v a few pixels
+apart on screen (:func:`affinity.draw.texture.line_colours`), so the split's
+crease shows as lines kinking at the diagonal whatever the atlas's scale.
 """
 
 from __future__ import annotations
@@ -54,7 +54,6 @@ class Closeup:
     error: np.ndarray | None = None
     covered: np.ndarray | None = None
     unit: str = ""
-    missing: dict = field(default_factory=dict)
     view: object = None
     place_pixels: int = 0
     dropped: str | None = None
@@ -75,11 +74,6 @@ def _map_kd(mesh: Mesh) -> str | None:
 
     path = mesh.texture_path()
     return path if path and image_size(path) else None
-
-
-def _face_uv(mesh: Mesh, face: int) -> np.ndarray:
-    corners = np.arange(mesh.face_start[face], mesh.face_start[face + 1])[None]
-    return np.nan_to_num(mesh.corner_attribute("texcoords", corners)[0])
 
 
 def _area(mesh: Mesh, faces: np.ndarray) -> float:
@@ -110,7 +104,7 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
     from ..draw.closeup import face_subset, outline
     from ..draw.drawing import RenderOptions, render_mesh
     from ..draw.shading import OVERLAY_TINT
-    from ..draw.texture import grid_cell, grid_colours
+    from ..draw.texture import LINE_SPACING, line_colours, pixel_footprint
     from ..loaders.imagesize import image_size
     from ..measures import pixel_error
 
@@ -118,12 +112,12 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
     sub = face_subset(mesh, view.drawn)
     show = _show_for(mesh, place.code)
     image_file = texture or _map_kd(mesh)
-    cell = None
+    lines = show == "uv" and not image_file
+    footprint = None
     if show == "uv" and image_file:
         label = f"texture {os.path.basename(image_file)}" + ("" if texture else " (map_Kd)")
-    elif show == "uv":
-        cell = grid_cell(_face_uv(mesh, place.worst))
-        label = f"UV grid, 8 cells across face {place.worst}'s uv extent (cell {cell:.3g} uv)"
+    elif lines:
+        label = f"lines of constant u (blue) and v (red) {LINE_SPACING:g} pixels apart"
     else:
         label = {"color": "vertex colours", "normal": "normals as RGB", "shaded": "shading"}[show]
     framed = (f"the {len(place.faces)} flagged faces and their neighbours" if len(framed_faces) > 1
@@ -135,18 +129,15 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
     for method in CLOSEUP_METHODS:
         # With the grid, the render's own texture is replaced pixel by pixel: a 1-texel one costs nothing to sample.
         options = RenderOptions(method=method, show=show, width=size, height=size, camera=view.camera, up=view.up,
-                                texture=image_file if cell is None else PLAIN, pixel_tolerance=pixel_tolerance)
-        try:
-            drawn = render_mesh(sub, options)
-        except NotImplementedError as err:
-            result.missing[method] = str(err)
-            continue
+                                texture=PLAIN if lines else image_file, pixel_tolerance=pixel_tolerance)
+        drawn = render_mesh(sub, options)
         image = drawn.image.copy()
         face = drawn.frame.face
         covered = face >= 0
         sub_face = np.where(covered, drawn.faces[np.maximum(face, 0)], -1)
-        if cell is not None:
-            image[covered] = grid_colours(drawn.frame.attrs[covered], cell)
+        if lines:
+            footprint = footprint or pixel_footprint(drawn.frame.attrs)  # the split's, for every panel
+            image[covered] = line_colours(drawn.frame.attrs[covered], footprint)
         own = covered & in_place[np.maximum(sub_face, 0)]
         if method == "split":
             result.place_pixels = int(own.sum())

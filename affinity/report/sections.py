@@ -337,7 +337,7 @@ def closeups_section(result: MeshResult) -> Section:
             "line": int(mesh.face_line[place.worst]), "group": mesh.group_names[mesh.face_group[place.worst]],
             "texture": view.texture, "framed": view.framed, "error": error,
             "images": [(method, image_uri(image)) for method, image in view.images.items()],
-            "missing": view.missing, "camera": ",".join(f"{x:.9g}" for x in (*eye, *target, fov)),
+            "camera": ",".join(f"{x:.9g}" for x in (*eye, *target, fov)),
             "up": view.view.up, "place": ",".join(map(str, place.faces.tolist())),
             "drawn": face_ranges(view.view.drawn), "place_pixels": view.place_pixels,
         })
