@@ -144,7 +144,7 @@ def test_demo_report_builds_with_every_scene(demo):
     assert (closeup.attrs["data-face"], closeup.attrs["data-rule"]) == ("0", "Q101")
     assert image_alts(closeup) == ["split, face 0", "hybrid, face 0", "exact, face 0",
                                    "split error against exact, face 0"]
-    assert "8 cells across face 0" in closeup.text()
+    assert "lines of constant u (blue) and v (red) 6 pixels apart" in closeup.text()
     assert [f.attrs.get("data-view") for f in section(trapezoid, "uv-layout").find_all("figure")] == ["uv-layout"]
     assert len(section(trapezoid, "errors").find_all("img")) == 3  # split, hybrid, mvc against exact
     assert "flagged-quads overlay" in image_alts(section(trapezoid, "overlay"))
