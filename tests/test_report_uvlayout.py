@@ -18,10 +18,10 @@ def test_per_face_unit_uv_is_one_square_filled_by_its_flagged_share(tmp_path):
     path.write_text(quad_obj([(trapezoid(0.2 + 0.1 * k, 3 * k), UNIT_UV) for k in range(4)]))
     flagged = np.array([True, False, False, False])
     layout = layout_image(load(str(path)), flagged, 64)
-    assert (layout.quads, layout.distinct, layout.left_out) == (4, 1, 0)
+    assert (layout.faces, layout.quads, layout.distinct, layout.left_out) == (4, 4, 1, 0)
     # a pixel away from the edges and the flagged face's centre mark: a quarter of the way to the flag colour
     assert np.allclose(layout.image[10, 50], FACE_FILL + 0.25 * (OVERLAY_TINT - FACE_FILL))
-    assert "4 faces draw 1 distinct uv quads" in _layout_notes(layout)[0]
+    assert "4 faces have only 1 distinct uv shape between them" in _layout_notes(layout)[0]
 
 
 def test_piled_up_distinct_quads_stay_within_the_budget_and_flagged_ones_are_drawn(tmp_path):

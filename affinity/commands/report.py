@@ -17,8 +17,7 @@ import sys
 
 from ..errors import UsageError
 from ..loaders.formats import described
-from ..report import MAX_VIEWS, RENDER_SIZE
-from ..report.places import PLACE_FACES
+from ..report import MAX_VIEWS, PLACE_FACES, RENDER_SIZE
 from . import EXIT_CLEAN, EXIT_ERROR, camera, image_size, pixel_tolerance, require
 
 

@@ -17,7 +17,9 @@ Nothing heavy is imported here: Pillow, Jinja2, matplotlib and pyvista are
 imported by the functions that use them.
 """
 
-#: Size of the renders and the 3-D overview (``--size``), and close-ups per mesh (``--max-views``): here, so the
-#: command line reads them without importing the builder.
+#: Size of the renders and the 3-D overview (``--size``), close-ups per mesh (``--max-views``) and the most faces
+#: a close-up's place holds (``--place-faces``: an eye takes in a few dozen): here, so the command line reads them
+#: without importing the builder.
 RENDER_SIZE = (480, 360)
 MAX_VIEWS = 6
+PLACE_FACES = 64

@@ -21,9 +21,8 @@ from ..lint import QuadScores, quad_scores, scored_codes
 from ..mesh import Mesh
 from ..scenes import View
 from ..settings import Settings
-from . import MAX_VIEWS, RENDER_SIZE
+from . import MAX_VIEWS, PLACE_FACES, RENDER_SIZE
 from .demo import MeshInput
-from .places import PLACE_FACES
 
 #: Methods drawn beside the hybrid when it sent quads to mvc (``exact``: the ray / bilinear-patch reference).
 COMPARED_METHODS = ("split", "mvc", "exact")
@@ -36,7 +35,7 @@ class ReportOptions:
     """The render options ``affinity report`` takes (None: the mesh's own or the default).
 
     ``camera`` and ``up`` replace every mesh's view; ``size`` is the overview and
-    render size (width, height); ``texture`` replaces map_Kd and the grid;
+    render size (width, height); ``texture`` replaces map_Kd and the line pattern;
     ``place_faces`` is the most faces a close-up's place holds.
     """
 

@@ -127,7 +127,7 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
     in_place = np.isin(view.drawn, place.faces)
     frames = {}
     for method in CLOSEUP_METHODS:
-        # With the grid, the render's own texture is replaced pixel by pixel: a 1-texel one costs nothing to sample.
+        # With the line pattern, the render's own texture is replaced pixel by pixel: a 1-texel one costs nothing.
         options = RenderOptions(method=method, show=show, width=size, height=size, camera=view.camera, up=view.up,
                                 texture=PLAIN if lines else image_file, pixel_tolerance=pixel_tolerance)
         drawn = render_mesh(sub, options)

@@ -16,10 +16,9 @@ import numpy as np
 from ..findings import RuleHits
 from ..mesh import Mesh
 from ..rules import RULES
+from . import PLACE_FACES
 
 LEVEL_ORDER = {"error": 0, "warning": 1, "info": 2}
-#: A place holds at most this many faces (``affinity report --place-faces``): an eye takes in a few dozen.
-PLACE_FACES = 64
 #: A bigger group is carved into this many places around its successive worst faces (the ones a close-up
 #: may show); the rest of it is cut into shells of ``PLACE_FACES`` by distance, so every place stays small.
 CARVED = 6

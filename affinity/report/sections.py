@@ -352,9 +352,10 @@ def _layout_notes(layout) -> list[str]:
     """What the layout picture does not show one quad at a time: uv shared by several faces, quads left out."""
     notes = []
     if layout.distinct < layout.quads:
-        notes.append(f"{layout.quads:,} faces draw {layout.distinct:,} distinct uv quads: faces with the same uv "
-                     "overlap in texture space (per-face unit squares, mirrored halves) and are drawn once, "
-                     "filled toward magenta by the share of them that is flagged")
+        shapes = f"{layout.distinct:,} distinct uv shape{'s' * (layout.distinct != 1)}"
+        notes.append(f"{layout.faces:,} faces have only {shapes} between them (an n-gon counts its triangles): "
+                     "faces with the same uv overlap in texture space (per-face unit squares, mirrored halves) "
+                     "and are drawn once, filled toward magenta by the share of them that is flagged")
     if layout.left_out:
         notes.append(f"{layout.left_out:,} distinct uv quads not drawn: the faces pile up in texture space beyond "
                      "the picture's budget (flagged ones are drawn first)")

@@ -52,7 +52,8 @@ class Layout:
 
     image : (S, S, 3) float64 RGB
     low, side : (2,) lower-left corner and side of the uv square drawn (:func:`uv_bounds`)
-    quads : render quads with uv at every corner (a triangle is one, an n-gon its fan)
+    faces : mesh faces with uv at every corner
+    quads : their render quads with uv at every corner (a triangle is one, an n-gon its fan)
     distinct : the distinct uv quads among them (quads with the same uv, to an eighth of a pixel, draw once)
     left_out : distinct quads not drawn, beyond :data:`FRAGMENT_BUDGET` (flagged ones are drawn first)
     """
@@ -60,6 +61,7 @@ class Layout:
     image: np.ndarray
     low: np.ndarray
     side: float
+    faces: int
     quads: int
     distinct: int
     left_out: int
@@ -114,7 +116,7 @@ def layout_image(mesh: Mesh, flagged: np.ndarray, size: int) -> Layout | None:
     col = np.clip(((centre[:, 0] + 1) / 2 * size).astype(int), 0, size - 1)
     row = np.clip(((1 - centre[:, 1]) / 2 * size).astype(int), 0, size - 1)
     image[row, col] = OVERLAY_TINT
-    return Layout(image, low, side, len(faces), len(first), len(first) - len(drawn))
+    return Layout(image, low, side, len(np.unique(faces)), len(faces), len(first), len(first) - len(drawn))
 
 
 def face_uv_centre(mesh: Mesh, face: int) -> np.ndarray:
