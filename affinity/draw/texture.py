@@ -89,34 +89,57 @@ def pixel_footprint(uv: np.ndarray) -> float:
     The scale at which a close-up's pattern is drawn: lines ``LINE_SPACING`` pixels
     apart are ``LINE_SPACING`` footprints apart in uv. 1.0 when no two neighbours are covered.
     """
-    steps = np.concatenate([np.linalg.norm(np.diff(uv, axis=0), axis=-1).ravel(),
-                            np.linalg.norm(np.diff(uv, axis=1), axis=-1).ravel()])
+    steps = np.linalg.norm(local_footprints(uv), axis=-1)
     steps = steps[np.isfinite(steps) & (steps > 0)]
     return float(np.median(steps)) if len(steps) else 1.0
 
 
-def line_colours(uv: np.ndarray, footprint: float) -> np.ndarray:
+def local_footprints(uv: np.ndarray) -> np.ndarray:
+    """(H, W, 2) float64: how much u and v each change from a pixel to its neighbours (per coordinate, the
+    larger of its row and column steps, each the smaller of the two sides, so a seam on one side does not
+    count); NaN where no neighbour is covered."""
+    def axis_step(axis: int) -> np.ndarray:
+        step = np.abs(np.diff(uv, axis=axis))
+        shape = list(step.shape)
+        shape[axis] = 1
+        pad = np.full(shape, np.nan)
+        before, after = np.concatenate([pad, step], axis=axis), np.concatenate([step, pad], axis=axis)
+        return np.fmin(before, after)
+
+    return np.fmax(axis_step(0), axis_step(1))
+
+
+def line_colours(uv: np.ndarray, footprint: float, local: np.ndarray | None = None) -> np.ndarray:
     """Antialiased lines of constant u (blue) and constant v (red), ``LINE_SPACING`` footprints apart.
 
     Computed from each pixel's coordinates: a pixel's ink is its coverage by a line
     ``LINE_WIDTH`` pixels wide (a box filter: ``clip(w / 2 + 1 / 2 - d, 0, 1)`` at a
-    distance of ``d`` pixels from the line's centre), so lines stay thin and smooth at
-    any scale. Both families cross the split's diagonal, so where the split moves the
-    texture they kink at it and the split and exact panels differ.
+    distance of ``d`` pixels from the line's centre), distances measured in the pixel's
+    own footprint in that coordinate (``local``), so lines stay thin and smooth on near
+    and far faces alike. Where a family's lines come closer than ``3 * LINE_WIDTH``
+    pixels they fade to the pattern's mean ink (``LINE_WIDTH / LINE_SPACING``) instead
+    of aliasing. Both families cross the split's diagonal, so where the split
+    moves the texture they kink at it and the split and exact panels differ.
 
     Parameters
     ----------
     uv : (N, 2) float, texture coordinates
-    footprint : the uv distance between neighbouring pixels (:func:`pixel_footprint`)
+    footprint : the uv distance between neighbouring pixels that sets the spacing (:func:`pixel_footprint`)
+    local : (N, 2) float, each pixel's own footprint in u and v (:func:`local_footprints`); None or NaN:
+        ``footprint``
 
     Returns
     -------
     (N, 3) float32 RGB.
     """
     spacing = LINE_SPACING * footprint
+    local = np.full((len(uv), 2), footprint) if local is None else np.where(np.isfinite(local), local, footprint)
+    apart = spacing / np.maximum(local, 1e-300)  # (N, 2) each family's spacing in this pixel's pixels
     scaled = np.asarray(uv, dtype=np.float64) / spacing
-    distance = np.abs(scaled - np.round(scaled)) * LINE_SPACING  # pixels from the nearest line of each family
+    distance = np.abs(scaled - np.round(scaled)) * apart  # pixels from the nearest line of each family
     ink = np.clip(LINE_WIDTH / 2 + 0.5 - distance, 0.0, 1.0)
+    fade = np.clip(apart / LINE_WIDTH - 2.0, 0.0, 1.0)  # 0 where lines are 2 widths apart or closer
+    ink = fade * ink + (1 - fade) * (LINE_WIDTH / LINE_SPACING)
     colour = PAPER + ink[:, :1] * (U_INK - PAPER)
     colour += ink[:, 1:] * (V_INK - colour)
     return colour.astype(np.float32)

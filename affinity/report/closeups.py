@@ -104,7 +104,7 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
     from ..draw.closeup import face_subset, outline
     from ..draw.drawing import RenderOptions, render_mesh
     from ..draw.shading import OVERLAY_TINT
-    from ..draw.texture import LINE_SPACING, line_colours, pixel_footprint
+    from ..draw.texture import LINE_SPACING, line_colours, local_footprints, pixel_footprint
     from ..loaders.imagesize import image_size
     from ..measures import pixel_error
 
@@ -137,7 +137,8 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
         sub_face = np.where(covered, drawn.faces[np.maximum(face, 0)], -1)
         if lines:
             footprint = footprint or pixel_footprint(drawn.frame.attrs)  # the split's, for every panel
-            image[covered] = line_colours(drawn.frame.attrs[covered], footprint)
+            image[covered] = line_colours(drawn.frame.attrs[covered], footprint,
+                                          local_footprints(drawn.frame.attrs)[covered])
         own = covered & in_place[np.maximum(sub_face, 0)]
         if method == "split":
             result.place_pixels = int(own.sum())
