@@ -56,8 +56,9 @@ def build_parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    from .commands.allocator import keep_freed_memory
+    from .commands.allocator import keep_freed_memory, one_blas_thread
 
+    one_blas_thread()
     args = build_parser(argv).parse_args(argv)
     keep_freed_memory()
     try:
@@ -72,5 +73,20 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_CLEAN
 
 
+def console_main() -> int:
+    """The ``affinity`` program: :func:`main` in a process of its own.
+
+    Before the interpreter exits, every object is moved out of the garbage
+    collector's reach (``gc.freeze``): the exit then frees them without the
+    collections the teardown of pyvista's and matplotlib's modules set off
+    (measured after a report: 0.50 s of exit, 0.07 s frozen).
+    """
+    import gc
+
+    code = main()
+    gc.freeze()
+    return code
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(console_main())

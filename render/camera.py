@@ -71,7 +71,7 @@ def orthographic(half_height, aspect, near, far) -> np.ndarray:
 
 
 def to_clip(points, matrix) -> np.ndarray:
-    """Clip coordinates (V, 4) float64 of points (V, 3) under ``matrix`` (4, 4)."""
+    """Clip coordinates (..., 4) float64 of points (..., 3) under ``matrix`` (4, 4)."""
     points = np.asarray(points, dtype=np.float64)
     matrix = np.asarray(matrix, dtype=np.float64)
     return points @ matrix[:, :3].T + matrix[:, 3]

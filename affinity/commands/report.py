@@ -133,7 +133,7 @@ def run(args) -> int:
     with tqdm(total=len(inputs), unit="file", file=sys.stderr, leave=False, delay=1.0,
               disable=args.quiet or not sys.stderr.isatty()) as bar:
         report = collect_run(inputs, lambda path: resolver.resolve(path).settings.for_file(path),
-                             resolver.resolve(os.curdir).settings, bar, options, demo=not args.meshes)
+                             resolver.resolve(os.curdir).settings, bar, options, demo=not args.meshes, start=start)
         skipped = [result.file for result in report.meshes if result.file.skipped is not None]
         if len(inputs) == 1 and skipped:  # a report of nothing: say so, write nothing
             raise UsageError(f"{skipped[0].path}: skipped ({skipped[0].skipped}): nothing to report")

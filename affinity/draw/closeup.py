@@ -71,9 +71,9 @@ def ring_of(mesh: Mesh, faces: np.ndarray) -> np.ndarray:
 
 def face_centroids(mesh: Mesh) -> np.ndarray:
     """(F, 3) float64: the mean of each face's corner positions."""
-    vertices, owner = face_vertices(mesh, np.arange(mesh.n_faces))
-    total = np.zeros((mesh.n_faces, 3))
-    np.add.at(total, owner, mesh.positions[vertices])
+    if mesh.n_faces == 0:
+        return np.zeros((0, 3))
+    total = np.add.reduceat(mesh.positions[mesh.corner_vertex], mesh.face_start[:-1], axis=0)  # faces are not empty
     return total / mesh.face_sizes[:, None]
 
 
@@ -114,26 +114,43 @@ def candidate_directions(normal: np.ndarray) -> np.ndarray:
     return np.array(directions)
 
 
-def _view_along(mesh: Mesh, place: np.ndarray, ring: np.ndarray, direction: np.ndarray, aspect: float,
-                centroids: np.ndarray) -> CloseupView:
-    """The close-up of ``place`` seen along unit ``direction`` (3,), framed on its ring."""
+@dataclass(frozen=True)
+class _Surroundings:
+    """What every view of one place shares: ``target`` (3,) the place's mean corner, ``radius`` its ring's
+    reach from there (at most ``RING_RADII`` times the place's own), ``ring`` (N,) int64, and the faces
+    ``near`` (K,) int64 whose centroid is within ``DRAWN_RADII`` radii, with their ``offset`` (K, 3) from
+    the target."""
+
+    target: np.ndarray
+    radius: float
+    ring: np.ndarray
+    near: np.ndarray
+    offset: np.ndarray
+
+
+def _surroundings(mesh: Mesh, place: np.ndarray, ring: np.ndarray) -> _Surroundings:
+    """The :class:`_Surroundings` of ``place`` (P,) int64 and its ``ring`` (N,) int64."""
     ring_points = mesh.positions[face_vertices(mesh, ring)[0]]
     place_points = mesh.positions[face_vertices(mesh, place)[0]]
     target = place_points.mean(axis=0)
     own = float(np.linalg.norm(place_points - target, axis=1).max())
     radius = min(float(np.linalg.norm(ring_points - target, axis=1).max()), RING_RADII * own)
     radius = radius if radius > 0 else 1.0
+    offset = face_centroids(mesh) - target
+    near = np.flatnonzero(np.einsum("fi,fi->f", offset, offset) <= (DRAWN_RADII * radius) ** 2)
+    return _Surroundings(target, radius, ring, near, offset[near])
+
+
+def _view_along(around: _Surroundings, direction: np.ndarray, aspect: float) -> CloseupView:
+    """The close-up seen along unit ``direction`` (3,), framed on the place's ring."""
     half = np.radians(CLOSEUP_FOV) / 2
     narrow = min(half, np.arctan(np.tan(half) * aspect))
-    distance = radius / (FILL * np.sin(narrow))
-    eye = target + distance * direction
+    eye = around.target + around.radius / (FILL * np.sin(narrow)) * direction
     up = "xyz"[int(np.argmin(np.abs(direction)))]
     # Draw what lies around the place, but nothing more than a radius in front of it: an occluder (an eyelid,
     # a helper cube inside the body, the other side of a thin part) would hide the place.
-    offset = centroids - target
-    drawn = np.flatnonzero((np.linalg.norm(offset, axis=1) <= DRAWN_RADII * radius) & (offset @ direction <= radius))
-    drawn = np.union1d(drawn, ring)
-    return CloseupView((tuple(eye.tolist()), tuple(target.tolist()), CLOSEUP_FOV), up, drawn, ring)
+    drawn = np.union1d(around.near[around.offset @ direction <= around.radius], around.ring)
+    return CloseupView((tuple(eye.tolist()), tuple(around.target.tolist()), CLOSEUP_FOV), up, drawn, around.ring)
 
 
 def place_pixels(mesh: Mesh, view: CloseupView, place: np.ndarray, width: int, height: int) -> np.ndarray:
@@ -157,10 +174,8 @@ def closeup_view(mesh: Mesh, place: np.ndarray, aspect: float = 1.0) -> CloseupV
     bounding sphere of the place's ring (:func:`ring_of`), at most ``RING_RADII``
     times the place's own, into ``FILL`` of the narrower half field of view.
     """
-    ring = ring_of(mesh, place)
-    centroids = face_centroids(mesh)
-    views = [_view_along(mesh, place, ring, direction, aspect, centroids)
-             for direction in candidate_directions(mean_normal(mesh, place))]
+    around = _surroundings(mesh, place, ring_of(mesh, place))
+    views = [_view_along(around, direction, aspect) for direction in candidate_directions(mean_normal(mesh, place))]
     height = max(1, round(PREPASS_SIZE / aspect))
     for k, view in enumerate(views):
         try:

@@ -238,7 +238,10 @@ def render_mesh(source: str | Mesh | None, options: RenderOptions,
     faces, corners = render_corners(mesh)
     inputs = shading_inputs(mesh, corners, show)
     camera = camera_for(mesh, options.width, options.height, options.camera, options.up)
-    clip = to_clip(mesh.positions, camera.matrix)[mesh.corner_vertex[corners]]
+    used = mesh.corner_vertex[corners]
+    # A close-up's subset uses a few of the vertices: transform its corners, not the whole table.
+    clip = (to_clip(mesh.positions[used], camera.matrix) if used.size < len(mesh.positions)
+            else to_clip(mesh.positions, camera.matrix)[used])
     if not (clip[..., 3] > 0).any():
         raise ValueError(f"{mesh.path}: all geometry is behind the camera")
     texture = resolve_texture(mesh, options, warn) if inputs.uv is not None else None

@@ -128,7 +128,7 @@ def camera_for(mesh: Mesh, width: int, height: int, camera: tuple | None = None,
     if not 0 < fov < 180:
         raise ValueError(f"--camera: the field of view must lie between 0 and 180 degrees, got {fov:g}")
     up = working_up(np.subtract(target, eye) / distance, up_axis)
-    extent = float(np.ptp(mesh.positions, axis=0).max()) if len(mesh.positions) else 1.0
+    extent = float(np.ptp(_used_points(mesh), axis=0).max()) if mesh.n_faces else 1.0  # the drawn vertices only
     far = distance + 2.0 * max(extent, distance)
     return Camera(eye=tuple(eye), target=tuple(target), up=up, fov_y=fov, aspect=aspect,
                   near=far * 1e-4, far=far)

@@ -9,7 +9,9 @@ from the :class:`MeshResult` collected here. Renders go through
 from __future__ import annotations
 
 import datetime
+import functools
 import os
+import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -28,6 +30,59 @@ from .demo import MeshInput
 COMPARED_METHODS = ("split", "mvc", "exact")
 #: Side of a close-up picture, pixels.
 CLOSEUP_SIZE = 240
+#: The overview's pyvista and the charts' matplotlib: about 2 s of imports, done on a thread while the
+#: renders run (see :func:`import_in_background`).
+SLOW_IMPORTS = ("pyvista.plotting", "matplotlib.figure", "matplotlib.backends.backend_svg")
+
+
+@functools.cache
+def import_in_background(modules: tuple[str, ...]) -> threading.Thread:
+    """Start importing ``modules`` on a daemon thread, once per process; the thread, to join before use.
+
+    Imports are mostly Python and the scores and renders they overlap mostly
+    NumPy, which lets go of the GIL (the lint is not overlapped: the loader's own
+    threads would compete for it). Join before using a module: pyvista's lazy
+    attributes would see a half-imported ``pyvista.plotting``. A module that is
+    not installed is left to the report's own message.
+    """
+    import importlib
+
+    def load() -> None:
+        for name in modules:
+            try:
+                importlib.import_module(name)
+            except Exception:  # the report's own import says what is wrong
+                return
+
+    thread = threading.Thread(target=load, name="affinity-imports", daemon=True)
+    thread.start()
+    return thread
+
+
+class StepTimer:
+    """Wall time of one mesh's steps, summed by part (``lint``, ``renders``, ``close-ups``, ...).
+
+    ``timer(label, part)`` ends the running step and starts the next, showing
+    ``label`` through ``show`` (the progress bar); ``part`` defaults to the label.
+    """
+
+    def __init__(self, show: Callable[[str], None]):
+        self.show = show
+        self.parts: dict[str, float] = {}
+        self._part: str | None = None
+        self._since = 0.0
+
+    def __call__(self, label: str, part: str | None = None) -> None:
+        self.stop()
+        self._part, self._since = part or label, time.perf_counter()
+        self.show(label)
+
+    def stop(self) -> dict[str, float]:
+        """End the running step; the seconds of every part so far."""
+        if self._part is not None:
+            self.parts[self._part] = self.parts.get(self._part, 0.0) + time.perf_counter() - self._since
+            self._part = None
+        return self.parts
 
 
 @dataclass(frozen=True)
@@ -84,7 +139,7 @@ class MeshResult:
     places: list = field(default_factory=list)
     closeups: list = field(default_factory=list)
     dropped: list[str] = field(default_factory=list)
-    closeup_seconds: float = 0.0
+    parts: dict[str, float] = field(default_factory=dict)
     stability: object | None = None
 
     @property
@@ -94,13 +149,21 @@ class MeshResult:
 
 @dataclass
 class ReportRun:
-    """A whole report: one result per input, the settings of the current folder, timing."""
+    """A whole report: one result per input, the settings of the current folder, timing.
+
+    ``start`` is the ``time.perf_counter()`` of the command's start (the page
+    prints the time from it to the page written); ``seconds`` the time of
+    collecting, ``parts`` its seconds by part summed over the meshes, with
+    ``start-up`` the time before the first mesh.
+    """
 
     meshes: list[MeshResult]
     settings: Settings
     started: datetime.datetime
     seconds: float
     demo: bool = False
+    start: float = 0.0
+    parts: dict[str, float] = field(default_factory=dict)
 
 
 def _texture_label(mesh: Mesh, view: View, texture: str | None = None) -> str:
@@ -119,7 +182,7 @@ def _texture_label(mesh: Mesh, view: View, texture: str | None = None) -> str:
     return f"texture {name} (map_Kd)" if image_size(path) else f"checker texture (map_Kd {name} is not readable)"
 
 
-def _render(result: MeshResult, texture: np.ndarray | None, step: Callable[[str], None]) -> None:
+def _render(result: MeshResult, texture: np.ndarray | None, step: StepTimer) -> None:
     """The hybrid render; when it sent quads to mvc, the compared methods too."""
     from ..draw.drawing import RenderOptions, render_mesh
     from ..draw.routing import MVC
@@ -132,7 +195,7 @@ def _render(result: MeshResult, texture: np.ndarray | None, step: Callable[[str]
                                texture=texture, pixel_tolerance=result.options.pixel_tolerance, **options)
         return render_mesh(result.mesh, chosen, warn)
 
-    step("render hybrid")
+    step("render hybrid", "renders")
     try:
         hybrid = draw(warn=result.warnings.append, method="hybrid")
     except (ValueError, TextureError) as err:
@@ -142,11 +205,11 @@ def _render(result: MeshResult, texture: np.ndarray | None, step: Callable[[str]
     if not (hybrid.methods == MVC).any():
         return
     for method in COMPARED_METHODS:
-        step(f"render {method}")
+        step(f"render {method}", "renders")
         result.renders[method] = draw(method=method)
 
 
-def _overview(result: MeshResult, step: Callable[[str], None]) -> None:
+def _overview(result: MeshResult, step: StepTimer) -> None:
     from ..view import INSTALL_HINT, overview_image, pyvista_installed
 
     if not pyvista_installed():
@@ -156,6 +219,7 @@ def _overview(result: MeshResult, step: Callable[[str], None]) -> None:
         result.overview_note = "the mesh has no faces to show"
         return
     step("3-D overview")
+    import_in_background(SLOW_IMPORTS).join()
     scores = result.scores.get(result.shown)
     try:
         result.overview = overview_image(result.mesh, scores, result.camera, result.up, result.options.size,
@@ -176,21 +240,21 @@ def _view(result: MeshResult) -> None:
         result.camera = overview_camera(result.mesh, *options.size, result.up)
 
 
-def _closeups(result: MeshResult, step: Callable[[str], None]) -> None:
+def _closeups(result: MeshResult, step: StepTimer) -> None:
     """Rank every flagged place; draw the first ``max_views``."""
     from .closeups import closeup
     from .places import choose_places, places_of
 
+    step("places")
     by_rule = {hits.code: places_of(result.mesh, hits, result.options.place_faces) for hits in result.file.hits}
     result.places = choose_places(by_rule, sum(len(p) for p in by_rule.values()))
-    start = time.perf_counter()
     shown = np.zeros(result.mesh.n_faces, dtype=bool)  # no two close-ups share a face
     for place in result.places:
         if len(result.closeups) == result.options.max_views:
             break
         if shown[place.faces].any():
             continue
-        step(f"close-up {len(result.closeups) + 1}")
+        step(f"close-up {len(result.closeups) + 1}", "close-ups")
         drawn = closeup(result.mesh, place, result.settings, CLOSEUP_SIZE, result.options.pixel_tolerance,
                         result.options.texture)
         if drawn.dropped:
@@ -198,54 +262,67 @@ def _closeups(result: MeshResult, step: Callable[[str], None]) -> None:
         else:
             result.closeups.append(drawn)
             shown[place.faces] = True
-    result.closeup_seconds = time.perf_counter() - start
 
 
 def collect_mesh(item: MeshInput, settings: Settings, step: Callable[[str], None] = lambda name: None,
                  options: ReportOptions = ReportOptions()) -> MeshResult:
-    """Lint, score, render and picture one mesh; an unreadable file gives a result with ``file.error``."""
+    """Lint, score, render and picture one mesh; an unreadable file gives a result with ``file.error``.
+
+    ``step`` is called with each step's name as it starts (the progress bar).
+    """
     from ..draw.texture import checker
     from ..pipeline.check import load_and_check
 
     start = time.perf_counter()
-    step("lint")
+    timer = StepTimer(step)
+    timer("lint")
     file, mesh = load_and_check(item.path, settings)
     result = MeshResult(item, file, settings, mesh=mesh, options=options)
     if result.readable:
-        step("scores")
+        timer("scores")
+        import_in_background(SLOW_IMPORTS)
         result.scores = {code: quad_scores(result.mesh, settings, code) for code in scored_codes(result.mesh)}
         result.shown = next(iter(result.scores), None)  # uv, else colours, else normals
         result.texture = _texture_label(result.mesh, item.view, options.texture)
         has_uv = result.mesh.texcoords is not None
         _view(result)
         texture = options.texture or (checker(512, item.view.checks) if item.view.checks and has_uv else None)
-        _render(result, texture, step)
+        _render(result, texture, timer)
         if "hybrid" in result.renders:
             from .stiffness import render_stability
 
-            step("stability")
+            timer("stability")
             result.stability = render_stability(result.renders["hybrid"])
-        _overview(result, step)
+        _overview(result, timer)
         if result.mesh.n_faces:
-            _closeups(result, step)
+            _closeups(result, timer)
+    import_in_background(SLOW_IMPORTS).join()  # nothing half-imported is left to the caller
+    result.parts = timer.stop()
     result.seconds = time.perf_counter() - start
     return result
 
 
 def collect_run(items: list[MeshInput], settings_for: Callable[[str], Settings], settings: Settings,
-                progress, options: ReportOptions = ReportOptions(), demo: bool = False) -> ReportRun:
+                progress, options: ReportOptions = ReportOptions(), demo: bool = False,
+                start: float | None = None) -> ReportRun:
     """Collect every input in order.
 
     ``settings_for(path)`` gives the lint settings of a file (its configuration);
     ``settings`` are the current folder's, for the summary's thresholds.
     ``progress`` is a tqdm bar (possibly disabled): it shows the file and step and
     advances once per file. ``demo``: the inputs are the built-in demo scenes.
+    ``start`` is the command's ``time.perf_counter()`` at its start (default: now).
     """
     started = datetime.datetime.now().astimezone()
-    start = time.perf_counter()
+    collecting = time.perf_counter()
+    start = collecting if start is None else start
     meshes = []
     for item in items:
         progress.set_description(os.path.basename(item.path), refresh=False)
         meshes.append(collect_mesh(item, settings_for(item.path), progress.set_postfix_str, options))
         progress.update()
-    return ReportRun(meshes, settings, started, time.perf_counter() - start, demo)
+    parts = {"start-up": collecting - start}
+    for result in meshes:
+        for part, seconds in result.parts.items():
+            parts[part] = parts.get(part, 0.0) + seconds
+    return ReportRun(meshes, settings, started, time.perf_counter() - collecting, demo, start, parts)

@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import re
+import time
 from pathlib import Path
 
 from .build import ReportRun
-from .sections import CLOSING_SECTIONS, MESH_SECTIONS, file_row, summary_section
+from .sections import CLOSING_SECTIONS, MESH_SECTIONS, PAGE_TIME, RUN_TIME, file_row, summary_section
 
 TEMPLATES = Path(__file__).parent / "templates"
 #: A line break and the indentation around it: one space to HTML (the page has no ``<pre>``, its script no
@@ -30,11 +31,14 @@ def render_page(run: ReportRun) -> str:
 
     Autoescaping is on for every template: file names, group names and error
     messages come from the user's files and must show as text, never as markup.
+    The run time printed is from ``run.start`` (the command's start) to the page
+    rendered: all of the command but writing the file.
     """
     from jinja2 import Environment, FileSystemLoader, StrictUndefined
 
     from .. import __version__
 
+    begun = time.perf_counter()
     environment = Environment(loader=FileSystemLoader(TEMPLATES), autoescape=True, undefined=StrictUndefined,
                               trim_blocks=True, lstrip_blocks=True)
     environment.filters["plural"] = plural
@@ -43,7 +47,11 @@ def render_page(run: ReportRun) -> str:
          "sections": [section(result) for section in MESH_SECTIONS] if result.readable else []}
         for result in run.meshes
     ]
-    return compact(environment.get_template("report.html.j2").render(
+    html = compact(environment.get_template("report.html.j2").render(
         run=run, version=__version__, summary=summary_section(run), meshes=meshes,
-        closing=[section(run) for section in CLOSING_SECTIONS],
+        closing=[section(run) for section in CLOSING_SECTIONS], run_time=RUN_TIME,
     ))
+    # Both stand-ins come before any text from the user's files (the header and the summary's facts).
+    finished = time.perf_counter()
+    html = html.replace(PAGE_TIME, f"{finished - begun:.1f} s", 1)
+    return html.replace(RUN_TIME, f"{finished - run.start:.1f} s", 2)
