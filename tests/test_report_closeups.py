@@ -147,6 +147,65 @@ def test_line_pattern_inks_each_pixel_by_its_coverage_of_a_line():
     assert np.allclose(ink, coverage, atol=1e-6)
 
 
+def test_glyph_is_a_box_filtered_upright_f_whose_mirror_images_differ():
+    """One glyph cell, pixel by pixel: the ink against 16 x 16 supersampling of the F's strokes, and the F
+    mirrored in u or in v is not the F (so a mirrored island shows), and it fades out in small cells."""
+    from affinity.draw.texture import GLYPH_SPACING, GLYPH_STROKES, glyph_ink
+
+    footprint = 1e-3
+    side = int(GLYPH_SPACING)
+    centres = np.arange(side) + 0.5
+    u, v = np.meshgrid(centres, centres, indexing="ij")
+    uv = np.stack([u.ravel(), v.ravel()], axis=1) * footprint
+    local = np.full_like(uv, footprint)
+    ink = glyph_ink(uv, footprint, local).reshape(side, side)
+
+    offsets = (np.arange(16) + 0.5) / 16 - 0.5
+    su, sv = (np.add.outer(centres, offsets) / side).reshape(-1), (np.add.outer(centres, offsets) / side).reshape(-1)
+    inside_u = (GLYPH_STROKES[:, 0] <= su[:, None]) & (su[:, None] <= GLYPH_STROKES[:, 1])  # (side * 16, 3)
+    inside_v = (GLYPH_STROKES[:, 2] <= sv[:, None]) & (sv[:, None] <= GLYPH_STROKES[:, 3])
+    union = (inside_u[:, None, :] & inside_v[None, :, :]).any(axis=2)  # (side * 16, side * 16)
+    sampled = union.reshape(side, 16, side, 16).mean(axis=(1, 3))
+    assert np.abs(ink - sampled).max() < 0.3 and np.abs(ink - sampled).mean() < 0.01
+    assert sampled.sum() > 0.1 * side * side  # the strokes are there to be seen
+
+    mirrored_u = glyph_ink(uv * [-1, 1], footprint, local).reshape(side, side)
+    mirrored_v = glyph_ink(uv * [1, -1], footprint, local).reshape(side, side)
+    for mirrored in (mirrored_u, mirrored_v):
+        assert (np.abs(mirrored - ink) > 0.5).mean() > 0.05
+    assert glyph_ink(uv, footprint, local * side / 8).max() == 0.0  # cells of 8 pixels: no glyph
+
+
+def test_a_mirrored_uv_closeup_draws_glyphs_and_a_disaffine_one_does_not(tmp_path):
+    """Q302 (mirroring is the finding) gets the F glyph over the lines; Q101 lines only."""
+    from affinity.draw.texture import GLYPH_INK
+    from affinity.report.build import ReportOptions, collect_mesh
+    from affinity.report.demo import MeshInput
+    from affinity.settings import Settings
+
+    mesh = grid_mesh(8, bent=[(1, 1)])
+    uv = mesh.texcoords.copy()
+    corner_x = mesh.positions[mesh.corner_vertex][:, 0]
+    right = corner_x.reshape(-1, 4).min(axis=1) >= 5  # columns 5-7 mirrored in u: flipped, still affine
+    mirrored = np.repeat(right, 4)
+    uv[mirrored, 0] = (13 - corner_x[mirrored]) / 8
+    write_obj(replace_uv(mesh, uv), tmp_path / "mirrored.obj")
+    result = collect_mesh(MeshInput(str(tmp_path / "mirrored.obj"), "mirrored.obj"), Settings(),
+                          options=ReportOptions(max_views=6))
+    by_code = {view.place.code: view for view in result.closeups}
+    assert {"Q101", "Q302"} <= by_code.keys()
+    dark = {code: (np.abs(view.images["exact"] - GLYPH_INK).max(axis=-1) < 0.08).mean()
+            for code, view in by_code.items()}
+    assert "upright F" in by_code["Q302"].texture and "F" not in by_code["Q101"].texture
+    assert dark["Q302"] > 0.02 and dark["Q101"] == 0.0
+
+
+def replace_uv(mesh, uv):
+    """``mesh`` with per-corner texture coordinates ``uv`` (C, 2)."""
+    return mesh_from_polygons("grid", mesh.positions[mesh.corner_vertex],
+                              np.arange(len(uv)).reshape(-1, 4), texcoords=uv)
+
+
 def test_outline_is_the_border_of_the_mask():
     from affinity.draw.closeup import outline
 

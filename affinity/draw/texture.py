@@ -109,7 +109,36 @@ def local_footprints(uv: np.ndarray) -> np.ndarray:
     return np.fmax(axis_step(0), axis_step(1))
 
 
-def line_colours(uv: np.ndarray, footprint: float, local: np.ndarray | None = None) -> np.ndarray:
+#: The glyph pattern: an "F" (no mirror image of it is itself) in cells this many pixels wide and high,
+#: shown in full where a cell spans at least ``GLYPH_FULL`` pixels, faded out below ``GLYPH_GONE``.
+GLYPH_SPACING = 4 * LINE_SPACING
+GLYPH_FULL, GLYPH_GONE = 16.0, 10.0
+GLYPH_INK = np.array([0.10, 0.10, 0.12])
+#: The F's strokes as (u0, u1, v0, v1) in a cell's unit square, v up: the stem, the top bar, the middle bar.
+GLYPH_STROKES = np.array([[0.30, 0.42, 0.18, 0.82], [0.30, 0.74, 0.70, 0.82], [0.30, 0.62, 0.45, 0.56]])
+
+
+def glyph_ink(uv: np.ndarray, footprint: float, local: np.ndarray) -> np.ndarray:
+    """(N,) float64 in [0, 1]: the ink of an upright "F" in every cell ``GLYPH_SPACING`` footprints square.
+
+    Mirrored texture coordinates (u to -u, or v to -v) draw the F mirrored, so a close-up of a mirrored
+    island shows it, as a checker or lines cannot. Each stroke is a rectangle in the cell's unit square;
+    a pixel's ink is its box-filtered coverage, ``clip(1/2 + d, 0, 1)`` per axis at a signed distance ``d``
+    pixels inside the stroke's edges (in the pixel's own footprint ``local`` (N, 2)), the strokes' union
+    their maximum; the glyph fades out where a cell is under ``GLYPH_FULL`` pixels.
+    """
+    spacing = GLYPH_SPACING * footprint
+    cell_pixels = spacing / np.maximum(local, 1e-300)  # (N, 2)
+    cell = np.mod(np.asarray(uv, dtype=np.float64) / spacing, 1.0)  # (N, 2) position in the cell
+    inside_u = np.minimum(cell[:, :1] - GLYPH_STROKES[:, 0], GLYPH_STROKES[:, 1] - cell[:, :1]) * cell_pixels[:, :1]
+    inside_v = np.minimum(cell[:, 1:] - GLYPH_STROKES[:, 2], GLYPH_STROKES[:, 3] - cell[:, 1:]) * cell_pixels[:, 1:]
+    ink = (np.clip(0.5 + inside_u, 0.0, 1.0) * np.clip(0.5 + inside_v, 0.0, 1.0)).max(axis=1)
+    size = cell_pixels.min(axis=1)
+    return ink * np.clip((size - GLYPH_GONE) / (GLYPH_FULL - GLYPH_GONE), 0.0, 1.0)
+
+
+def line_colours(uv: np.ndarray, footprint: float, local: np.ndarray | None = None,
+                 glyphs: bool = False) -> np.ndarray:
     """Antialiased lines of constant u (blue) and constant v (red), ``LINE_SPACING`` footprints apart.
 
     Computed from each pixel's coordinates: a pixel's ink is its coverage by a line
@@ -127,6 +156,7 @@ def line_colours(uv: np.ndarray, footprint: float, local: np.ndarray | None = No
     footprint : the uv distance between neighbouring pixels that sets the spacing (:func:`pixel_footprint`)
     local : (N, 2) float, each pixel's own footprint in u and v (:func:`local_footprints`); None or NaN:
         ``footprint``
+    glyphs : also draw :func:`glyph_ink`'s "F" glyphs over the lines (a close-up of mirroring)
 
     Returns
     -------
@@ -142,4 +172,6 @@ def line_colours(uv: np.ndarray, footprint: float, local: np.ndarray | None = No
     ink = fade * ink + (1 - fade) * (LINE_WIDTH / LINE_SPACING)
     colour = PAPER + ink[:, :1] * (U_INK - PAPER)
     colour += ink[:, 1:] * (V_INK - colour)
+    if glyphs:
+        colour += glyph_ink(uv, footprint, local)[:, None] * (GLYPH_INK - colour)
     return colour.astype(np.float32)

@@ -6,7 +6,10 @@ around it are drawn, so a place the overview cannot see still gets its picture.
 The texture is the mesh's own ``map_Kd`` when it can be read; otherwise a
 procedural pattern of antialiased lines of constant u and v a few pixels
 apart on screen (:func:`affinity.draw.texture.line_colours`), so the split's
-crease shows as lines kinking at the diagonal whatever the atlas's scale.
+crease shows as lines kinking at the diagonal whatever the atlas's scale. A
+rule whose finding is mirroring (``Rule.mirroring``, Q302) gets an upright "F"
+drawn in uv over the lines (:func:`affinity.draw.texture.glyph_ink`): it reads
+mirrored on the mirrored faces, which a symmetric pattern cannot show.
 """
 
 from __future__ import annotations
@@ -104,7 +107,7 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
     from ..draw.closeup import face_subset, outline
     from ..draw.drawing import RenderOptions, render_mesh
     from ..draw.shading import OVERLAY_TINT
-    from ..draw.texture import LINE_SPACING, line_colours, local_footprints, pixel_footprint
+    from ..draw.texture import GLYPH_SPACING, LINE_SPACING, line_colours, local_footprints, pixel_footprint
     from ..loaders.imagesize import image_size
     from ..measures import pixel_error
 
@@ -113,11 +116,14 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
     show = _show_for(mesh, place.code)
     image_file = texture or _map_kd(mesh)
     lines = show == "uv" and not image_file
+    glyphs = lines and RULES[place.code].mirroring
     footprint = None
     if show == "uv" and image_file:
         label = f"texture {os.path.basename(image_file)}" + ("" if texture else " (map_Kd)")
     elif lines:
-        label = f"lines of constant u (blue) and v (red) {LINE_SPACING:g} pixels apart"
+        label = f"lines of constant u (blue) and v (red) {LINE_SPACING:g} pixels apart" + (
+            f", and an upright F every {GLYPH_SPACING:g} pixels in uv: where it reads mirrored, so is the texture"
+            if glyphs else "")
     else:
         label = {"color": "vertex colours", "normal": "normals as RGB", "shaded": "shading"}[show]
     framed = (f"the {len(place.faces)} flagged faces and their neighbours" if len(framed_faces) > 1
@@ -138,7 +144,7 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
         if lines:
             footprint = footprint or pixel_footprint(drawn.frame.attrs)  # the split's, for every panel
             image[covered] = line_colours(drawn.frame.attrs[covered], footprint,
-                                          local_footprints(drawn.frame.attrs)[covered])
+                                          local_footprints(drawn.frame.attrs)[covered], glyphs)
         own = covered & in_place[np.maximum(sub_face, 0)]
         if method == "split":
             result.place_pixels = int(own.sum())

@@ -60,6 +60,8 @@ class Rule:
         (the report's histograms, the hybrid's ``--route lint``)
     readings : measure -> (unit, default threshold) where a ``--measure`` reading
         changes them (Q101's dimensionless barycentric score)
+    mirroring : a finding is a texture mirrored against the surface: its report close-up draws an
+        asymmetric glyph in texture space (a symmetric pattern looks the same mirrored)
     scope : ``"quad"``: ``check(quads) -> (rows, values)`` over a batch of quads
         (``affinity.lint.QuadBatch``; ``rows`` index the batch, a slice for all);
         ``"mesh"``: ``check(mesh, settings) -> (faces, lines, values)`` or None
@@ -82,6 +84,7 @@ class Rule:
     worst: str = "highest"
     attribute: str | None = None
     scored: bool = False
+    mirroring: bool = False
     readings: Mapping[str, tuple[str, float]] = field(default_factory=dict)
     scope: str = "quad"
     check: Callable | None = None

@@ -42,7 +42,8 @@ def uv_degenerate(quads) -> tuple:
     return quads.uv[0], np.abs(relative_signed_area(quads.uv_planar))
 
 
-@rule(code="Q302", name="uv-flipped", level="info", unit="relative area", worst="lowest", attribute="texcoords")
+@rule(code="Q302", name="uv-flipped", level="info", unit="relative area", worst="lowest", attribute="texcoords",
+      mirroring=True)
 def uv_flipped(quads) -> tuple:
     """Texture orientation reversed against the surface.
 
