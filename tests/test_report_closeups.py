@@ -200,6 +200,51 @@ def test_a_mirrored_uv_closeup_draws_glyphs_and_a_disaffine_one_does_not(tmp_pat
     assert dark["Q302"] > 0.02 and dark["Q101"] == 0.0
 
 
+@pytest.mark.parametrize(("difference", "gain"), [(5 / 255, 20), (3 / 255, 20), (0.004, 100), (0.3, 1), (1e-3, 500),
+                                                  (0.0, 1), (0.9, 1)])
+def test_gain_brings_the_largest_change_to_about_half(difference, gain):
+    from affinity.report.closeups import gain_for
+
+    assert gain_for(difference) == gain  # 1, 2 or 5 times a power of ten, the most that keeps it at <= 0.5
+
+
+def test_amplified_difference_is_exact_plus_gain_times_the_split_s_change():
+    from affinity.report.closeups import amplified_difference
+
+    rng = np.random.default_rng(3)
+    exact = rng.uniform(0.35, 0.65, (16, 16, 3))  # never clipped at the gain
+    split = exact + rng.uniform(-4, 4, (16, 16, 3)) / 255
+    same = rng.random((16, 16)) < 0.8
+    split[~same] = 0.0  # another face there: a silhouette, not a crease
+    image, gain = amplified_difference(split, exact, same)
+    assert gain == 20  # largest change under 4/255: 0.5 / (4 / 255) = 31.9
+    np.testing.assert_allclose(image[same], (exact + gain * (split - exact))[same], atol=1e-6)
+    np.testing.assert_allclose(image[~same], exact[~same], atol=1e-6)
+
+
+def test_a_faint_colour_crease_gets_an_amplified_panel_that_shows_it(tmp_path):
+    """One unit square, grey but for one corner 12/255 lighter (colours bilinear, not affine): the split's
+    crease is a few 1/255 at true size, and tens of 1/255 in the amplified panel."""
+    from affinity.draw.shading import OVERLAY_TINT
+    from affinity.report.build import ReportOptions, collect_mesh
+    from affinity.report.demo import MeshInput
+    from affinity.settings import Settings
+
+    colors = np.full((4, 3), 0.5)
+    colors[2] += 12 / 255
+    square = mesh_from_polygons("faint", [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], [[0, 1, 2, 3]], colors=colors)
+    write_obj(square, tmp_path / "faint.obj")
+    result = collect_mesh(MeshInput(str(tmp_path / "faint.obj"), "faint.obj"), Settings(),
+                          options=ReportOptions(max_views=1))
+    (view,) = result.closeups
+    assert view.place.code == "Q102" and view.gain >= 10
+    split, exact = view.images["split"], view.images["exact"]
+    inside = view.covered & ~(split == OVERLAY_TINT).all(axis=-1)
+    true_size = np.abs(split - exact).max(axis=-1)[inside]
+    shown = np.abs(view.amplified - exact).max(axis=-1)[inside]
+    assert true_size.max() < 6 / 255 and (shown > 20 / 255).mean() > 0.05
+
+
 def replace_uv(mesh, uv):
     """``mesh`` with per-corner texture coordinates ``uv`` (C, 2)."""
     return mesh_from_polygons("grid", mesh.positions[mesh.corner_vertex],

@@ -35,6 +35,13 @@ SLIVER_AREA = 1e-3
 PLAIN = np.ones((1, 1, 3), dtype=np.float32)
 #: Attribute shown for each scored rule; the geometric rules show uv when the mesh has it.
 SHOW_FOR = ATTRIBUTE_NAMES
+#: Shown attributes whose close-up also gets the split's difference from exact amplified (a colour or normal
+#: crease of a few 1/255 is invisible at its true size; the uv lines kink visibly at it).
+AMPLIFIED = ("color", "normal")
+#: The amplified difference's largest channel change is brought to about this much (of 1), by a gain in
+#: ``GAIN_STEPS`` times a power of ten, never below 1.
+AMPLIFIED_REACH = 0.5
+GAIN_STEPS = (1, 2, 5)
 
 
 @dataclass
@@ -46,6 +53,7 @@ class Closeup:
     covered : (S, S) bool, the pixels where split and exact show the same face
     view : the :class:`affinity.draw.closeup.CloseupView` drawn (camera, up, drawn faces)
     place_pixels : the pixels the place's faces cover in the split picture
+    amplified : (S, S, 3) float, exact plus ``gain`` times (split - exact), for colours and normals (else None)
     dropped : why the close-up is not shown (its place covers too few pixels from every side), else None
     """
 
@@ -60,6 +68,8 @@ class Closeup:
     view: object = None
     place_pixels: int = 0
     dropped: str | None = None
+    amplified: np.ndarray | None = None
+    gain: float = 1.0
 
 
 def _show_for(mesh: Mesh, code: str) -> str:
@@ -69,6 +79,34 @@ def _show_for(mesh: Mesh, code: str) -> str:
     if mesh.texcoords is not None:
         return "uv"
     return "color" if mesh.colors is not None else "shaded"
+
+
+def gain_for(difference: float) -> float:
+    """The gain (1, 2, 5, 10, 20, ...) that brings a largest channel ``difference`` (of 1) to at most
+    ``AMPLIFIED_REACH``; 1 for a difference already that big or none."""
+    if not difference > 0:
+        return 1.0
+    wanted = AMPLIFIED_REACH / difference
+    decade = 10.0 ** np.floor(np.log10(max(wanted, 1.0)))
+    return float(max([decade * step for step in GAIN_STEPS if decade * step <= wanted], default=decade))
+
+
+def amplified_difference(split: np.ndarray, exact: np.ndarray, same: np.ndarray) -> tuple[np.ndarray, float]:
+    """The split's picture with its difference from exact amplified: ``exact + gain * (split - exact)``.
+
+    Parameters
+    ----------
+    split, exact : (S, S, 3) float RGB in [0, 1], the two close-ups
+    same : (S, S) bool, the pixels where both show the same face (elsewhere the exact picture is kept:
+        a silhouette is no crease)
+
+    Returns
+    -------
+    (S, S, 3) float32 in [0, 1], and the gain (:func:`gain_for` of the largest change where ``same``).
+    """
+    difference = np.where(same[..., None], split - exact, 0.0)
+    gain = gain_for(float(np.abs(difference).max(initial=0.0)))
+    return np.clip(exact + gain * difference, 0.0, 1.0).astype(np.float32), gain
 
 
 def _map_kd(mesh: Mesh) -> str | None:
@@ -131,7 +169,7 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
                                                               if len(place.faces) > 1 else ""))
     result = Closeup(place, show, label, framed, view=view)
     in_place = np.isin(view.drawn, place.faces)
-    frames = {}
+    frames, plain = {}, {}  # plain: the pictures before the outline
     for method in CLOSEUP_METHODS:
         # With the line pattern, the render's own texture is replaced pixel by pixel: a 1-texel one costs nothing.
         options = RenderOptions(method=method, show=show, width=size, height=size, camera=view.camera, up=view.up,
@@ -147,7 +185,8 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
                                           local_footprints(drawn.frame.attrs)[covered], glyphs)
         own = covered & in_place[np.maximum(sub_face, 0)]
         if method == "split":
-            result.place_pixels = int(own.sum())
+            result.place_pixels, split_outline = int(own.sum()), outline(own)
+        plain[method] = image.copy()
         image[outline(own)] = OVERLAY_TINT
         result.images[method] = image
         frames[method] = (drawn.frame, sub_face)
@@ -160,6 +199,9 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
         error[covered] = pixel_error(split.attrs[covered], exact.attrs[covered], attribute, texture_size)
         code = next(code for code, rule in RULES.items() if rule.scored and rule.attribute == attribute)
         result.error, result.covered, result.unit = error, covered, RULES[code].unit_for(settings.measure)
+        if show in AMPLIFIED:
+            result.amplified, result.gain = amplified_difference(plain["split"], plain["exact"], covered)
+            result.amplified[split_outline] = OVERLAY_TINT
     sliver = _area(mesh, place.faces) < SLIVER_AREA * _area(mesh, view.ring)
     if "split" in result.images and result.place_pixels < PLACE_FLOOR * size * size and not sliver:
         result.dropped = (f"{place.code} at face {place.worst}: its faces cover {result.place_pixels} pixels of "

@@ -324,8 +324,9 @@ def face_ranges(faces) -> str:
 
 
 def closeups_section(result: MeshResult) -> Section:
-    """One close-up per flagged place, worst first: split | hybrid | exact with the place outlined, and the
-    split's error against exact with its colour bar."""
+    """One close-up per flagged place, worst first: split | hybrid | exact with the place outlined, for colours
+    and normals the split's difference from exact amplified (its gain printed), and the split's error against
+    exact with its colour bar."""
     title = "Close-ups of the flagged places"
     if not result.places:
         return leave_out("closeups", title, "nothing flagged, so no place to look at")
@@ -343,8 +344,9 @@ def closeups_section(result: MeshResult) -> Section:
             scale = float(view.error[view.covered].max(initial=0.0))
             error = {"src": heatmap_uri(view.error, view.covered, scale),
                      "bar": heat_bar(scale, f"split error against exact ({view.unit})")}
+        amplified = None if view.amplified is None else {"src": image_uri(view.amplified), "gain": f"{view.gain:g}"}
         figures.append({
-            "face": place.worst, "code": place.code, "name": rule.name, "level": place.level,
+            "amplified": amplified, "face": place.worst, "code": place.code, "name": rule.name, "level": place.level,
             "value": with_unit(number(place.value), unit), "faces": len(place.faces),
             "line": int(mesh.face_line[place.worst]), "group": mesh.group_names[mesh.face_group[place.worst]],
             "texture": view.texture, "framed": view.framed, "error": error,
