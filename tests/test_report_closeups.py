@@ -112,6 +112,43 @@ def test_places_take_turns_between_rules_worst_first():
     assert choose_places(by_rule, 0) == []
 
 
+def test_mirror_twins_are_mirrored_places_with_values_within_a_tenth():
+    """A symmetric model's two halves: positions mirror exactly, an atlas's values only roughly
+    (MakeHuman's lip: 3.467695 and 3.467417 texels; Spot's cheeks: 1.030 and 0.996)."""
+    from affinity.report.places import Place, mirror_twins
+
+    centroids = np.array([[0.33, 7.2, 1.4], [-0.33, 7.2, 1.4], [-0.33, 7.2, 1.4], [0.5, 2.0, 0.0], [-0.5, 2.1, 0.0]])
+    low, high = np.array([-5.0, -8.0, -1.0]), np.array([5.0, 8.0, 3.0])
+    values = [3.467695, 3.467417, 4.5, 2.0, 2.0]
+
+    def place(face):
+        return Place("Q101", np.array([face]), np.array([values[face]]), face, values[face], 1.0, "warning")
+
+    twin = mirror_twins([place(f) for f in range(5)], centroids, low, high)
+    # 1 mirrors 0 with a value 8e-5 apart; 2 mirrors it at a value 30 % off; 4 is no mirror image of 3 (y differs).
+    np.testing.assert_array_equal(twin, [False, True, False, False, False])
+
+
+def test_a_place_an_earlier_closeup_shows_gets_no_closeup_of_its_own(tmp_path):
+    """Two neighbouring flagged quads cut into two places (--place-faces 1): the first close-up shows both, so
+    there is one close-up (the other place is counted as not drawn); far apart, each gets its own."""
+    from affinity.report.build import ReportOptions, collect_mesh
+    from affinity.report.demo import MeshInput
+    from affinity.settings import Settings
+
+    counts = []
+    for bent in ([(5, 5), (4, 5)], [(1, 1), (10, 10)]):  # not mirror images of each other
+        write_obj(grid_mesh(12, bent=bent), tmp_path / "two.obj")
+        result = collect_mesh(MeshInput(str(tmp_path / "two.obj"), "two.obj"), Settings(),
+                              options=ReportOptions(place_faces=1))
+        assert len(result.places) == 2
+        counts.append(len(result.closeups))
+        first = result.closeups[0]
+        other = next(p for p in result.places if p is not first.place)
+        assert (other.worst in first.seen) == (len(result.closeups) == 1)
+    assert counts == [1, 2]
+
+
 def test_closeup_camera_looks_at_the_place_along_its_normal_and_fits_its_ring():
     from affinity.draw.closeup import TILT_DEGREES, closeup_view, face_subset
     from affinity.draw.framing import camera_for
@@ -243,6 +280,46 @@ def test_a_faint_colour_crease_gets_an_amplified_panel_that_shows_it(tmp_path):
     true_size = np.abs(split - exact).max(axis=-1)[inside]
     shown = np.abs(view.amplified - exact).max(axis=-1)[inside]
     assert true_size.max() < 6 / 255 and (shown > 20 / 255).mean() > 0.05
+
+
+def test_amplified_uv_moves_the_split_s_texture_by_gain_times_its_error():
+    from affinity.report.closeups import UV_REACH, amplified_uv
+
+    rng = np.random.default_rng(5)
+    exact = rng.uniform(0, 1, (12, 12, 2))
+    local = np.full((12, 12, 2), 1e-3)
+    split = exact + rng.uniform(-0.4e-3, 0.4e-3, (12, 12, 2))  # under 0.4 pixels
+    same = np.ones((12, 12), dtype=bool)
+    same[0] = False
+    uv, gain = amplified_uv(split, exact, same, local)
+    largest = np.abs(split - exact)[same].max() / 1e-3
+    assert gain * largest <= UV_REACH < 2.5 * gain * largest  # the next step (x2 or x2.5) would pass the reach
+    np.testing.assert_allclose(uv[same], (exact + gain * (split - exact))[same])
+    np.testing.assert_array_equal(uv[~same], exact[~same])
+
+
+def test_a_sub_pixel_uv_crease_gets_an_amplified_panel_whose_lines_kink_more(tmp_path):
+    """One quad's corner uv pushed by 2 texels: the split's error is under a pixel in the close-up, and the
+    panel with the uv error amplified moves the lines at least half as much again (ink moved, summed)."""
+    from affinity.draw.shading import OVERLAY_TINT
+    from affinity.report.build import ReportOptions, collect_mesh
+    from affinity.report.demo import MeshInput
+    from affinity.settings import Settings
+
+    mesh = grid_mesh(10)
+    uv = mesh.texcoords.copy()
+    uv[4 * 44 + 2] += 2 / 1024
+    write_obj(replace_uv(mesh, uv), tmp_path / "faint_uv.obj")
+    result = collect_mesh(MeshInput(str(tmp_path / "faint_uv.obj"), "faint_uv.obj"), Settings(),
+                          options=ReportOptions(max_views=1))
+    (view,) = result.closeups
+    assert view.place.code == "Q101" and view.gain > 1 and view.amplified_label == f"split, its uv error ×{view.gain:g}"
+    split, exact = view.images["split"], view.images["exact"]
+    inside = view.covered & ~(split == OVERLAY_TINT).all(axis=-1)
+    assert view.error.max() < 1.0  # texels, and a texel is about a pixel here
+    moved_true = np.abs(split - exact)[inside].sum()
+    moved_amplified = np.abs(view.amplified - exact)[inside].sum()
+    assert moved_true > 0 and moved_amplified > 1.5 * moved_true
 
 
 def replace_uv(mesh, uv):

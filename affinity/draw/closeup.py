@@ -31,7 +31,7 @@ DRAWN_RADII = 2.5
 #: Side of the visibility pre-pass that picks the view direction, pixels.
 PREPASS_SIZE = 64
 #: A ring reaching farther than this many place radii (long neighbours, a pole) is framed at that distance.
-RING_RADII = 3.0
+RING_RADII = 2.0
 
 
 @dataclass(frozen=True)

@@ -83,15 +83,18 @@ U_INK = np.array([0.12, 0.28, 0.62])
 V_INK = np.array([0.80, 0.18, 0.12])
 
 
-def pixel_footprint(uv: np.ndarray) -> float:
-    """The median uv distance between neighbouring pixels of a frame's uv (H, W, 2) float (NaN where empty).
+def pixel_footprint(uv: np.ndarray, where: np.ndarray | None = None) -> float:
+    """The median uv distance between neighbouring pixels of a frame's uv (H, W, 2) float (NaN where empty),
+    over the pixels ``where`` (H, W) bool (default: all; all as well when ``where`` has none to measure).
 
     The scale at which a close-up's pattern is drawn: lines ``LINE_SPACING`` pixels
     apart are ``LINE_SPACING`` footprints apart in uv. 1.0 when no two neighbours are covered.
     """
     steps = np.linalg.norm(local_footprints(uv), axis=-1)
-    steps = steps[np.isfinite(steps) & (steps > 0)]
-    return float(np.median(steps)) if len(steps) else 1.0
+    measured = np.isfinite(steps) & (steps > 0)
+    if where is not None and (measured & where).any():
+        measured &= where
+    return float(np.median(steps[measured])) if measured.any() else 1.0
 
 
 def local_footprints(uv: np.ndarray) -> np.ndarray:

@@ -241,7 +241,8 @@ def _view(result: MeshResult) -> None:
 
 
 def _closeups(result: MeshResult, step: StepTimer) -> None:
-    """Rank every flagged place; draw the first ``max_views``."""
+    """Rank every flagged place; draw the first ``max_views`` that share no face with an earlier close-up and
+    whose worst face no earlier close-up shows (``Closeup.seen``): each close-up a new spot."""
     from .closeups import closeup
     from .places import choose_places, places_of
 
@@ -249,10 +250,11 @@ def _closeups(result: MeshResult, step: StepTimer) -> None:
     by_rule = {hits.code: places_of(result.mesh, hits, result.options.place_faces) for hits in result.file.hits}
     result.places = choose_places(by_rule, sum(len(p) for p in by_rule.values()))
     shown = np.zeros(result.mesh.n_faces, dtype=bool)  # no two close-ups share a face
+    seen = np.zeros(result.mesh.n_faces, dtype=bool)  # nor show one place's worst face again
     for place in result.places:
         if len(result.closeups) == result.options.max_views:
             break
-        if shown[place.faces].any():
+        if shown[place.faces].any() or seen[place.worst]:
             continue
         step(f"close-up {len(result.closeups) + 1}", "close-ups")
         drawn = closeup(result.mesh, place, result.settings, CLOSEUP_SIZE, result.options.pixel_tolerance,
@@ -262,6 +264,7 @@ def _closeups(result: MeshResult, step: StepTimer) -> None:
         else:
             result.closeups.append(drawn)
             shown[place.faces] = True
+            seen[drawn.seen] = True
 
 
 def collect_mesh(item: MeshInput, settings: Settings, step: Callable[[str], None] = lambda name: None,

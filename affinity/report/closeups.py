@@ -35,12 +35,16 @@ SLIVER_AREA = 1e-3
 PLAIN = np.ones((1, 1, 3), dtype=np.float32)
 #: Attribute shown for each scored rule; the geometric rules show uv when the mesh has it.
 SHOW_FOR = ATTRIBUTE_NAMES
-#: Shown attributes whose close-up also gets the split's difference from exact amplified (a colour or normal
-#: crease of a few 1/255 is invisible at its true size; the uv lines kink visibly at it).
+#: A face covering at least this many pixels of a close-up's split panel is seen in it: a later place whose
+#: worst face an earlier close-up shows gets no close-up of its own (it would show the same spot again).
+SEEN_PIXELS = 24
+#: Shown attributes whose close-up also gets the split's difference from exact amplified, when it is faint (a
+#: colour or normal crease of a few 1/255, a uv error under a pixel): the largest channel change is brought to
+#: about ``COLOUR_REACH`` (of 1), the largest uv displacement to about ``UV_REACH`` pixels on screen, by a gain
+#: of ``GAIN_STEPS`` times a power of ten.
 AMPLIFIED = ("color", "normal")
-#: The amplified difference's largest channel change is brought to about this much (of 1), by a gain in
-#: ``GAIN_STEPS`` times a power of ten, never below 1.
-AMPLIFIED_REACH = 0.5
+COLOUR_REACH = 0.5
+UV_REACH = 3.0
 GAIN_STEPS = (1, 2, 5)
 
 
@@ -53,7 +57,9 @@ class Closeup:
     covered : (S, S) bool, the pixels where split and exact show the same face
     view : the :class:`affinity.draw.closeup.CloseupView` drawn (camera, up, drawn faces)
     place_pixels : the pixels the place's faces cover in the split picture
-    amplified : (S, S, 3) float, exact plus ``gain`` times (split - exact), for colours and normals (else None)
+    seen : (K,) int64, the mesh faces covering at least ``SEEN_PIXELS`` pixels of the split picture
+    amplified : (S, S, 3) float, the split with its difference from exact (colours, normals) or its uv error
+        times ``gain``, where that is faint (a gain above 1), else None; ``amplified_label`` says which
     dropped : why the close-up is not shown (its place covers too few pixels from every side), else None
     """
 
@@ -70,6 +76,8 @@ class Closeup:
     dropped: str | None = None
     amplified: np.ndarray | None = None
     gain: float = 1.0
+    amplified_label: str = ""
+    seen: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
 
 
 def _show_for(mesh: Mesh, code: str) -> str:
@@ -81,17 +89,27 @@ def _show_for(mesh: Mesh, code: str) -> str:
     return "color" if mesh.colors is not None else "shaded"
 
 
-def gain_for(difference: float) -> float:
-    """The gain (1, 2, 5, 10, 20, ...) that brings a largest channel ``difference`` (of 1) to at most
-    ``AMPLIFIED_REACH``; 1 for a difference already that big or none."""
-    if not difference > 0:
+def gain_for(change: float, reach: float = COLOUR_REACH) -> float:
+    """The gain (1, 2, 5, 10, 20, ...) that brings a largest ``change`` to at most ``reach``; 1 for a change
+    already that big, or none."""
+    if not change > 0:
         return 1.0
-    wanted = AMPLIFIED_REACH / difference
+    wanted = reach / change
     decade = 10.0 ** np.floor(np.log10(max(wanted, 1.0)))
     return float(max([decade * step for step in GAIN_STEPS if decade * step <= wanted], default=decade))
 
 
-def amplified_difference(split: np.ndarray, exact: np.ndarray, same: np.ndarray) -> tuple[np.ndarray, float]:
+def _largest(change: np.ndarray, same: np.ndarray, place: np.ndarray | None) -> float:
+    """The largest finite ``change`` (S, S, K) on the place's pixels ``place`` (S, S) bool that ``same`` keeps,
+    else on all of ``same``'s."""
+    keep = same if place is None or not (same & place).any() else same & place
+    values = change[keep]
+    values = values[np.isfinite(values)]
+    return float(values.max(initial=0.0))
+
+
+def amplified_difference(split: np.ndarray, exact: np.ndarray, same: np.ndarray,
+                         place: np.ndarray | None = None) -> tuple[np.ndarray, float]:
     """The split's picture with its difference from exact amplified: ``exact + gain * (split - exact)``.
 
     Parameters
@@ -99,14 +117,38 @@ def amplified_difference(split: np.ndarray, exact: np.ndarray, same: np.ndarray)
     split, exact : (S, S, 3) float RGB in [0, 1], the two close-ups
     same : (S, S) bool, the pixels where both show the same face (elsewhere the exact picture is kept:
         a silhouette is no crease)
+    place : (S, S) bool, the place's pixels, whose largest change sets the gain (default: all ``same``)
 
     Returns
     -------
-    (S, S, 3) float32 in [0, 1], and the gain (:func:`gain_for` of the largest change where ``same``).
+    (S, S, 3) float32 in [0, 1], and the gain (:func:`gain_for` of the largest change on the place).
     """
     difference = np.where(same[..., None], split - exact, 0.0)
-    gain = gain_for(float(np.abs(difference).max(initial=0.0)))
+    gain = gain_for(_largest(np.abs(difference), same, place))
     return np.clip(exact + gain * difference, 0.0, 1.0).astype(np.float32), gain
+
+
+def amplified_uv(split: np.ndarray, exact: np.ndarray, same: np.ndarray, local: np.ndarray,
+                 place: np.ndarray | None = None) -> tuple[np.ndarray, float]:
+    """The split's texture coordinates with their error amplified: ``exact + gain * (split - exact)``.
+
+    Parameters
+    ----------
+    split, exact : (S, S, 2) float uv of the two close-ups
+    same : (S, S) bool, the pixels where both show the same face
+    local : (S, S, 2) float, each pixel's footprint in u and v (NaN where unknown)
+    place : (S, S) bool, the place's pixels, whose largest displacement sets the gain (default: all ``same``)
+
+    Returns
+    -------
+    (S, S, 2) float64 uv (exact where not ``same``), and the gain that brings the place's largest
+    displacement, in pixels of the pixel's own footprint, to about ``UV_REACH`` pixels.
+    """
+    error = np.where(same[..., None], split - exact, 0.0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        pixels = np.abs(error) / np.where(local > 0, local, np.nan)
+    gain = gain_for(_largest(pixels, same, place), UV_REACH)
+    return exact + gain * error, gain
 
 
 def _map_kd(mesh: Mesh) -> str | None:
@@ -145,7 +187,15 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
     from ..draw.closeup import face_subset, outline
     from ..draw.drawing import RenderOptions, render_mesh
     from ..draw.shading import OVERLAY_TINT
-    from ..draw.texture import GLYPH_SPACING, LINE_SPACING, line_colours, local_footprints, pixel_footprint
+    from ..draw.texture import (
+        GLYPH_SPACING,
+        LINE_SPACING,
+        line_colours,
+        load_image,
+        local_footprints,
+        pixel_footprint,
+        sample_bilinear,
+    )
     from ..loaders.imagesize import image_size
     from ..measures import pixel_error
 
@@ -179,13 +229,14 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
         face = drawn.frame.face
         covered = face >= 0
         sub_face = np.where(covered, drawn.faces[np.maximum(face, 0)], -1)
-        if lines:
-            footprint = footprint or pixel_footprint(drawn.frame.attrs)  # the split's, for every panel
+        own = covered & in_place[np.maximum(sub_face, 0)]
+        if lines:  # at the place's scale: the split's footprint on the place's pixels, for every panel
+            footprint = footprint or pixel_footprint(drawn.frame.attrs, own)
             image[covered] = line_colours(drawn.frame.attrs[covered], footprint,
                                           local_footprints(drawn.frame.attrs)[covered], glyphs)
-        own = covered & in_place[np.maximum(sub_face, 0)]
         if method == "split":
-            result.place_pixels, split_outline = int(own.sum()), outline(own)
+            result.place_pixels, split_own, split_outline = int(own.sum()), own, outline(own)
+            result.seen = view.drawn[np.bincount(sub_face[covered], minlength=len(view.drawn)) >= SEEN_PIXELS]
         plain[method] = image.copy()
         image[outline(own)] = OVERLAY_TINT
         result.images[method] = image
@@ -200,8 +251,18 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
         code = next(code for code, rule in RULES.items() if rule.scored and rule.attribute == attribute)
         result.error, result.covered, result.unit = error, covered, RULES[code].unit_for(settings.measure)
         if show in AMPLIFIED:
-            result.amplified, result.gain = amplified_difference(plain["split"], plain["exact"], covered)
-            result.amplified[split_outline] = OVERLAY_TINT
+            amplified, gain = amplified_difference(plain["split"], plain["exact"], covered, split_own)
+            what = "its difference from exact"
+        else:  # uv: the split's texture moved by gain times its error, drawn as the panels are
+            local = local_footprints(exact.attrs)
+            uv, gain = amplified_uv(split.attrs, exact.attrs, covered, local, split_own)
+            amplified = plain["exact"].copy()
+            amplified[covered] = (line_colours(uv[covered], footprint, local[covered], glyphs) if lines
+                                  else sample_bilinear(load_image(image_file), uv[covered]))
+            what = "its uv error"
+        if gain > 1:  # at a gain of 1 the panel would be the split's again
+            amplified[split_outline] = OVERLAY_TINT
+            result.amplified, result.gain, result.amplified_label = amplified, gain, f"split, {what} ×{gain:g}"
     sliver = _area(mesh, place.faces) < SLIVER_AREA * _area(mesh, view.ring)
     if "split" in result.images and result.place_pixels < PLACE_FLOOR * size * size and not sliver:
         result.dropped = (f"{place.code} at face {place.worst}: its faces cover {result.place_pixels} pixels of "

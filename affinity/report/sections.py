@@ -344,7 +344,8 @@ def closeups_section(result: MeshResult) -> Section:
             scale = float(view.error[view.covered].max(initial=0.0))
             error = {"src": heatmap_uri(view.error, view.covered, scale),
                      "bar": heat_bar(scale, f"split error against exact ({view.unit})")}
-        amplified = None if view.amplified is None else {"src": image_uri(view.amplified), "gain": f"{view.gain:g}"}
+        amplified = (None if view.amplified is None
+                     else {"src": image_uri(view.amplified), "label": view.amplified_label})
         figures.append({
             "amplified": amplified, "face": place.worst, "code": place.code, "name": rule.name, "level": place.level,
             "value": with_unit(number(place.value), unit), "faces": len(place.faces),
