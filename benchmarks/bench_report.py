@@ -6,7 +6,9 @@ every one of them mapping the whole texture square, as the issue's car did. When
 the shared meshes are absent the built-in demo sphere is subdivided instead (said
 in the table). Each round runs ``affinity report -q`` in a fresh process; the UV
 layout (:func:`affinity.report.uvlayout.layout_image` and its SVG) is timed in one
-more process on the same file and the lint's flags.
+more process on the same file and the lint's flags. Without ``--small``, each
+mesh of ``../shared/meshes`` is then reported once the same way (wall time and peak
+memory), so the README can say what the report costs on real assets.
 
     python benchmarks/bench_report.py                 # 100,800 quads, 3 rounds
     python benchmarks/bench_report.py --small --out /tmp/bench   # 6,300 quads, 1 round (the test's case)
@@ -29,7 +31,8 @@ from pathlib import Path
 import numpy as np
 from common import parse_with_output, write_table
 
-CAR = Path(__file__).resolve().parents[2] / "shared" / "meshes" / "osd_catmark_car.obj"
+SHARED = Path(__file__).resolve().parents[2] / "shared" / "meshes"
+CAR = SHARED / "osd_catmark_car.obj"
 LAYOUT_CHILD = """
 import sys, time
 import numpy as np
@@ -106,8 +109,15 @@ def main(argv=None) -> None:
         runs = [timed_process([sys.executable, "-m", "affinity.cli", "report", "-q", mesh,
                                "-o", os.path.join(folder, "report.html")]) for _ in range(rounds)]
         layout = float(timed_process([sys.executable, "-c", LAYOUT_CHILD, mesh])[2])
+        shared = [] if args.small else [
+            (path.name, *timed_process([sys.executable, "-m", "affinity.cli", "report", "-q", str(path),
+                                        "-o", os.path.join(folder, "shared.html")])[:2])
+            for path in sorted(SHARED.glob("*.obj"))]
     wall = statistics.median(run[0] for run in runs)
     memory = max(run[1] for run in runs)
+    shared_table = ["", "The meshes of `../shared/meshes`, one `affinity report -q` each:", "",
+                    "| mesh | wall (s) | peak memory (MiB) |", "|---|---:|---:|",
+                    *(f"| {name} | {seconds:.2f} | {peak:.0f} |" for name, seconds, peak in shared)] if shared else []
     write_table([
         f"{quads:,} quads ({source}, per-face unit uv), {platform.processor() or platform.machine()}, "
         f"{os.cpu_count()} CPUs, load {load:.2f} before, median of {rounds} round{'s' * (rounds > 1)}:",
@@ -115,6 +125,7 @@ def main(argv=None) -> None:
         "| `affinity report -q` | wall (s) | peak memory (MiB) | UV layout (s) | UV layout share |",
         "|---|---:|---:|---:|---:|",
         f"| {quads:,} quads | {wall:.2f} | {memory:.0f} | {layout:.2f} | {layout / wall:.1%} |",
+        *shared_table,
     ], args.out, "bench_report.md")
 
 
