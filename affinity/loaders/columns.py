@@ -10,9 +10,9 @@ token's word at offsets of its own). Exported meshes are mostly such groups
 (``%.6f`` coordinates, ``v/vt/vn`` faces of consecutive indices); what is not
 is the token reader's job.
 
-Rows are copied into a zero-padded matrix whose width is a multiple of 8, with
-8 spare bytes before each row, so that each row is a run of aligned ``uint64``
-words. Once XORed with the first row's bytes (``'0'`` at its digits), the
+Each line is read as ``uint64`` words, word ``k`` of every line in one array
+(a strided view of the buffer when the lines follow each other), so that every
+operation runs along the lines. Once XORed with the first row's bytes (``'0'`` at its digits), the
 bytes of a row that is laid out alike are 0 outside the digits and digit
 values 0..9 in them: one check per word (the ``+6`` digit test of
 :mod:`affinity.loaders.numbers` at the digits, an exact 0 elsewhere).
@@ -25,10 +25,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from .numbers import eight_digits
+from .numbers import words as unaligned_words
 
 _U = np.uint64
 _ONES = _U((1 << 64) - 1)
-_FRONT = 8  # spare bytes before each row: a word ending at a row's first digits stays inside it
 _DIGITS = np.zeros(256, dtype=bool)
 _DIGITS[ord("0") : ord("9") + 1] = True
 
@@ -41,33 +41,46 @@ class Group:
         Indices of the lines (ascending) among those passed to :func:`alike_groups`.
     first : bytes
         The first line, its line break included.
-    digits : (n, W) uint64
-        The rows as words: digit values 0..9 where the first line has a digit, 0 elsewhere;
-        byte ``k`` of a line is byte ``(k + 8) % 8`` of word ``(k + 8) // 8``.
+    digits : (W, m) uint64
+        Lines as words, word by word (every operation runs along the lines):
+        digit values 0..9 where the first line has a digit, 0 elsewhere; byte
+        ``k`` of a line is byte ``k % 8`` of its word ``k // 8`` (the last word's bytes past
+        the line are another line's, and ignored).
+    select : (n,) int64 or None
+        The columns of ``digits`` that are the group's lines (None: all).
     """
 
     rows: np.ndarray
     first: bytes
     digits: np.ndarray
+    select: np.ndarray | None = None
+
+    def _words(self, word) -> np.ndarray:
+        """(S, n) uint64 words ``word`` (S,) of the group's lines."""
+        if self.select is None:
+            return self.digits[word]
+        return self.digits[np.ix_(word, self.select)]
 
     def numbers(self, spans, dots=None) -> np.ndarray:
-        """(n, S) uint64 value of the digits in each span ``spans[s] = (start, end)``
+        """(S, n) uint64 value of the digits in each span ``spans[s] = (start, end)``
         (byte offsets in the line, at most 8 bytes) but the one at ``dots[s]`` (-1: none),
         a decimal point."""
-        end = np.array([e for _, e in spans], dtype=np.int64) + _FRONT
-        length = (end - _FRONT - np.array([s for s, _ in spans], dtype=np.int64)).astype(np.uint64)
-        start = end - 8  # the word of the 8 bytes ending at the span's end
+        end = np.array([e for _, e in spans], dtype=np.int64)
+        length = (end - np.array([s for s, _ in spans], dtype=np.int64)).astype(np.uint64)
+        # The 8 bytes ending at the span's end, from two words; before a line's first
+        # word (word -1: its last) are bytes the mask drops.
+        start = end - 8
         word = start >> 3
-        shift = (start & 7).astype(np.uint64) << _U(3)
-        low = self.digits[:, word]
+        shift = ((start & 7).astype(np.uint64) << _U(3))[:, None]
+        low = self._words(word)
         low >>= shift
-        high = self.digits[:, word + 1]
+        high = self._words(np.minimum(word + 1, len(self.digits) - 1))  # unused when aligned
         high <<= _U(64) - shift  # a shift by 64 gives 0 in NumPy
         low |= high
-        low &= _ONES << (_U(8) * (_U(8) - length))  # the span's bytes only
-        if dots is not None:  # the digits before the point move up into its (zero) byte
-            at = (np.asarray(dots) + _FRONT - start).astype(np.uint64)
-            below = np.where(np.asarray(dots) >= 0, (_U(1) << (_U(8) * at)) - _U(1), _U(0))
+        low &= (_ONES << (_U(8) * (_U(8) - length)))[:, None]  # the span's bytes only
+        if dots is not None and max(dots) >= 0:  # the digits before the point move up into its (zero) byte
+            at = (np.asarray(dots) - start).astype(np.uint64)
+            below = np.where(np.asarray(dots) >= 0, (_U(1) << (_U(8) * at)) - _U(1), _U(0))[:, None]
             before = low & below
             low ^= before
             before <<= _U(8)
@@ -86,46 +99,51 @@ def alike_groups(buf: np.ndarray, begin: np.ndarray, end: np.ndarray, limit: int
     cuts = np.flatnonzero(np.diff(length[order])) + 1
     for rows in np.split(order, cuts):
         width = int(length[rows[0]])
-        padded = -(-(width + _FRONT) // 8) * 8 + 8  # and a spare word after the row
-        window = np.lib.stride_tricks.sliding_window_view(buf, width)
+        words = _line_words(buf, begin[rows], width)
+        masks = None
         while len(rows):
             if len(groups) == limit:
                 return None
             first = bytes(buf[begin[rows[0]] : begin[rows[0]] + width])
-            matrix = np.zeros((len(rows), padded), np.uint8)
-            consecutive = rows[-1] - rows[0] + 1 == len(rows)
-            if consecutive and begin[rows[-1]] - begin[rows[0]] == width * (len(rows) - 1):
-                start = begin[rows[0]]
-                matrix[:, _FRONT : _FRONT + width] = buf[start : start + width * len(rows)].reshape(-1, width)
-            else:
-                matrix[:, _FRONT : _FRONT + width] = window[begin[rows]]
-            words = matrix.view("<u8")
-            expected, sixes, checked = _row_masks(first, padded)
-            words ^= expected
+            previous, masks = masks, _row_masks(first, len(words))
+            expected, sixes, checked = masks
+            words ^= expected if previous is None else expected ^ previous[0]
             bad = words + sixes
             bad |= words
             bad &= checked
             if bad.max() == 0:
                 groups.append(Group(rows, first, words))
                 break
-            alike = ~np.bitwise_or.reduce(bad, axis=1).astype(bool)
-            if alike.all():
-                groups.append(Group(rows, first, words))
-                break
-            groups.append(Group(rows[alike], first, words[alike]))
-            rows = rows[~alike]
+            alike = np.bitwise_or.reduce(bad, axis=0) == 0
+            groups.append(Group(rows[alike], first, words, np.flatnonzero(alike)))
+            rows, words = rows[~alike], words[:, ~alike]
     return groups
 
 
-def _row_masks(first: bytes, padded: int):
-    """(W,) uint64 words for the first row: the bytes to XOR away (``'0'`` at the digits),
+def _line_words(buf: np.ndarray, begin: np.ndarray, width: int) -> np.ndarray:
+    """(W, n) uint64: word ``k`` of each line of ``width`` bytes starting at ``begin`` (n,),
+    the bytes ``begin + 8k ..`` (the last word runs into the next line: masks ignore that)."""
+    count = -(-width // 8)
+    words = np.empty((count, len(begin)), np.uint64)
+    if begin[-1] - begin[0] == width * (len(begin) - 1):  # consecutive lines: a strided view
+        for k in range(count):
+            words[k] = np.ndarray((len(begin),), "<u8", buffer=buf, offset=int(begin[0]) + 8 * k, strides=(width,))
+    else:
+        every = unaligned_words(buf)
+        for k in range(count):
+            words[k] = every[begin + 8 * k]
+    return words
+
+
+def _row_masks(first: bytes, count: int):
+    """(W, 1) uint64 words for the first row: the bytes to XOR away (``'0'`` at the digits),
     the ``+6`` of the digit test at the digits, and the bits that must be 0 afterwards."""
     row = np.frombuffer(first, np.uint8)
     digit = _DIGITS[row]
-    expected = np.zeros(padded, np.uint8)
-    expected[_FRONT : _FRONT + len(row)] = np.where(digit, ord("0"), row)
-    sixes = np.zeros(padded, np.uint8)
-    sixes[_FRONT : _FRONT + len(row)][digit] = 6
-    checked = np.full(padded, 0xFF, np.uint8)
-    checked[_FRONT : _FRONT + len(row)][digit] = 0xF0
-    return expected.view("<u8"), sixes.view("<u8"), checked.view("<u8")
+    expected = np.zeros(8 * count, np.uint8)
+    expected[: len(row)] = np.where(digit, ord("0"), row)
+    sixes = np.zeros(8 * count, np.uint8)
+    sixes[: len(row)][digit] = 6
+    checked = np.zeros(8 * count, np.uint8)  # the bytes after the line are not checked
+    checked[: len(row)] = np.where(digit, 0xF0, 0xFF)
+    return tuple(mask.view("<u8")[:, None] for mask in (expected, sixes, checked))

@@ -273,7 +273,7 @@ def _alike_part(chunk) -> _Part | None:
     corners, bounds = [None] * 3, [None] * 3
     if faces:
         layout = faces[0][1]
-        blocks = [(g.rows, g.numbers(own.spans).view(np.int64)) for g, own in faces]
+        blocks = [(g.rows, g.numbers(own.spans).view(np.int64).T) for g, own in faces]
         indices = _in_file_order(kind, _F, blocks, (0, len(layout.slots)), np.int64)
         if not indices.all():  # index 0: the token reader says where
             return None
@@ -296,11 +296,11 @@ def _alike_part(chunk) -> _Part | None:
 def _alike_numbers(group: Group, layout: _Layout) -> np.ndarray:
     """(n, T) float64 numbers of a group of ``v``/``vt``/``vn`` lines."""
     runs = group.numbers(layout.spans, layout.dots).view(np.int64).astype(np.float64)
-    values = runs if len(layout.last) == len(layout.spans) else runs[:, layout.last]
+    values = runs if len(layout.last) == len(layout.spans) else runs[layout.last]
     for run, column, weight in layout.extra:  # exact: integers below 2**53
-        values[:, column] += runs[:, run] * weight
-    values /= layout.divisor
-    return values
+        values[column] += runs[run] * weight
+    values /= layout.divisor[:, None]
+    return values.T
 
 
 def _in_file_order(kind, which, blocks, empty_shape, dtype) -> np.ndarray:
