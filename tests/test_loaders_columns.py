@@ -1,6 +1,6 @@
 """The OBJ reader's column path (lines laid out alike, :mod:`affinity.loaders.columns`).
 
-Generated files hold only ``v``/``vt``/``vn``/``f`` lines, so that chunks are read
+Generated files hold only ``v``/``vt``/``vn``/``f`` lines (and blank and comment lines), so that chunks are read
 as groups of lines laid out alike: numbers of random signs, digit counts (up to the
 15 that a float64 holds exactly, longer than a word) and separators, faces of one
 form. The mesh must equal what Python's own ``float`` and ``int`` make of the text,
@@ -52,6 +52,8 @@ def generated(seed: int) -> tuple[str, dict]:
             lines.append(gap.join([kind, *numbers]) + end)
         if rng.random() < 0.3:
             lines.append(end)  # a blank line
+        if rng.random() < 0.3:
+            lines.append(f"# {kind} 1/2 done" + end)  # a comment line
     faces, face_line = [], []
     for _ in range(rng.randint(1, 500)):
         base = rng.choice([1, 9, 99, 999, 9999, 99999, 9999999]) % counts["v"] + 1
@@ -107,6 +109,7 @@ def test_column_path_matches_python_and_the_token_reader(tmp_path, monkeypatch, 
     ("v 1.234567890123456 0 0", None),  # 16 digits: the token reader rounds
     ("v 1 2 3 0.5 0.5 0.5", None),  # a colour
     ("g part", None),
+    ("v 1 2 3 # a trailing comment", None),
     ("f 0 1 2", "bad index '0'"),
     ("f 1 2", "face with 2 corners"),
     ("v 1 2 nan", "not a finite number"),

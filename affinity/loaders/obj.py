@@ -6,7 +6,7 @@ keyword, signs, points and separators) is read as byte columns
 (:mod:`affinity.loaders.columns`): no tokens, each number read at offsets fixed
 for its group. That is the common exported file (``%.6f`` coordinates,
 ``v/vt/vn`` faces). Any other chunk, and any chunk holding a line the column
-path does not take (statements, comments, exponents, colours, index 0, ...),
+path does not take (statements, trailing comments, exponents, colours, index 0, ...),
 goes to the token reader below, which also names the line of every error.
 
 Otherwise each chunk of lines is tokenized once at whitespace and '/'. Lines are
@@ -188,12 +188,13 @@ class _Layout:
 
 
 def _line_layout(first: bytes) -> _Layout | None:
-    """The :class:`_Layout` of lines laid out like ``first`` (kind 0: a blank line), None
-    when the token reader must read them (statements, comments, exponents, colours, ...)."""
+    """The :class:`_Layout` of lines laid out like ``first`` (kind 0: a blank or comment line),
+    None when the token reader must read them (statements, trailing comments, exponents,
+    colours, ...)."""
     if not _TEXT_LINE.fullmatch(first):
         return None
     tokens = list(_OBJ_TOKEN.finditer(first))
-    if not tokens:
+    if not tokens or tokens[0].group().startswith(b"#"):  # blank, or a comment line
         return _Layout(0, [])
     kind = _KINDS.get(tokens[0].group())
     if kind == _F:
@@ -244,7 +245,7 @@ def _face_layout_of(first: bytes, tokens) -> _Layout | None:
 def _alike_part(chunk) -> _Part | None:
     """The chunk read as groups of lines laid out alike (:mod:`affinity.loaders.columns`),
     or None when some line needs the token reader (which then finds any error)."""
-    if len(chunk.joined) or chunk.find(b"#") >= 0:
+    if len(chunk.joined):
         return None
     buf = chunk.buf
     end = np.flatnonzero(buf == ord("\n"))
