@@ -267,7 +267,8 @@ def _alike_part(chunk) -> _Part | None:
         if len({len(layout.divisor) for _, layout in own}) > 1:
             return None
         blocks = [(g.rows, _alike_numbers(g, layout)) for g, layout in own]
-        elements[which] = _in_file_order(kind, which, blocks, (0, _WIDTHS[which][0]), np.float64)
+        # (n, T) rows in memory order here on the worker: the reading thread's append is then a plain copy
+        elements[which] = np.ascontiguousarray(_in_file_order(kind, which, blocks, (0, _WIDTHS[which][0]), np.float64))
     faces = [(g, layout) for g, layout in zip(groups, layouts) if layout.kind == _F]
     if len({layout.slots for _, layout in faces}) > 1:
         return None
