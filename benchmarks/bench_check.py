@@ -86,10 +86,25 @@ def machine() -> str:
     return f"{model}, {cpus} CPUs, Python {platform.python_version()}, NumPy {numpy.__version__}"
 
 
+#: The checkout this benchmark belongs to: its children import ``affinity`` from here (a
+#: git worktree measures itself, not the checkout the environment has installed).
+CHECKOUT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def revision() -> str:
+    """The commit of :data:`CHECKOUT` (``unknown`` outside git)."""
+    try:
+        found = subprocess.run(["git", "-C", CHECKOUT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True)
+    except OSError:
+        return "unknown"
+    return found.stdout.strip() or "unknown"
+
+
 def run(command: list[str]) -> tuple[float, float, float, str, int]:
     """Run a child; return (wall s, CPU s = user + system, peak RSS MiB, stdout, exit code)."""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [CHECKOUT, os.environ.get("PYTHONPATH")])))
     start = time.perf_counter()
-    child = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    child = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, env=env)
     out = child.stdout.read()
     _, status, usage = os.wait4(child.pid, 0)
     wall = time.perf_counter() - start
@@ -153,7 +168,8 @@ def main(argv=None) -> None:
             if importlib.util.find_spec(module) is not None and (args.trimesh or module != "trimesh"):
                 cases[name] = [sys.executable, "-c", statement, path]
 
-        header = [f"Measured {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())} on {machine()}.",
+        header = [f"Measured {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())} on {machine()}, "
+                  f"affinity at {revision()}.",
                   f"{os.path.getsize(path) / 1e6:.1f} MB OBJ, {args.quads:,} quads with vt and vn; "
                   f"{args.rounds} rounds, every case a fresh process, taking turns.",
                   f"Load average before: {' '.join(f'{x:.2f}' for x in os.getloadavg())} "

@@ -101,7 +101,7 @@ class WordReader:
         return low
 
 
-def _eight_digits(x: np.ndarray) -> np.ndarray:
+def eight_digits(x: np.ndarray) -> np.ndarray:
     """(K,) uint64 words of eight digit values 0..9 (first digit in the lowest byte)
     -> their values, in place (Lemire 2021, multiply-shift form)."""
     x *= _U(10 << 8 | 1)
@@ -204,10 +204,10 @@ def _fixed_decimals(buf, starts, ends, allow_dot):
         _close_dot(lo, below_lo)
         scale_index += negative * 256
     bad = _not_digits(lo)
-    mantissa = _eight_digits(lo)
+    mantissa = eight_digits(lo)
     if wide:
         bad |= _not_digits(hi)
-        mantissa += _eight_digits(hi) * _U(100000000)
+        mantissa += eight_digits(hi) * _U(100000000)
     ok = bad == 0
     if wide:
         ok &= mantissa < _EXACT
@@ -297,7 +297,7 @@ def parse_ints(buf, starts, ends):
     digits &= _KEEP_LO[length]
     ok = _not_digits(digits) == 0
     ok &= length <= 8
-    values = _eight_digits(digits).view(np.int64)
+    values = eight_digits(digits).view(np.int64)
     if ok.all():
         return values, np.zeros(0, dtype=np.int64)
     rest = np.flatnonzero(~ok)

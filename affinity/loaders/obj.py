@@ -1,6 +1,15 @@
 """Wavefront OBJ reader, vectorized over lines and corners.
 
-Each chunk of lines is tokenized once at whitespace and '/'. Lines are
+A chunk whose lines fall into a few groups laid out alike (every line of a
+group the same bytes as the group's first line but for its digits: same
+keyword, signs, points and separators) is read as byte columns
+(:mod:`affinity.loaders.columns`): no tokens, each number read at offsets fixed
+for its group. That is the common exported file (``%.6f`` coordinates,
+``v/vt/vn`` faces). Any other chunk, and any chunk holding a line the column
+path does not take (statements, trailing comments, exponents, colours, index 0, ...),
+goes to the token reader below, which also names the line of every error.
+
+Otherwise each chunk of lines is tokenized once at whitespace and '/'. Lines are
 classified by their keyword token (``v``, ``vt``, ``vn``, ``f``); the numbers of
 all lines of one kind are parsed in one call and reshaped by their per-line
 counts. A face token's role in its corner (``v``, ``vt`` or ``vn`` slot) follows
@@ -35,6 +44,7 @@ import numpy as np
 
 from ..errors import MeshError
 from ..mesh import Mesh
+from .columns import Group, alike_groups
 from .faces import check_indices, color_note, ragged_positions
 from .numbers import PAD, parse_floats, parse_ints
 from .resources import obj_resources, uncommented
@@ -108,6 +118,9 @@ def load_obj(path, chunk_bytes: int | None = None, source: bytes | None = None) 
 
 
 def _parse_chunk(chunk, path) -> _Part:
+    part = _alike_part(chunk)
+    if part is not None:
+        return part
     tokens = tokenize(chunk, path, slash=True)
     counts = tokens.counts
     kind = _line_kinds(tokens, counts)
@@ -139,6 +152,172 @@ def _parse_chunk(chunk, path) -> _Part:
         for line in statements:
             _statement(tokens, path, line, int(faces_before[line]), part)
     return part
+
+
+#: Layouts a chunk may hold and still be read as groups of lines laid out alike.
+_ALIKE_LIMIT = 32
+_TEXT_LINE = re.compile(rb"[\t -~]*\r?\n")
+_OBJ_TOKEN = re.compile(rb"[^ \t\r\n/]+")
+_DECIMAL = re.compile(rb"([-+]?)(\d+)(?:\.(\d+))?")
+_KINDS = {b"v": _V, b"vt": _VT, b"vn": _VN, b"f": _F}
+#: Numbers per line the column reader takes (colours and ``w`` go to the token reader).
+_ALIKE_WIDTHS = {_V: (3,), _VT: (1, 2, 3), _VN: (3,)}
+#: Corner forms as the slots present: v, v/vt, v//vn, v/vt/vn.
+_FORMS = {1: (0,), 2: (0, 1), 3: (0, 1, 2)}
+
+
+@dataclass
+class _Layout:
+    """How to read the lines of one :class:`~affinity.loaders.columns.Group`.
+
+    ``spans`` are runs of at most 8 bytes holding digits (and, at ``dots``, a
+    decimal point). For ``v``/``vt``/``vn`` lines number ``t`` is run ``last[t]``
+    plus ``weight`` times run ``s`` for each ``(s, t, weight)`` of ``extra`` (the
+    runs before it, when it is longer than 8 bytes), over ``divisor[t]`` (which
+    carries the sign); for faces every run is one index, of slot ``slots[t]``.
+    """
+
+    kind: int
+    spans: list
+    dots: list | None = None
+    last: list | None = None
+    extra: list | None = None
+    divisor: np.ndarray | None = None  # (T,) float64
+    slots: tuple = ()
+    size: int = 0  # corners of a face
+
+
+def _line_layout(first: bytes) -> _Layout | None:
+    """The :class:`_Layout` of lines laid out like ``first`` (kind 0: a blank or comment line),
+    None when the token reader must read them (statements, trailing comments, exponents,
+    colours, ...)."""
+    if not _TEXT_LINE.fullmatch(first):
+        return None
+    tokens = list(_OBJ_TOKEN.finditer(first))
+    if not tokens or tokens[0].group().startswith(b"#"):  # blank, or a comment line
+        return _Layout(0, [])
+    kind = _KINDS.get(tokens[0].group())
+    if kind == _F:
+        return _face_layout_of(first, tokens[1:])
+    if kind is None or b"/" in first or len(tokens) - 1 not in _ALIKE_WIDTHS[kind]:
+        return None
+    layout = _Layout(kind, [], dots=[], last=[], extra=[])
+    divisor = []
+    for token in tokens[1:]:
+        number = _DECIMAL.fullmatch(token.group())
+        if number is None or len(number.group(2) + (number.group(3) or b"")) > 15:  # > 2**53: not exact
+            return None
+        start, end = token.start() + len(number.group(1)), token.end()
+        dot = token.start() + number.start(3) - 1 if number.group(3) else -1
+        after = 0  # digits after the run
+        for run_end in range(end, start, -8):
+            run_start = max(start, run_end - 8)
+            if after:
+                layout.extra.append((len(layout.spans), len(divisor), 10.0**after))
+            else:
+                layout.last.append(len(layout.spans))
+            layout.spans.append((run_start, run_end))
+            layout.dots.append(dot if run_start <= dot < run_end else -1)
+            after += run_end - run_start - (run_start <= dot < run_end)
+        sign = -1.0 if number.group(1) == b"-" else 1.0
+        divisor.append(sign * 10.0 ** len(number.group(3) or b""))
+    layout.divisor = np.array(divisor)
+    return layout
+
+
+def _face_layout_of(first: bytes, tokens) -> _Layout | None:
+    """The :class:`_Layout` of ``f`` lines like ``first`` (``tokens``: its indices), or None."""
+    corners = first.split()[1:]
+    forms = set()
+    for corner in corners:
+        parts = corner.split(b"/")
+        if len(parts) > 3 or not all(parts[:1] + parts[2:]) or (len(parts) == 2 and not parts[1]):
+            return None
+        forms.add(tuple(k for k, part in enumerate(parts) if part))
+    if len(forms) != 1 or len(corners) < 3:
+        return None
+    slots = forms.pop()
+    if any(len(token.group()) > 8 or not token.group().isdigit() for token in tokens):
+        return None
+    return _Layout(_F, [token.span() for token in tokens], slots=slots * len(corners), size=len(corners))
+
+
+def _alike_part(chunk) -> _Part | None:
+    """The chunk read as groups of lines laid out alike (:mod:`affinity.loaders.columns`),
+    or None when some line needs the token reader (which then finds any error)."""
+    if len(chunk.joined):
+        return None
+    buf = chunk.buf
+    end = np.flatnonzero(buf == ord("\n"))
+    begin = np.empty_like(end)
+    begin[:1] = PAD
+    np.add(end[:-1], 1, out=begin[1:])
+    groups = alike_groups(buf, begin, end, _ALIKE_LIMIT)
+    if groups is None:
+        return None
+    layouts = [_line_layout(group.first) for group in groups]
+    if None in layouts:
+        return None
+    kind = np.zeros(len(end), np.int8)
+    for group, layout in zip(groups, layouts):
+        kind[group.rows] = layout.kind
+    elements = {}
+    for which in _WIDTHS:
+        own = [(g, layout) for g, layout in zip(groups, layouts) if layout.kind == which]
+        if len({len(layout.divisor) for _, layout in own}) > 1:
+            return None
+        blocks = [(g.rows, _alike_numbers(g, layout)) for g, layout in own]
+        # (n, T) rows in memory order here on the worker: the reading thread's append is then a plain copy
+        elements[which] = np.ascontiguousarray(_in_file_order(kind, which, blocks, (0, _WIDTHS[which][0]), np.float64))
+    faces = [(g, layout) for g, layout in zip(groups, layouts) if layout.kind == _F]
+    if len({layout.slots for _, layout in faces}) > 1:
+        return None
+    corners, bounds = [None] * 3, [None] * 3
+    if faces:
+        layout = faces[0][1]
+        blocks = [(g.rows, g.numbers(own.spans).view(np.int64).T) for g, own in faces]
+        indices = _in_file_order(kind, _F, blocks, (0, len(layout.slots)), np.int64)
+        if not indices.all():  # index 0: the token reader says where
+            return None
+        slots = np.array(layout.slots)
+        for which in set(layout.slots):
+            picked = indices[:, slots == which].reshape(-1) - 1
+            corners[which], bounds[which] = picked, (int(picked.min()), int(picked.max()))
+    return _Part(
+        elements=elements,
+        face_sizes=faces[0][1].size if faces else 0,
+        face_line=np.flatnonzero(kind == _F) + 1,
+        corners=corners,
+        relative=[None] * 3,
+        bounds=bounds,
+        lines=len(end),
+        bytes=len(buf) - 2 * PAD,
+    )
+
+
+def _alike_numbers(group: Group, layout: _Layout) -> np.ndarray:
+    """(n, T) float64 numbers of a group of ``v``/``vt``/``vn`` lines."""
+    runs = group.numbers(layout.spans, layout.dots).view(np.int64).astype(np.float64)
+    values = runs if len(layout.last) == len(layout.spans) else runs[layout.last]
+    for run, column, weight in layout.extra:  # exact: integers below 2**53
+        values[column] += runs[run] * weight
+    values /= layout.divisor[:, None]
+    return values.T
+
+
+def _in_file_order(kind, which, blocks, empty_shape, dtype) -> np.ndarray:
+    """The rows of the ``which`` lines, from ``blocks`` of (line indices, (n, T) values), in file order."""
+    if len(blocks) == 1:
+        return blocks[0][1]
+    if not blocks:
+        return np.zeros(empty_shape, dtype)
+    rank = np.cumsum(kind == which) - 1
+    out = np.empty((blocks[0][1].shape[1], int(rank[-1]) + 1), dtype)  # (T, n): along the lines
+    for rows, values in blocks:
+        at = rank[rows]
+        for column, numbers in zip(out, values.T):  # 1-D scatters: several times faster than one 2-D
+            column[at] = numbers
+    return out.T
 
 
 def _line_kinds(tokens: Tokens, counts) -> np.ndarray:

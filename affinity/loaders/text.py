@@ -42,6 +42,7 @@ class Chunk:
     def find(self, byte: bytes) -> int:
         """Offset of the first ``byte`` in ``buf`` (-1: none), at C speed."""
         base = self.buf.base
+        base = base.obj if isinstance(base, memoryview) else base  # NumPy 2 keeps a memoryview of it
         if isinstance(base, bytearray):
             return base.find(byte, 0, len(self.buf))
         hits = np.flatnonzero(self.buf == byte[0])
