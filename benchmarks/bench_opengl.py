@@ -35,6 +35,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT / "tests"), str(ROOT / "benchmarks")]
 
 from bench_render import SCENES, clip_space, hybrid_methods, uv_sphere  # noqa: E402
+from common import write_table  # noqa: E402
 from helpers.opengl_reference import OpenGLQuads, create_context  # noqa: E402
 
 from affinity.commands.allocator import keep_freed_memory  # noqa: E402
@@ -160,10 +161,8 @@ def main(argv=None) -> int:
     hybrid = hybrid_rows(clip, uv, pole_rank, size, frames)
     load = f"{os.getloadavg()[0]:.1f}"
     table = markdown(rows, hybrid, size, frames, clip.shape[0], renderer, load)
-    args.out.mkdir(parents=True, exist_ok=True)
-    (args.out / "bench_opengl.md").write_text(table)
+    write_table(table.splitlines(), args.out, "bench_opengl.md")
     (args.out / "bench_opengl.json").write_text(json.dumps({"rows": rows, "hybrid": hybrid}, indent=1) + "\n")
-    print(table, end="")
     disagreeing = [f"{r['method']} ({'culled' if r['culling'] else 'drawn'})" for r in rows if not r["agrees"]]
     if disagreeing:
         print("frames disagree: " + ", ".join(disagreeing), file=sys.stderr)

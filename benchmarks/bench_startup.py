@@ -25,7 +25,8 @@ import tempfile
 import time
 from pathlib import Path
 
-OUT = Path(__file__).resolve().parents[1] / "reports" / "bench"
+from common import OUT, write_table
+
 
 def affinity_command() -> list[str]:
     """The installed ``affinity`` console script beside this interpreter, else ``python -m affinity.cli``."""
@@ -105,9 +106,7 @@ def main() -> None:
         times = timings(commands, runs, env)
     table = comparison(times, "check / import numpy", "; bytecode cached as after `pip install`",
                        "Goal (issue 28): at most 1.5x, median.")
-    args.out.mkdir(parents=True, exist_ok=True)
-    (args.out / "bench_startup.md").write_text(table)
-    print(table, end="")
+    write_table(table.splitlines(), args.out, "bench_startup.md")
 
 
 if __name__ == "__main__":

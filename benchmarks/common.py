@@ -1,12 +1,17 @@
-"""What the benchmark scripts share: the ``--small``/``--out`` options and writing a table to ``reports/bench``."""
+"""What the benchmark scripts share: the ``--small``/``--out`` options and writing a table to ``reports/bench``
+(and into the README's and docs' copies of it)."""
 
 from __future__ import annotations
 
 import argparse
+import re
 from pathlib import Path
 
+ROOT = Path(__file__).resolve().parents[1]
 #: Where every benchmark writes its table (``reports/bench/<script>.md``).
-OUT = Path(__file__).resolve().parents[1] / "reports" / "bench"
+OUT = ROOT / "reports" / "bench"
+#: The pages that quote tables between ``<!-- generated: benchmarks/<script>.py -->`` and ``<!-- end generated -->``.
+PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
 
 
 def parse_with_output(parser: argparse.ArgumentParser, small: str, out: str, argv=None) -> argparse.Namespace:
@@ -18,9 +23,26 @@ def parse_with_output(parser: argparse.ArgumentParser, small: str, out: str, arg
 
 
 def write_table(lines: list[str], folder: Path, name: str) -> str:
-    """Write ``lines`` as ``folder/name`` (folder made when missing) and print them; return the text."""
+    """Write ``lines`` as ``folder/name`` (folder made when missing) and print them; return the text.
+
+    Written to :data:`OUT`, the table also replaces its quoted copies in :data:`PAGES` (a test checks that
+    they are equal).
+    """
     table = "\n".join(lines) + "\n"
     folder.mkdir(parents=True, exist_ok=True)
     (folder / name).write_text(table)
+    if folder.resolve() == OUT.resolve():
+        quote(Path(name).stem, table)
     print(table, end="")
     return table
+
+
+def quote(stem: str, table: str) -> None:
+    """Put ``table`` into every generated block of ``benchmarks/<stem>.py`` in :data:`PAGES`."""
+    block = re.compile(rf"(^<!-- generated: benchmarks/{re.escape(stem)}\.py -->\n).*?(^<!-- end generated -->$)",
+                       re.S | re.M)
+    for page in PAGES:
+        text = page.read_text()
+        updated = block.sub(lambda match: match[1] + table + match[2], text)
+        if updated != text:
+            page.write_text(updated)
