@@ -22,4 +22,4 @@ imported by the functions that use them.
 #: without importing the builder.
 RENDER_SIZE = (480, 360)
 MAX_VIEWS = 6
-PLACE_FACES = 64
+PLACE_FACES = 24
