@@ -180,11 +180,9 @@ def squared_lengths(v: np.ndarray) -> np.ndarray:
 
 
 def dot_by_component(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """(D, ...), (D, ...) vectors laid out by component -> (...) float64 dot products."""
-    total = a[0] * b[0]
-    for u, v in zip(a[1:], b[1:]):
-        total += u * v
-    return total
+    """(D, ...), (D, ...) vectors laid out by component -> (...) float64 dot products
+    (broadcast against each other)."""
+    return np.einsum("d...,d...->...", a, b)
 
 
 def cross_by_component(a: np.ndarray, b: np.ndarray) -> np.ndarray:

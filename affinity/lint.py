@@ -20,7 +20,7 @@ import numpy as np
 
 from .attributes import ATTRIBUTES, attribute_named, scoring_rules
 from .findings import RuleHits
-from .geometry import PlanarQuads, planar_quads_by_component
+from .geometry import PlanarQuads, planar_quads_by_component, squared_lengths
 from .loaders.imagesize import image_size
 from .measures import split_error_by_component, split_scale
 from .mesh import Mesh
@@ -44,27 +44,22 @@ class CornerTables:
         self.has_nan: dict[str, bool] = {}
 
     def prepare(self, name: str) -> None:
-        """Look table ``name`` over once (NaN rows mark missing values) and scale normals to unit
-        length (zero ones kept) before the batches share it."""
+        """Look table ``name`` over once (NaN rows mark missing values) before the batches share it."""
         if name in self.tables:
             return
         values = getattr(self.mesh, name)
         if values is None or len(values) == 0 or self.corner_index[name] is None:
             self.tables[name] = None
             return
-        table = np.asarray(values, dtype=np.float64)
-        self.has_nan[name] = name != "positions" and bool(np.isnan(table).any())
-        if name in ATTRIBUTES and ATTRIBUTES[name].unit_length:  # once a value, not once a corner
-            length = np.sqrt(np.einsum("vd,vd->v", table, table))[:, None]
-            table = np.divide(table, length, out=np.array(table), where=length > 0)
-        self.tables[name] = table
+        self.tables[name] = np.asarray(values, dtype=np.float64)
+        self.has_nan[name] = name != "positions" and bool(np.isnan(self.tables[name]).any())
 
     def gather(self, name: str, corners: np.ndarray,
                complete: bool = True) -> tuple[np.ndarray | slice, np.ndarray] | None:
         """Attribute ``name`` at the (4, Q) corners: ``rows`` of the quads that have
         it at all four corners (a slice when all do, or without ``complete``) and
-        their values laid out by component, (D, 4, n); normals of unit
-        length (see :meth:`prepare`). None when the mesh has no such attribute."""
+        their values laid out by component, (D, 4, n); normals scaled to unit
+        length (zero ones kept). None when the mesh has no such attribute."""
         table = self.tables[name]
         if table is None:
             return None
@@ -72,6 +67,10 @@ class CornerTables:
         missing = index < 0
         np.maximum(index, 0, out=index)
         values = np.ascontiguousarray(np.transpose(table.take(index, axis=0), (2, 0, 1)))
+        if name in ATTRIBUTES and ATTRIBUTES[name].unit_length:
+            length = np.sqrt(squared_lengths(values))
+            length[length == 0] = 1.0  # zero normals are kept as they are
+            values /= length
         if complete and (self.has_nan[name] or missing.any()):
             has_all = ~(missing.any(axis=0) | np.isnan(values).any(axis=(0, 1)))
             if not has_all.all():

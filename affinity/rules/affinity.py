@@ -133,7 +133,7 @@ def normal_disaffinity(quads) -> tuple:
         relax the loop), or triangulate before baking normals so the split diagonal
         is fixed.
     """
-    rows, unit = quads.complete("normals")  # unit length already (see affinity.lint.CornerTables.prepare)
+    rows, unit = quads.complete("normals")  # unit length already (see affinity.lint.CornerTables.gather)
     m = quads.split_error(rows, unit)
     # The angle atan2(|m|, |mean normal|) exceeds the threshold only where
     # |m| > tan(threshold) |mean normal|: the arctangent is taken for those only.
