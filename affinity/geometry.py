@@ -413,7 +413,7 @@ def is_bowtie(quads: PlanarQuads) -> np.ndarray:
     -------
     (Q,) bool
     """
-    return quads.reflex.sum(axis=1) == 2
+    return quads.reflex.sum(axis=1, dtype=np.int8) == 2  # int8: a sum of 4 flags, without an int64 cast
 
 
 def folded_fraction(quads: PlanarQuads) -> np.ndarray:
