@@ -72,6 +72,8 @@ def by_component(corners: np.ndarray) -> np.ndarray:
 
 # Corner-major helpers: ``p`` is (4, Q, D), p[k] the k-th corner of every quad.
 _NEXT, _PREVIOUS = [1, 2, 3, 0], [3, 0, 1, 2]
+#: C_{k-2}, the corner turn at corner k, for k = 0..3 (component-major; see :func:`_opposite_areas`).
+_CORNER_TURN_AT = [2, 3, 0, 1]
 
 
 def _diagonals_parallel(n: np.ndarray, d02: np.ndarray, d13: np.ndarray) -> np.ndarray:
@@ -163,10 +165,12 @@ def plane_coordinates(corners: np.ndarray) -> np.ndarray:
 
 
 def _edges(p: np.ndarray) -> np.ndarray:
-    """(D, 4, Q) edge vectors e_k = p_{k+1} - p_k."""
-    e = np.empty_like(p)
-    np.subtract(p[:, 1:], p[:, :-1], out=e[:, :-1])
-    np.subtract(p[:, 0], p[:, -1], out=e[:, -1])
+    """(D, 6, Q) edge vectors e_k = p_{k+1} - p_k at [:, k], k = 0..5 (indices mod 4): the
+    four edges followed by e_0, e_1 again, so that every run of consecutive edges is a slice."""
+    e = np.empty((p.shape[0], 6, p.shape[2]))
+    np.subtract(p[:, 1:], p[:, :-1], out=e[:, :3])
+    np.subtract(p[:, 0], p[:, -1], out=e[:, 3])
+    e[:, 4:] = e[:, :2]
     return e
 
 
@@ -176,11 +180,9 @@ def squared_lengths(v: np.ndarray) -> np.ndarray:
 
 
 def dot_by_component(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """(D, ...), (D, ...) vectors laid out by component -> (...) float64 dot products."""
-    total = a[0] * b[0]
-    for u, v in zip(a[1:], b[1:]):
-        total += u * v
-    return total
+    """(D, ...), (D, ...) vectors laid out by component -> (...) float64 dot products
+    (broadcast against each other)."""
+    return np.einsum("d...,d...->...", a, b)
 
 
 def cross_by_component(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -194,14 +196,16 @@ def cross_by_component(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return out
 
 
-def _corner_turns(e: np.ndarray) -> np.ndarray:
-    """(D, 4, Q) edges -> c_k = e_k x e_{k+1}: (3, 4, Q) vectors for D = 3, (4, Q)
-    z components for D = 2. c_k is the corner normal at corner k + 1, and the
-    triangle opposite corner i has the doubled vector area c_{i+1}."""
-    following = np.roll(e, -1, axis=1)
+def _opposite_areas(e: np.ndarray) -> np.ndarray:
+    """(D, 6, Q) edges (see :func:`_edges`) -> C_i = e_{i+1} x e_{i+2}, the doubled vector
+    area of the triangle opposite corner i (the corner turn at corner i + 2): (3, 4, Q)
+    vectors for D = 3, (4, Q) z components for D = 2."""
+    following, after = e[:, 1:5], e[:, 2:6]
     if len(e) == 2:
-        return e[0] * following[1] - e[1] * following[0]
-    return cross_by_component(e, following)
+        C = following[0] * after[1]
+        C -= following[1] * after[0]
+        return C
+    return cross_by_component(following, after)
 
 
 @dataclass(frozen=True)
@@ -225,6 +229,9 @@ class PlanarQuads:
     normals : (3, Q) float64 or None
         The quad normals d02 x d13 of 3-D corners (before the stand-in for
         parallel diagonals, see :func:`quad_normals`); None for 2-D corners.
+    vector_areas : (3, 4, Q) float64 or None
+        C_i = e_{i+1} x e_{i+2}, the doubled vector area of the triangle opposite
+        corner i, of 3-D corners (so T_i = C_i . n / |n|); None for 2-D corners.
     """
 
     areas: np.ndarray
@@ -232,6 +239,7 @@ class PlanarQuads:
     diagonals: np.ndarray
     components: np.ndarray
     normals: np.ndarray | None = None
+    vector_areas: np.ndarray | None = None
 
     @cached_property
     def xy(self) -> np.ndarray:
@@ -253,10 +261,15 @@ class PlanarQuads:
         return np.maximum(2 * DEGENERATE_AREA * self.size**2, self.rounding)
 
     @cached_property
+    def reflex(self) -> np.ndarray:
+        """(Q, 4) bool: corner turns T_i that go clockwise, beyond the degenerate :attr:`tolerance`."""
+        return self.areas < -self.tolerance[:, None]
+
+    @cached_property
     def rounding(self) -> np.ndarray:
         """(Q,) float64: doubled areas within rounding of zero for corners of this
         magnitude, ``ROUNDING_AREA`` eps max_k |p_k| times the longest edge."""
-        magnitude = np.abs(self.components).max(axis=(0, 1))
+        magnitude = np.maximum(self.components.max(axis=(0, 1)), -self.components.min(axis=(0, 1)))
         return (ROUNDING_AREA * np.finfo(np.float64).eps) * magnitude * self.size
 
     def take(self, rows) -> PlanarQuads:
@@ -264,8 +277,9 @@ class PlanarQuads:
         if isinstance(rows, slice) and rows == slice(None):
             return self
         normals = None if self.normals is None else self.normals[:, rows]
+        vector_areas = None if self.vector_areas is None else self.vector_areas[:, :, rows]
         return PlanarQuads(self.areas.T[:, rows].T, self.size[rows], self.diagonals[rows], self.components[:, :, rows],
-                           normals)
+                           normals, vector_areas)
 
     def __len__(self) -> int:
         return len(self.size)
@@ -290,31 +304,29 @@ def planar_quads_by_component(p: np.ndarray) -> PlanarQuads:
     p : (D, 4, Q) float64, D = 3 or 2 (see :func:`by_component`)
     """
     e = _edges(p)
-    size = np.sqrt(squared_lengths(e).max(axis=0))
-    turns = _corner_turns(e)
+    size = np.sqrt(squared_lengths(e[:, :4]).max(axis=0))
+    C = _opposite_areas(e)
     d02, d13 = e[:, 0] + e[:, 1], e[:, 1] + e[:, 2]
-    diagonals = np.sqrt(np.stack([squared_lengths(d02), squared_lengths(d13)])).T
-    normals = None
+    diagonals = np.empty((len(size), 2))
+    diagonals[:, 0], diagonals[:, 1] = squared_lengths(d02), squared_lengths(d13)
+    np.sqrt(diagonals, out=diagonals)
     if len(p) == 2:
-        areas = turns
-    else:
-        # d02 x d13 = c_0 + c_2: the sum of opposite corner turns is twice the vector area.
-        normals = turns[:, 0] + turns[:, 2]
-        normal_length = np.sqrt(squared_lengths(normals))
-        unit = normals.copy()
-        parallel = normal_length <= DEGENERATE_AREA * diagonals[:, 0] * diagonals[:, 1]
-        if parallel.any():  # the largest corner normal stands in (see quad_normals)
-            corner = turns[:, _PREVIOUS][:, :, parallel]  # the normal at corner k is c_{k-1}
-            largest = squared_lengths(corner).argmax(axis=0)
-            unit[:, parallel] = corner[:, largest, np.arange(corner.shape[2])]
-            normal_length[parallel] = np.sqrt(squared_lengths(unit[:, parallel]))
-        np.divide(unit, normal_length, out=unit, where=normal_length > 0)
-        areas = turns[0] * unit[0]
-        areas += turns[1] * unit[1]
-        areas += turns[2] * unit[2]
-    # The triangle opposite corner i has the vector area c_{i+1}.
-    areas = np.roll(areas, -1, axis=0)
-    return PlanarQuads(areas.T, size, diagonals, p, normals)
+        return PlanarQuads(C.T, size, diagonals, p)
+    # d02 x d13 = c_0 + c_2 (c_k = C_{k-1} the corner turns): twice the vector area.
+    normals = C[:, 3] + C[:, 1]
+    normal_length = np.sqrt(squared_lengths(normals))
+    # T_i = C_i . n / |n|; a zero normal (all corners collinear) leaves T_i = C_i . n = 0.
+    areas = dot_by_component(C, normals[:, None])
+    np.divide(areas, normal_length, out=areas, where=normal_length > 0)
+    parallel = np.flatnonzero(normal_length <= DEGENERATE_AREA * diagonals[:, 0] * diagonals[:, 1])
+    if len(parallel):  # the largest corner normal stands in (see quad_normals)
+        corner = C[:, _CORNER_TURN_AT][:, :, parallel]  # the normal at corner k is C_{k-2}
+        largest = squared_lengths(corner).argmax(axis=0)
+        unit = corner[:, largest, np.arange(len(parallel))]
+        length = np.sqrt(squared_lengths(unit))
+        np.divide(unit, length, out=unit, where=length > 0)
+        areas[:, parallel] = dot_by_component(C[:, :, parallel], unit[:, None])
+    return PlanarQuads(areas.T, size, diagonals, p, normals, C)
 
 
 def _relative(area: np.ndarray, size: np.ndarray) -> np.ndarray:
@@ -390,11 +402,6 @@ def nonplanarity(corners: np.ndarray) -> np.ndarray:
     return np.divide(distance, denominator, out=np.zeros_like(distance), where=~parallel)
 
 
-def _reflex(quads: PlanarQuads) -> np.ndarray:
-    """(Q, 4) bool: corner turns that go clockwise, beyond the degenerate tolerance."""
-    return quads.areas < -quads.tolerance[:, None]
-
-
 def is_bowtie(quads: PlanarQuads) -> np.ndarray:
     """Quads that cross themselves in their own plane.
 
@@ -406,7 +413,7 @@ def is_bowtie(quads: PlanarQuads) -> np.ndarray:
     -------
     (Q,) bool
     """
-    return _reflex(quads).sum(axis=1) == 2
+    return quads.reflex.sum(axis=1, dtype=np.int8) == 2  # int8: a sum of 4 flags, without an int64 cast
 
 
 def folded_fraction(quads: PlanarQuads) -> np.ndarray:
@@ -419,7 +426,7 @@ def folded_fraction(quads: PlanarQuads) -> np.ndarray:
     (Q,) float64
     """
     magnitude = np.abs(quads.areas)
-    folded = np.where(_reflex(quads), magnitude, 0).sum(axis=1)
+    folded = np.where(quads.reflex, magnitude, 0).sum(axis=1)
     total = magnitude.sum(axis=1)
     return np.divide(folded, total, out=np.zeros_like(total), where=total > 0)
 

@@ -69,7 +69,8 @@ class CornerTables:
         values = np.ascontiguousarray(np.transpose(table.take(index, axis=0), (2, 0, 1)))
         if name in ATTRIBUTES and ATTRIBUTES[name].unit_length:
             length = np.sqrt(squared_lengths(values))
-            np.divide(values, length, out=values, where=length > 0)
+            length[length == 0] = 1.0  # zero normals are kept as they are
+            values /= length
         if complete and (self.has_nan[name] or missing.any()):
             has_all = ~(missing.any(axis=0) | np.isnan(values).any(axis=(0, 1)))
             if not has_all.all():

@@ -218,7 +218,7 @@ def split_error_by_component(quads: PlanarQuads, attrs: np.ndarray, diagonal: st
 def _cap_at_extent(quads: PlanarQuads, attrs: np.ndarray, E: np.ndarray) -> None:
     """Scale E (K, Q) down, in place, to the attribute's corner extent on quads with a
     reflex corner (concave, bow-tie), where the closed form is only an upper bound."""
-    folded = np.flatnonzero((quads.areas < -quads.tolerance[:, None]).any(axis=1))
+    folded = np.flatnonzero(quads.reflex.any(axis=1))
     if len(folded) == 0:
         return
     a = attrs[:, :, folded]

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..geometry import squared_lengths
 from ..measures import barycentric_score, color_steps, normal_degrees, texels
 from .registry import rule
 
@@ -140,9 +141,8 @@ def normal_disaffinity(quads) -> tuple:
     threshold = quads.settings.threshold("Q103")
     picked = slice(None)
     if 0 <= threshold < 89:  # a negative threshold (every value wanted) picks every quad
-        m_length = np.sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2])
-        mean = unit.sum(axis=1)
-        mean_length = np.sqrt(mean[0] * mean[0] + mean[1] * mean[1] + mean[2] * mean[2]) / 4
+        m_length = np.sqrt(squared_lengths(m))
+        mean_length = np.sqrt(squared_lengths(unit.sum(axis=1))) / 4
         picked = np.flatnonzero(m_length >= mean_length * (np.tan(np.radians(threshold)) * (1 - 1e-9)))
     rows = np.arange(len(quads))[rows][picked]
     degrees = normal_degrees(m.T[picked], np.transpose(unit, (2, 1, 0))[picked])

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..geometry import (
+    PlanarQuads,
     cross_by_component,
     degeneracy,
     dot_by_component,
@@ -50,43 +51,43 @@ def degenerate(quads) -> tuple:
     return slice(None), degeneracy(quads.planar)
 
 
-def _fold(p: np.ndarray, normal: np.ndarray, a: int, b: int, c: int, d: int) -> np.ndarray:
-    """(Q,) float64 degrees between the normals of triangles (a, b, c) and (a, c, d):
-    the fold along the diagonal a-c of corners ``p`` (3, 4, Q).
+def _fold(C: np.ndarray, sides: np.ndarray, a: int, b: int) -> np.ndarray:
+    """(Q,) float64 degrees between the normals C_a, C_b (3, Q) of two triangles of a split,
+    each taken on the side of the quad's normal: ``sides`` (4, Q) holds sign(C_i . n).
 
-    Each triangle's normal is taken on the side of the quad's ``normal`` (3, Q)
-    (d02 x d13), so a flat concave or self-crossing quad, whose wrong split
-    overlaps itself, folds nothing (that is Q203's and Q204's). A triangle without
-    area has no normal and folds nothing either: that quad is Q201's.
+    On the quad normal's side (n = d02 x d13) a flat concave or self-crossing quad, whose
+    wrong split overlaps itself, folds nothing (that is Q203's and Q204's). A triangle
+    without area has no normal and folds nothing either: that quad is Q201's.
     """
-    e1, e2, e3 = p[:, b] - p[:, a], p[:, c] - p[:, a], p[:, d] - p[:, a]
-    n1, n2 = cross_by_component(e1, e2), cross_by_component(e2, e3)
-    n1 *= np.sign(dot_by_component(n1, normal))
-    n2 *= np.sign(dot_by_component(n2, normal))
-    sine = np.sqrt(squared_lengths(cross_by_component(n1, n2)))
-    cosine = dot_by_component(n1, n2) + 0.0  # a zeroed normal gives -0: atan2(0, -0) would be 180
+    side = sides[a] * sides[b]  # the angle between s_a C_a and s_b C_b, s = +-1 or 0
+    sine = np.sqrt(squared_lengths(cross_by_component(C[:, a], C[:, b])))
+    sine *= np.abs(side)
+    cosine = dot_by_component(C[:, a], C[:, b])
+    cosine *= side
+    cosine += 0.0  # a zeroed normal gives -0: atan2(0, -0) would be 180
     return np.degrees(np.arctan2(sine, cosine))
 
 
-def fold_degrees(p: np.ndarray, diagonal: str, diagonals: np.ndarray | None = None) -> np.ndarray:
-    """(Q,) float64 fold angle in degrees of quads with corners ``p`` (3, 4, Q) float64.
+def fold_degrees(quads: PlanarQuads, diagonal: str) -> np.ndarray:
+    """(Q,) float64 fold angle in degrees of 3-D quads (PlanarQuads of Q quads).
 
     The angle between the normals of the two triangles of the split along 0-2
-    (triangles 012 and 023) or 1-3 (123 and 130), as the dihedral angle of the
-    split surface: 0 for a planar quad (see :func:`_fold`), atan2(|n1 x n2|, n1 . n2).
-    ``diagonal`` is the setting: ``"02"``, ``"13"``, ``"both"`` (the worse of the
-    two) or ``"shortest"`` (the diagonal shorter in 3-D; ``diagonals`` (Q, 2)
-    holds the lengths of 0-2 and 1-3).
+    (triangles 012 and 023, opposite corners 3 and 1) or 1-3 (123 and 130, opposite
+    corners 0 and 2), as the dihedral angle of the split surface: 0 for a planar
+    quad (see :func:`_fold`), atan2(|n1 x n2|, n1 . n2). ``diagonal`` is the
+    setting: ``"02"``, ``"13"``, ``"both"`` (the worse of the two) or
+    ``"shortest"`` (the diagonal shorter in 3-D).
     """
-    normal = cross_by_component(p[:, 2] - p[:, 0], p[:, 3] - p[:, 1])
+    C = quads.vector_areas
+    sides = np.sign(dot_by_component(C, quads.normals[:, None]))
     if diagonal == "02":
-        return _fold(p, normal, 0, 1, 2, 3)
+        return _fold(C, sides, 3, 1)
     if diagonal == "13":
-        return _fold(p, normal, 1, 2, 3, 0)
-    fold02, fold13 = _fold(p, normal, 0, 1, 2, 3), _fold(p, normal, 1, 2, 3, 0)
+        return _fold(C, sides, 0, 2)
+    fold02, fold13 = _fold(C, sides, 3, 1), _fold(C, sides, 0, 2)
     if diagonal == "shortest":
-        return np.where(diagonals[:, 0] <= diagonals[:, 1], fold02, fold13)
-    return np.maximum(fold02, fold13)
+        return np.where(quads.diagonals[:, 0] <= quads.diagonals[:, 1], fold02, fold13)
+    return np.maximum(fold02, fold13, out=fold02)
 
 
 @rule(code="Q202", name="nonplanar-quad", unit="degrees", default_threshold=45.0, references=REFERENCES)
@@ -122,8 +123,7 @@ def nonplanar(quads) -> tuple:
         Flatten the quad (Blender: Mesh > Clean Up > Make Planar Faces), subdivide
         it, or triangulate it along the intended diagonal.
     """
-    planar = quads.planar
-    return slice(None), fold_degrees(planar.components, quads.settings.diagonal, planar.diagonals)
+    return slice(None), fold_degrees(quads.planar, quads.settings.diagonal)
 
 
 @rule(code="Q203", name="concave-quad", level="info", unit="degrees", default_threshold=180.0, references=REFERENCES)
