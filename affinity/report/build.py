@@ -13,6 +13,7 @@ import functools
 import os
 import threading
 import time
+from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -324,8 +325,7 @@ def collect_run(items: list[MeshInput], settings_for: Callable[[str], Settings],
         progress.set_description(os.path.basename(item.path), refresh=False)
         meshes.append(collect_mesh(item, settings_for(item.path), progress.set_postfix_str, options))
         progress.update()
-    parts = {"start-up": collecting - start}
+    parts = Counter({"start-up": collecting - start})
     for result in meshes:
-        for part, seconds in result.parts.items():
-            parts[part] = parts.get(part, 0.0) + seconds
-    return ReportRun(meshes, settings, started, time.perf_counter() - collecting, demo, start, parts)
+        parts.update(result.parts)  # adds the seconds of each part
+    return ReportRun(meshes, settings, started, time.perf_counter() - collecting, demo, start, dict(parts))

@@ -99,13 +99,17 @@ def gain_for(change: float, reach: float = COLOUR_REACH) -> float:
     return float(max([decade * step for step in GAIN_STEPS if decade * step <= wanted], default=decade))
 
 
-def _largest(change: np.ndarray, same: np.ndarray, place: np.ndarray | None) -> float:
-    """The largest finite ``change`` (S, S, K) on the place's pixels ``place`` (S, S) bool that ``same`` keeps,
-    else on all of ``same``'s."""
+def _amplified(split: np.ndarray, exact: np.ndarray, same: np.ndarray, unit: np.ndarray | float, reach: float,
+               place: np.ndarray | None) -> tuple[np.ndarray, float]:
+    """``exact + gain * (split - exact)`` (S, S, K) where ``same`` (S, S) bool, ``exact`` elsewhere, and the gain:
+    :func:`gain_for` of the largest finite change in ``unit`` (a scalar, or (S, S, K) with NaN where unknown)
+    on the place's pixels ``place`` (S, S) bool that ``same`` keeps (all of ``same``'s when none or None)."""
+    error = np.where(same[..., None], split - exact, 0.0)
     keep = same if place is None or not (same & place).any() else same & place
-    values = change[keep]
-    values = values[np.isfinite(values)]
-    return float(values.max(initial=0.0))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        change = (np.abs(error) / unit)[keep]
+    gain = gain_for(float(change[np.isfinite(change)].max(initial=0.0)), reach)
+    return exact + gain * error, gain
 
 
 def amplified_difference(split: np.ndarray, exact: np.ndarray, same: np.ndarray,
@@ -123,9 +127,8 @@ def amplified_difference(split: np.ndarray, exact: np.ndarray, same: np.ndarray,
     -------
     (S, S, 3) float32 in [0, 1], and the gain (:func:`gain_for` of the largest change on the place).
     """
-    difference = np.where(same[..., None], split - exact, 0.0)
-    gain = gain_for(_largest(np.abs(difference), same, place))
-    return np.clip(exact + gain * difference, 0.0, 1.0).astype(np.float32), gain
+    image, gain = _amplified(split, exact, same, 1.0, COLOUR_REACH, place)
+    return np.clip(image, 0.0, 1.0).astype(np.float32), gain
 
 
 def amplified_uv(split: np.ndarray, exact: np.ndarray, same: np.ndarray, local: np.ndarray,
@@ -144,11 +147,7 @@ def amplified_uv(split: np.ndarray, exact: np.ndarray, same: np.ndarray, local: 
     (S, S, 2) float64 uv (exact where not ``same``), and the gain that brings the place's largest
     displacement, in pixels of the pixel's own footprint, to about ``UV_REACH`` pixels.
     """
-    error = np.where(same[..., None], split - exact, 0.0)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        pixels = np.abs(error) / np.where(local > 0, local, np.nan)
-    gain = gain_for(_largest(pixels, same, place), UV_REACH)
-    return exact + gain * error, gain
+    return _amplified(split, exact, same, np.where(local > 0, local, np.nan), UV_REACH, place)
 
 
 def _map_kd(mesh: Mesh) -> str | None:
@@ -230,15 +229,16 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
         covered = face >= 0
         sub_face = np.where(covered, drawn.faces[np.maximum(face, 0)], -1)
         own = covered & in_place[np.maximum(sub_face, 0)]
+        edge = outline(own)
         if lines:  # at the place's scale: the split's footprint on the place's pixels, for every panel
             footprint = footprint or pixel_footprint(drawn.frame.attrs, own)
             image[covered] = line_colours(drawn.frame.attrs[covered], footprint,
                                           local_footprints(drawn.frame.attrs)[covered], glyphs)
         if method == "split":
-            result.place_pixels, split_own, split_outline = int(own.sum()), own, outline(own)
+            result.place_pixels, split_own, split_outline = int(own.sum()), own, edge
             result.seen = view.drawn[np.bincount(sub_face[covered], minlength=len(view.drawn)) >= SEEN_PIXELS]
         plain[method] = image.copy()
-        image[outline(own)] = OVERLAY_TINT
+        image[edge] = OVERLAY_TINT
         result.images[method] = image
         frames[method] = (drawn.frame, sub_face)
     if show != "shaded" and {"split", "exact"} <= frames.keys():
@@ -256,10 +256,11 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
         else:  # uv: the split's texture moved by gain times its error, drawn as the panels are
             local = local_footprints(exact.attrs)
             uv, gain = amplified_uv(split.attrs, exact.attrs, covered, local, split_own)
-            amplified = plain["exact"].copy()
-            amplified[covered] = (line_colours(uv[covered], footprint, local[covered], glyphs) if lines
-                                  else sample_bilinear(load_image(image_file), uv[covered]))
             what = "its uv error"
+            if gain > 1:
+                amplified = plain["exact"].copy()
+                amplified[covered] = (line_colours(uv[covered], footprint, local[covered], glyphs) if lines
+                                      else sample_bilinear(load_image(image_file), uv[covered]))
         if gain > 1:  # at a gain of 1 the panel would be the split's again
             amplified[split_outline] = OVERLAY_TINT
             result.amplified, result.gain, result.amplified_label = amplified, gain, f"split, {what} ×{gain:g}"

@@ -324,9 +324,9 @@ def face_ranges(faces) -> str:
 
 
 def closeups_section(result: MeshResult) -> Section:
-    """One close-up per flagged place, worst first: split | hybrid | exact with the place outlined, for colours
-    and normals the split's difference from exact amplified (its gain printed), and the split's error against
-    exact with its colour bar."""
+    """One close-up per flagged place, worst first: split | hybrid | exact with the place outlined, where the
+    crease is faint the split with its difference from exact (or its uv error) amplified (the gain printed),
+    and the split's error against exact with its colour bar."""
     title = "Close-ups of the flagged places"
     if not result.places:
         return leave_out("closeups", title, "nothing flagged, so no place to look at")
