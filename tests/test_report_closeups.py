@@ -112,21 +112,31 @@ def test_places_take_turns_between_rules_worst_first():
     assert choose_places(by_rule, 0) == []
 
 
-def test_mirror_twins_are_mirrored_places_with_values_within_a_tenth():
-    """A symmetric model's two halves: positions mirror exactly, an atlas's values only roughly
-    (MakeHuman's lip: 3.467695 and 3.467417 texels; Spot's cheeks: 1.030 and 0.996)."""
-    from affinity.report.places import Place, mirror_twins
+def test_a_place_repeats_its_mirror_twin_and_its_group_s_parts_with_values_within_a_tenth():
+    """A symmetric model's two halves: positions mirror exactly, an atlas's values only roughly (MakeHuman's
+    lip: 3.467695 and 3.467417 texels; Spot's cheeks: 1.030 and 0.996). Parts carved from one group repeat it
+    wherever they lie when their values agree as closely."""
+    from affinity.report.places import Place, repeats
 
-    centroids = np.array([[0.33, 7.2, 1.4], [-0.33, 7.2, 1.4], [-0.33, 7.2, 1.4], [0.5, 2.0, 0.0], [-0.5, 2.1, 0.0]])
+    centroids = np.array([[0.33, 7.2, 1.4], [-0.33, 7.2, 1.4], [-0.33, 7.2, 1.4], [0.5, 2.0, 0.0], [-0.5, 2.1, 0.0],
+                          [4.0, -6.0, 2.0], [4.0, -6.0, 2.0]])
     low, high = np.array([-5.0, -8.0, -1.0]), np.array([5.0, 8.0, 3.0])
-    values = [3.467695, 3.467417, 4.5, 2.0, 2.0]
+    values = [3.467695, 3.467417, 4.5, 2.0, 2.0, 3.3, 3.3]
+    groups = [0, 1, 2, 3, 4, 0, 0]
 
-    def place(face):
-        return Place("Q101", np.array([face]), np.array([values[face]]), face, values[face], 1.0, "warning")
+    def place(face, code="Q101"):
+        return Place(code, np.array([face]), np.array([values[face]]), face, values[face], 1.0, "warning",
+                     groups[face])
 
-    twin = mirror_twins([place(f) for f in range(5)], centroids, low, high)
+    def repeat(a, b, code="Q101"):
+        return repeats(place(a, code), place(b), centroids, low, high)
+
     # 1 mirrors 0 with a value 8e-5 apart; 2 mirrors it at a value 30 % off; 4 is no mirror image of 3 (y differs).
-    np.testing.assert_array_equal(twin, [False, True, False, False, False])
+    assert repeat(1, 0) and not repeat(2, 0) and not repeat(4, 3)
+    assert not repeat(1, 0, code="Q202")  # another rule's finding is news
+    assert repeat(5, 0) and not repeat(6, 1)  # 5 is a part of 0's group 5 % off; 6 is no part of 1's
+    alone = Place("Q101", np.array([6]), np.array([3.3]), 6, 3.3, 1.0, "warning")  # a place of its own
+    assert not repeats(alone, place(5), centroids, low, high)
 
 
 def test_a_place_an_earlier_closeup_shows_gets_no_closeup_of_its_own(tmp_path):
@@ -168,6 +178,44 @@ def test_closeup_camera_looks_at_the_place_along_its_normal_and_fits_its_ring():
     assert np.abs(ndc[ring_corners]).max() < 1.0
     assert np.abs(ndc[face_subset(mesh, np.array([55])).corner_vertex].mean(axis=0)).max() < 0.05
     assert view.ring.tolist() == [44, 45, 46, 54, 55, 56, 64, 65, 66]  # the quad and its eight neighbours
+
+
+def _worst_face_share(tmp_path, bent) -> tuple:
+    """Report a welded 30 x 30 grid whose ``bent`` quads are flagged; the first close-up, its place and the share
+    of its picture the place's worst face covers (a depth-tested face-id render at its camera)."""
+    from affinity.draw.closeup import place_pixels
+    from affinity.report.build import collect_mesh
+    from affinity.report.demo import MeshInput
+    from affinity.settings import Settings
+
+    write_obj(welded_grid(30, bent=bent), tmp_path / "grid.obj")
+    mesh = load(str(tmp_path / "grid.obj"))
+    first = collect_mesh(MeshInput(str(tmp_path / "grid.obj"), "grid.obj"), Settings()).closeups[0]
+    return first, float(place_pixels(mesh, first.view, np.array([first.place.worst]), 240, 240).mean())
+
+
+def test_a_long_place_is_framed_on_its_worst_face_and_a_compact_one_whole(tmp_path):
+    """A row of 24 flagged unit quads framed whole would leave each about 10 pixels wide: the close-up frames the
+    worst one and its neighbours instead. Seen from 20 degrees off the normal, a unit quad filling the picture
+    as the ring frame puts it (half-height = radius / FILL) covers (240 / (2 tan(15) d))^2 cos(20) pixels."""
+    from affinity.draw.closeup import CLOSEUP_FOV, FILL, RING_RADII, TILT_DEGREES
+
+    first, share = _worst_face_share(tmp_path, [(15, c) for c in range(3, 27)])
+    assert len(first.place.faces) == 24
+    worst = divmod(first.place.worst, 30)
+    np.testing.assert_allclose(first.view.camera[1], [worst[1] + 0.5, worst[0] + 0.5, 0.0])
+    radius = RING_RADII * np.sqrt(0.5)  # the ring reaches farther (1.5 sqrt 2) than twice the quad's own radius
+    half = np.radians(CLOSEUP_FOV / 2)
+    distance = radius / (FILL * np.sin(half))
+    expected = (1 / (2 * np.tan(half) * distance)) ** 2 * np.cos(np.radians(TILT_DEGREES))
+    assert share == pytest.approx(expected, rel=0.15)
+    assert "of a place of 24 flagged faces" in first.framed
+
+    # A pair framed whole is sqrt(5) / sqrt(2) as wide as its worst quad's frame (twice its own radius, sqrt(5) / 2,
+    # against twice the quad's): framed whole, around the pair's centre.
+    pair, _ = _worst_face_share(tmp_path, [(15, 14), (15, 15)])
+    np.testing.assert_allclose(pair.view.camera[1], [15.0, 15.5, 0.0])
+    assert pair.framed == "the 2 flagged faces and their neighbours"
 
 
 def test_line_pattern_inks_each_pixel_by_its_coverage_of_a_line():

@@ -42,6 +42,7 @@ class CloseupView:
     up : the world axis name (``"x"``, ``"y"``, ``"z"``) least aligned with the view direction
     drawn : (D,) int64, the mesh faces to draw (the place, its ring and what lies around them)
     ring : (N,) int64, the place's faces and every face sharing a vertex with them
+    radius : the world radius framed around the target (the ring's reach, at most ``RING_RADII`` place radii)
     visible : the fraction of the pre-pass picture (``PREPASS_SIZE`` squared) the place's faces cover
     """
 
@@ -49,6 +50,7 @@ class CloseupView:
     up: str
     drawn: np.ndarray
     ring: np.ndarray
+    radius: float
     visible: float = 0.0
 
 
@@ -150,7 +152,8 @@ def _view_along(around: _Surroundings, direction: np.ndarray, aspect: float) -> 
     # Draw what lies around the place, but nothing more than a radius in front of it: an occluder (an eyelid,
     # a helper cube inside the body, the other side of a thin part) would hide the place.
     drawn = np.union1d(around.near[around.offset @ direction <= around.radius], around.ring)
-    return CloseupView((tuple(eye.tolist()), tuple(around.target.tolist()), CLOSEUP_FOV), up, drawn, around.ring)
+    return CloseupView((tuple(eye.tolist()), tuple(around.target.tolist()), CLOSEUP_FOV), up, drawn, around.ring,
+                       around.radius)
 
 
 def place_pixels(mesh: Mesh, view: CloseupView, place: np.ndarray, width: int, height: int) -> np.ndarray:

@@ -27,7 +27,7 @@ LYING_FACING = 1.8
 OVERVIEW_ELEVATION = 0.45
 
 
-def _used_points(mesh: Mesh) -> np.ndarray:
+def used_points(mesh: Mesh) -> np.ndarray:
     """(U, 3) float64: the positions some face uses."""
     return mesh.positions[np.unique(mesh.corner_vertex)]
 
@@ -50,7 +50,7 @@ def guess_up_axis(mesh: Mesh) -> str:
 
     if mesh.n_faces == 0:
         return "y"
-    extent = np.ptp(_used_points(mesh), axis=0)
+    extent = np.ptp(used_points(mesh), axis=0)
     _, corners = render_corners(mesh)
     normals = quad_normals(mesh.positions[mesh.corner_vertex[corners]])
     area = np.linalg.norm(normals, axis=1)
@@ -93,7 +93,7 @@ def overview_direction(mesh: Mesh, up: str) -> tuple[float, float, float]:
     """
     k = "xyz".index(up)
     a, b = [axis for axis in range(3) if axis != k]
-    extent = np.ptp(_used_points(mesh), axis=0) if mesh.n_faces else np.ones(3)
+    extent = np.ptp(used_points(mesh), axis=0) if mesh.n_faces else np.ones(3)
     thin, broad = (a, b) if extent[a] <= extent[b] else (b, a)
     direction = np.zeros(3)
     direction[thin], direction[broad], direction[k] = 1.0, 0.35, OVERVIEW_ELEVATION
@@ -118,7 +118,7 @@ def camera_for(mesh: Mesh, width: int, height: int, camera: tuple | None = None,
     up = UP_AXES[up_axis]
     chosen = camera
     if chosen is None:
-        points = _used_points(mesh)
+        points = used_points(mesh)
         return frame_bounds(points.min(axis=0), points.max(axis=0), aspect=aspect, up=up,
                             direction=direction or VIEW_DIRECTIONS[up_axis])
     eye, target, fov = chosen
@@ -128,7 +128,7 @@ def camera_for(mesh: Mesh, width: int, height: int, camera: tuple | None = None,
     if not 0 < fov < 180:
         raise ValueError(f"--camera: the field of view must lie between 0 and 180 degrees, got {fov:g}")
     up = working_up(np.subtract(target, eye) / distance, up_axis)
-    extent = float(np.ptp(_used_points(mesh), axis=0).max()) if mesh.n_faces else 1.0  # the drawn vertices only
+    extent = float(np.ptp(used_points(mesh), axis=0).max()) if mesh.n_faces else 1.0  # the drawn vertices only
     far = distance + 2.0 * max(extent, distance)
     return Camera(eye=tuple(eye), target=tuple(target), up=up, fov_y=fov, aspect=aspect,
                   near=far * 1e-4, far=far)

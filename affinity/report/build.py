@@ -242,23 +242,31 @@ def _view(result: MeshResult) -> None:
 
 
 def _closeups(result: MeshResult, step: StepTimer) -> None:
-    """Rank every flagged place; draw the first ``max_views`` that share no face with an earlier close-up and
-    whose worst face no earlier close-up shows (``Closeup.seen``): each close-up a new spot."""
+    """Rank every flagged place; draw the first ``max_views`` that share no face with an earlier close-up, whose
+    worst face no earlier close-up shows (``Closeup.seen``) and that show no earlier one's defect again
+    (:func:`affinity.report.places.repeats`): each close-up a new spot."""
+    from ..draw.closeup import face_centroids
+    from ..draw.framing import used_points
     from .closeups import closeup
-    from .places import choose_places, places_of
+    from .places import choose_places, places_of, repeats
 
     step("places")
-    by_rule = {hits.code: places_of(result.mesh, hits, result.options.place_faces) for hits in result.file.hits}
+    mesh = result.mesh
+    by_rule = {hits.code: places_of(mesh, hits, result.options.place_faces) for hits in result.file.hits}
     result.places = choose_places(by_rule, sum(len(p) for p in by_rule.values()))
-    shown = np.zeros(result.mesh.n_faces, dtype=bool)  # no two close-ups share a face
-    seen = np.zeros(result.mesh.n_faces, dtype=bool)  # nor show one place's worst face again
+    shown = np.zeros(mesh.n_faces, dtype=bool)  # no two close-ups share a face
+    seen = np.zeros(mesh.n_faces, dtype=bool)  # nor show one place's worst face again
+    centroids = face_centroids(mesh)
+    points = used_points(mesh)
+    box = (points.min(axis=0), points.max(axis=0)) if len(points) else (np.zeros(3), np.zeros(3))
     for place in result.places:
         if len(result.closeups) == result.options.max_views:
             break
-        if shown[place.faces].any() or seen[place.worst]:
+        if (shown[place.faces].any() or seen[place.worst]
+                or any(repeats(place, drawn.place, centroids, *box) for drawn in result.closeups)):
             continue
         step(f"close-up {len(result.closeups) + 1}", "close-ups")
-        drawn = closeup(result.mesh, place, result.settings, CLOSEUP_SIZE, result.options.pixel_tolerance,
+        drawn = closeup(mesh, place, result.settings, CLOSEUP_SIZE, result.options.pixel_tolerance,
                         result.options.texture)
         if drawn.dropped:
             result.dropped.append(drawn.dropped)

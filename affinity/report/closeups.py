@@ -29,6 +29,10 @@ CLOSEUP_METHODS = ("split", "hybrid", "exact")
 #: A close-up whose place covers fewer pixels than this fraction of the picture (300 pixels of 240 x 240) is
 #: re-framed on its worst face, and dropped with a line saying why when that covers too few as well.
 PLACE_FLOOR = 300 / 240**2
+#: A place is framed whole when that frame is at most this many times as wide as its worst face's: a wider one
+#: shrinks the worst face (and the kink of its lines at the split diagonal) below what an eye reads at page size,
+#: so the close-up is framed on the worst face and its neighbours instead.
+WHOLE_PLACE = 2.0
 #: A place whose faces' area is below this fraction of its ring's is a sliver (a collapsed quad): it covers
 #: no pixels from any side, so the floor does not apply and its outline's halo marks it.
 SLIVER_AREA = 1e-3
@@ -165,17 +169,25 @@ def _area(mesh: Mesh, faces: np.ndarray) -> float:
     return float(np.linalg.norm(vector_areas(mesh, faces), axis=1).sum() / 2)
 
 
-def _framed_view(mesh: Mesh, place: Place, size: int):
-    """The view of ``place`` and the faces it is framed on: the whole place, else (it covers less than
-    ``PLACE_FLOOR`` of the pre-pass from every side) its worst face alone."""
+def _framed_view(mesh: Mesh, place: Place):
+    """The view of ``place`` and the faces it is framed on (see :data:`WHOLE_PLACE`).
+
+    The whole place when its frame is at most ``WHOLE_PLACE`` times as wide as its worst face's, else the worst
+    face and its neighbours; whichever of the two the pre-pass sees when the chosen one covers less than
+    ``PLACE_FLOOR`` of it from every side.
+    """
     from ..draw.closeup import closeup_view
 
-    view = closeup_view(mesh, place.faces)
-    if view.visible >= PLACE_FLOOR or len(place.faces) == 1:
-        return view, place.faces
     worst = np.array([place.worst])
-    tighter = closeup_view(mesh, worst)
-    return (tighter, worst) if tighter.visible > view.visible else (view, place.faces)
+    tight = closeup_view(mesh, worst)
+    if len(place.faces) == 1:
+        return tight, worst
+    whole = closeup_view(mesh, place.faces)
+    chosen, other = ((whole, place.faces), (tight, worst)) if whole.radius <= WHOLE_PLACE * tight.radius else (
+        (tight, worst), (whole, place.faces))
+    if chosen[0].visible >= PLACE_FLOOR or other[0].visible <= chosen[0].visible:
+        return chosen
+    return other
 
 
 def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_tolerance: float,
@@ -198,7 +210,7 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
     from ..loaders.imagesize import image_size
     from ..measures import pixel_error
 
-    view, framed_faces = _framed_view(mesh, place, size)
+    view, framed_faces = _framed_view(mesh, place)
     sub = face_subset(mesh, view.drawn)
     show = _show_for(mesh, place.code)
     image_file = texture or _map_kd(mesh)

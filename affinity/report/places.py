@@ -40,6 +40,7 @@ class Place:
     value : its value
     beyond : how far beyond the threshold it is, as a ratio >= 1 (inf at a zero value of a lowest-is-worst rule)
     level : the level of the worst face's finding (``error`` above the rule's visibility threshold)
+    group : the group of neighbours it was carved from (numbered per rule; -1: a place of its own)
     """
 
     code: str
@@ -49,6 +50,7 @@ class Place:
     value: float
     beyond: float
     level: str
+    group: int = -1
 
 
 def connected_components(n_items: int, a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -120,33 +122,28 @@ def carve(values: np.ndarray, centroids: np.ndarray, lowest: bool, limit: int = 
     return parts
 
 
-def mirror_twins(places: list[Place], centroids: np.ndarray, low: np.ndarray, high: np.ndarray) -> np.ndarray:
-    """(P,) bool: the places that are the mirror twin of an earlier one (see :data:`TWIN_VALUE`).
+def repeats(place: Place, earlier: Place, centroids: np.ndarray, low: np.ndarray, high: np.ndarray) -> bool:
+    """Whether ``place`` shows ``earlier``'s defect again: the same rule, worst values within ``TWIN_VALUE``,
+    and either another part of the same group (a ring of equal faces around a vase, a pole's fan) or its mirror
+    twin (its worst face's centroid the mirror image of ``earlier``'s across a mid-plane of the bounding box
+    ``low``/``high`` (3,), within ``TWIN_DISTANCE`` of its diagonal). ``centroids`` (F, 3) of the mesh's faces.
 
-    ``centroids`` (F, 3) of the mesh's faces, ``low``/``high`` (3,) its bounding box. A symmetric model
-    (a face, a car, a cow) flags its two halves alike: a second close-up of the mirror image shows nothing
-    new. Only the first ``4 * CARVED`` places are compared (the ones a close-up may show): O(P^2) stays small.
+    A symmetric model (a face, a car, a cow) flags its two halves alike, and a carved group its parts alike: a
+    second close-up of either shows nothing new.
     """
-    twin = np.zeros(len(places), dtype=bool)
-    head = places[:4 * CARVED]
-    if len(head) < 2:
-        return twin
-    value = np.array([p.value for p in head])
-    at = centroids[[p.worst for p in head]]
+    if place.code != earlier.code or abs(place.value - earlier.value) > TWIN_VALUE * abs(earlier.value):
+        return False
+    if place.group >= 0 and place.group == earlier.group:
+        return True
     tolerance = TWIN_DISTANCE * max(float(np.linalg.norm(high - low)), 1e-300)
-    same = np.abs(value[:, None] - value[None]) <= TWIN_VALUE * np.maximum(np.abs(value[:, None]), 1e-300)
-    for axis in range(3):
-        mirrored = at.copy()
-        mirrored[:, axis] = low[axis] + high[axis] - at[:, axis]
-        close = np.linalg.norm(mirrored[:, None] - at[None], axis=2) <= tolerance
-        earlier = np.tril(same & close & (np.abs(at[:, axis] - (low[axis] + high[axis]) / 2) > tolerance)[:, None],
-                          k=-1)
-        twin[:len(head)] |= earlier.any(axis=1)
-    return twin
+    at, there = centroids[place.worst], centroids[earlier.worst]
+    mirrored = np.where(np.eye(3, dtype=bool), low + high - there, there)  # row k: mirrored across plane k
+    off_plane = np.abs(there - (low + high) / 2) > tolerance
+    return bool((off_plane & (np.linalg.norm(mirrored - at, axis=1) <= tolerance)).any())
 
 
 def places_of(mesh: Mesh, hits: RuleHits, limit: int = PLACE_FACES) -> list[Place]:
-    """Every place of one rule's hits, worst first, mirror twins left out (quads with ``faces`` >= 0 only).
+    """Every place of one rule's hits, worst first (quads with ``faces`` >= 0 only).
 
     A group of neighbours bigger than ``limit`` faces is :func:`carve`d into places of at most ``limit``.
     """
@@ -160,20 +157,19 @@ def places_of(mesh: Mesh, hits: RuleHits, limit: int = PLACE_FACES) -> list[Plac
     centroids = face_centroids(mesh)
     places = []
     groups = group_faces(mesh, faces)
-    parts = [members[part] for members in groups  # one pass per place, not per face
+    parts = [(number, members[part]) for number, members in enumerate(groups)  # one pass per place, not per face
              for part in carve(values[members], centroids[faces[members]], rule.worst == "lowest", limit)]
-    for members in parts:
+    for number, members in parts:
         group, vals = faces[members], values[members]
         k = int(np.argmin(vals) if rule.worst == "lowest" else np.argmax(vals))
         value = float(vals[k])
         with np.errstate(divide="ignore", invalid="ignore"):
             beyond = (hits.threshold / value if value > 0 else np.inf) if rule.worst == "lowest" else (
                 value / hits.threshold if hits.threshold > 0 else np.inf)
-        places.append(Place(hits.code, group, vals, int(group[k]), value, float(beyond), str(levels[members][k])))
+        places.append(Place(hits.code, group, vals, int(group[k]), value, float(beyond), str(levels[members][k]),
+                            number))
     places.sort(key=lambda p: (-p.beyond, p.worst))
-    used = mesh.positions[np.unique(mesh.corner_vertex)] if mesh.n_faces else np.zeros((1, 3))
-    twin = mirror_twins(places, centroids, used.min(axis=0), used.max(axis=0))
-    return [place for place, is_twin in zip(places, twin) if not is_twin]
+    return places
 
 
 def choose_places(by_rule: dict[str, list[Place]], limit: int) -> list[Place]:
