@@ -209,13 +209,13 @@ def test_a_long_place_is_framed_on_its_worst_face_and_a_compact_one_whole(tmp_pa
     distance = radius / (FILL * np.sin(half))
     expected = (1 / (2 * np.tan(half) * distance)) ** 2 * np.cos(np.radians(TILT_DEGREES))
     assert share == pytest.approx(expected, rel=0.15)
-    assert "of a place of 24 flagged faces" in first.framed
+    assert first.framed == f"face {first.place.worst} and its neighbours"
 
     # A pair framed whole is sqrt(5) / sqrt(2) as wide as its worst quad's frame (twice its own radius, sqrt(5) / 2,
     # against twice the quad's): framed whole, around the pair's centre.
     pair, _ = _worst_face_share(tmp_path, [(15, 14), (15, 15)])
     np.testing.assert_allclose(pair.view.camera[1], [15.0, 15.5, 0.0])
-    assert pair.framed == "the 2 flagged faces and their neighbours"
+    assert pair.framed == "the place's faces and their neighbours"
 
 
 def test_line_pattern_inks_each_pixel_by_its_coverage_of_a_line():

@@ -42,7 +42,6 @@ class CloseupView:
     up : the world axis name (``"x"``, ``"y"``, ``"z"``) least aligned with the view direction
     drawn : (D,) int64, the mesh faces to draw (the place, its ring and what lies around them)
     ring : (N,) int64, the place's faces and every face sharing a vertex with them
-    radius : the world radius framed around the target (the ring's reach, at most ``RING_RADII`` place radii)
     visible : the fraction of the pre-pass picture (``PREPASS_SIZE`` squared) the place's faces cover
     """
 
@@ -50,7 +49,6 @@ class CloseupView:
     up: str
     drawn: np.ndarray
     ring: np.ndarray
-    radius: float
     visible: float = 0.0
 
 
@@ -130,14 +128,25 @@ class _Surroundings:
     offset: np.ndarray
 
 
-def _surroundings(mesh: Mesh, place: np.ndarray, ring: np.ndarray) -> _Surroundings:
-    """The :class:`_Surroundings` of ``place`` (P,) int64 and its ``ring`` (N,) int64."""
+def _target_and_radius(mesh: Mesh, place: np.ndarray, ring: np.ndarray) -> tuple[np.ndarray, float]:
+    """(3,) the mean corner of ``place`` (P,) int64, and its ``ring``'s (N,) int64 reach from there, at most
+    ``RING_RADII`` times the place's own."""
     ring_points = mesh.positions[face_vertices(mesh, ring)[0]]
     place_points = mesh.positions[face_vertices(mesh, place)[0]]
     target = place_points.mean(axis=0)
     own = float(np.linalg.norm(place_points - target, axis=1).max())
     radius = min(float(np.linalg.norm(ring_points - target, axis=1).max()), RING_RADII * own)
-    radius = radius if radius > 0 else 1.0
+    return target, (radius if radius > 0 else 1.0)
+
+
+def frame_radius(mesh: Mesh, place: np.ndarray) -> float:
+    """The world radius a close-up of ``place`` (P,) int64 frames (:func:`closeup_view`), without drawing."""
+    return _target_and_radius(mesh, place, ring_of(mesh, place))[1]
+
+
+def _surroundings(mesh: Mesh, place: np.ndarray, ring: np.ndarray) -> _Surroundings:
+    """The :class:`_Surroundings` of ``place`` (P,) int64 and its ``ring`` (N,) int64."""
+    target, radius = _target_and_radius(mesh, place, ring)
     offset = face_centroids(mesh) - target
     near = np.flatnonzero(np.einsum("fi,fi->f", offset, offset) <= (DRAWN_RADII * radius) ** 2)
     return _Surroundings(target, radius, ring, near, offset[near])
@@ -152,8 +161,7 @@ def _view_along(around: _Surroundings, direction: np.ndarray, aspect: float) -> 
     # Draw what lies around the place, but nothing more than a radius in front of it: an occluder (an eyelid,
     # a helper cube inside the body, the other side of a thin part) would hide the place.
     drawn = np.union1d(around.near[around.offset @ direction <= around.radius], around.ring)
-    return CloseupView((tuple(eye.tolist()), tuple(around.target.tolist()), CLOSEUP_FOV), up, drawn, around.ring,
-                       around.radius)
+    return CloseupView((tuple(eye.tolist()), tuple(around.target.tolist()), CLOSEUP_FOV), up, drawn, around.ring)
 
 
 def place_pixels(mesh: Mesh, view: CloseupView, place: np.ndarray, width: int, height: int) -> np.ndarray:

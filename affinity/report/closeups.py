@@ -173,21 +173,21 @@ def _framed_view(mesh: Mesh, place: Place):
     """The view of ``place`` and the faces it is framed on (see :data:`WHOLE_PLACE`).
 
     The whole place when its frame is at most ``WHOLE_PLACE`` times as wide as its worst face's, else the worst
-    face and its neighbours; whichever of the two the pre-pass sees when the chosen one covers less than
-    ``PLACE_FLOOR`` of it from every side.
+    face and its neighbours; the other of the two when the pre-pass sees it better and the first covers less
+    than ``PLACE_FLOOR`` of it from every side.
     """
-    from ..draw.closeup import closeup_view
+    from ..draw.closeup import closeup_view, frame_radius
 
     worst = np.array([place.worst])
-    tight = closeup_view(mesh, worst)
     if len(place.faces) == 1:
-        return tight, worst
-    whole = closeup_view(mesh, place.faces)
-    chosen, other = ((whole, place.faces), (tight, worst)) if whole.radius <= WHOLE_PLACE * tight.radius else (
-        (tight, worst), (whole, place.faces))
-    if chosen[0].visible >= PLACE_FLOOR or other[0].visible <= chosen[0].visible:
-        return chosen
-    return other
+        return closeup_view(mesh, worst), worst
+    whole = frame_radius(mesh, place.faces) <= WHOLE_PLACE * frame_radius(mesh, worst)
+    first, second = (place.faces, worst) if whole else (worst, place.faces)
+    view = closeup_view(mesh, first)
+    if view.visible >= PLACE_FLOOR:
+        return view, first
+    other = closeup_view(mesh, second)
+    return (other, second) if other.visible > view.visible else (view, first)
 
 
 def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_tolerance: float,
@@ -225,9 +225,8 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
             if glyphs else "")
     else:
         label = {"color": "vertex colours", "normal": "normals as RGB", "shaded": "shading"}[show]
-    framed = (f"the {len(place.faces)} flagged faces and their neighbours" if len(framed_faces) > 1
-              else f"face {place.worst} and its neighbours" + (f" (of a place of {len(place.faces)} flagged faces)"
-                                                              if len(place.faces) > 1 else ""))
+    framed = ("the place's faces and their neighbours" if len(framed_faces) > 1
+              else f"face {place.worst} and its neighbours")
     result = Closeup(place, show, label, framed, view=view)
     in_place = np.isin(view.drawn, place.faces)
     frames, plain = {}, {}  # plain: the pictures before the outline

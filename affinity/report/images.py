@@ -49,21 +49,27 @@ def colour_bar(stops, ticks: list[tuple[float, str]], label: str, width: int = 2
     """An inline SVG colour bar: the ramp through ``stops`` (RGB in [0, 1], evenly spaced), tick labels, a unit label.
 
     ``ticks`` are (position in [0, 1] along the bar, text); ``label`` names the
-    quantity and its unit. Text is 12 px, so it stays legible wherever the bar is.
+    quantity and its unit. The bar is ``width`` pixels wide at most: its shapes are
+    placed in percent of its width, so a narrower box shrinks the ramp and keeps the
+    text at 12 px, legible wherever the bar is.
     """
     gradient = "".join(f'<stop offset="{k / (len(stops) - 1):.3f}" stop-color="{_hex(c)}"/>'
                        for k, c in enumerate(stops))
     bar_id = f"bar{abs(hash((tuple(map(tuple, stops)), label))) % 10**8}"
+    margin = 100 * 8 / width  # percent
+
+    def along(t: float) -> str:
+        return f"{margin + t * (100 - 2 * margin):.2f}%"
+
     marks = "".join(
-        f'<line x1="{8 + t * (width - 16):.1f}" x2="{8 + t * (width - 16):.1f}" y1="20" y2="25" stroke="#374151"/>'
-        f'<text x="{8 + t * (width - 16):.1f}" y="38" '
-        f'text-anchor="{"start" if t == 0 else "end" if t == 1 else "middle"}">'
+        f'<line x1="{along(t)}" x2="{along(t)}" y1="20" y2="25" stroke="#374151"/>'
+        f'<text x="{along(t)}" y="38" text-anchor="{"start" if t == 0 else "end" if t == 1 else "middle"}">'
         f'{escape(text)}</text>' for t, text in ticks)
     return (f'<svg class="colour-bar" role="img" aria-label="colour bar: {escape(label)}" width="{width}" height="58" '
-            f'viewBox="0 0 {width} 58" font-size="12" fill="#1f2937" font-family="system-ui, sans-serif">'
+            f'font-size="12" fill="#1f2937" font-family="system-ui, sans-serif">'
             f'<defs><linearGradient id="{bar_id}">{gradient}</linearGradient></defs>'
-            f'<rect x="8" y="6" width="{width - 16}" height="14" fill="url(#{bar_id})" stroke="#9ca3af"/>'
-            f'{marks}<text x="{width / 2:.0f}" y="54" text-anchor="middle">{escape(label)}</text></svg>')
+            f'<rect x="{along(0)}" y="6" width="{100 - 2 * margin:.2f}%" height="14" fill="url(#{bar_id})" '
+            f'stroke="#9ca3af"/>{marks}<text x="50%" y="54" text-anchor="middle">{escape(label)}</text></svg>')
 
 
 def heat_bar(vmax: float, label: str) -> str:
