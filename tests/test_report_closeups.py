@@ -218,6 +218,32 @@ def test_a_long_place_is_framed_on_its_worst_face_and_a_compact_one_whole(tmp_pa
     assert pair.framed == "the place's faces and their neighbours"
 
 
+def test_a_closeup_s_error_map_spans_its_ramp_over_the_place(tmp_path):
+    """A bent quad's split error peaks along its diagonal and falls to 0 at its edges: with the ramp ending at the
+    place's largest error only that pixel would be dark red. It ends where the place's worst 5 % begin, so about
+    that share of the place's pixels saturate and the rest spread over the ramp."""
+    import base64
+    import io
+
+    from PIL import Image
+
+    from affinity.report.build import collect_mesh
+    from affinity.report.demo import MeshInput
+    from affinity.report.images import HEAT_STOPS
+    from affinity.report.sections import closeups_section
+    from affinity.settings import Settings
+
+    write_obj(welded_grid(12, bent=[(6, 6)]), tmp_path / "bent.obj")
+    result = collect_mesh(MeshInput(str(tmp_path / "bent.obj"), "bent.obj"), Settings())
+    figure = closeups_section(result).data["figures"][0]
+    heat = np.asarray(Image.open(io.BytesIO(base64.b64decode(figure["error"]["src"].split(",", 1)[1]))).convert("RGB"))
+    place = result.closeups[0].own & result.closeups[0].covered
+    darkest = np.round(np.array(HEAT_STOPS[-1]) * 255)
+    saturated = (np.abs(heat[place] - darkest).max(axis=1) <= 1).mean()
+    assert 0.03 <= saturated <= 0.08
+    assert (np.abs(heat[place] - 255).max(axis=1) > 60).mean() > 0.5  # most of the place is visibly tinted
+
+
 def test_line_pattern_inks_each_pixel_by_its_coverage_of_a_line():
     """A u ramp of one footprint per pixel: the ink of a 1.5 px box-filtered line, from its closed form."""
     from affinity.draw.texture import LINE_SPACING, LINE_WIDTH, PAPER, U_INK, line_colours, pixel_footprint

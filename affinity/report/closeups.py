@@ -59,6 +59,7 @@ class Closeup:
     images : method -> (S, S, 3) float RGB, the place outlined in the flag colour
     error : (S, S) float64 split error against exact in ``unit`` (None without an attribute or exact)
     covered : (S, S) bool, the pixels where split and exact show the same face
+    own : (S, S) bool, the pixels where the split picture shows the place's faces
     view : the :class:`affinity.draw.closeup.CloseupView` drawn (camera, up, drawn faces)
     place_pixels : the pixels the place's faces cover in the split picture
     seen : (K,) int64, the mesh faces covering at least ``SEEN_PIXELS`` pixels of the split picture
@@ -74,6 +75,7 @@ class Closeup:
     images: dict = field(default_factory=dict)
     error: np.ndarray | None = None
     covered: np.ndarray | None = None
+    own: np.ndarray | None = None
     unit: str = ""
     view: object = None
     place_pixels: int = 0
@@ -246,7 +248,7 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
             image[covered] = line_colours(drawn.frame.attrs[covered], footprint,
                                           local_footprints(drawn.frame.attrs)[covered], glyphs)
         if method == "split":
-            result.place_pixels, split_own, split_outline = int(own.sum()), own, edge
+            result.place_pixels, result.own, split_outline = int(own.sum()), own, edge
             result.seen = view.drawn[np.bincount(sub_face[covered], minlength=len(view.drawn)) >= SEEN_PIXELS]
         plain[method] = image.copy()
         image[edge] = OVERLAY_TINT
@@ -262,11 +264,11 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
         code = next(code for code, rule in RULES.items() if rule.scored and rule.attribute == attribute)
         result.error, result.covered, result.unit = error, covered, RULES[code].unit_for(settings.measure)
         if show in AMPLIFIED:
-            amplified, gain = amplified_difference(plain["split"], plain["exact"], covered, split_own)
+            amplified, gain = amplified_difference(plain["split"], plain["exact"], covered, result.own)
             what = "its difference from exact"
         else:  # uv: the split's texture moved by gain times its error, drawn as the panels are
             local = local_footprints(exact.attrs)
-            uv, gain = amplified_uv(split.attrs, exact.attrs, covered, local, split_own)
+            uv, gain = amplified_uv(split.attrs, exact.attrs, covered, local, result.own)
             what = "its uv error"
             if gain > 1:
                 amplified = plain["exact"].copy()

@@ -29,10 +29,8 @@ def image_uri(image: np.ndarray) -> str:
 
 
 def heatmap_uri(error: np.ndarray, covered: np.ndarray, vmax: float) -> str:
-    """Data URI of a per-pixel error (H, W) as a heatmap: white 0 to dark red ``vmax``; uncovered pixels light grey.
-
-    One ``vmax`` for every heatmap of a mesh, so their colours compare.
-    """
+    """Data URI of a per-pixel error (H, W) as a heatmap: white 0 to dark red at ``vmax`` and beyond; pixels not
+    ``covered`` (H, W) bool light grey."""
     t = np.clip(np.nan_to_num(error) / vmax, 0.0, 1.0)[..., None] if vmax > 0 else np.zeros(error.shape + (1,))
     stops = np.array(HEAT_STOPS)
     low = stops[0] + (stops[1] - stops[0]) * np.minimum(2 * t, 1.0)

@@ -323,6 +323,19 @@ def face_ranges(faces) -> str:
     return ",".join(f"{a}" if a == b else f"{a}-{b}" for a, b in zip(starts.tolist(), ends.tolist()))
 
 
+#: A close-up's error map ends its ramp at this percentile of the error on the place's own pixels: the crease
+#: across the place spans the ramp (the worst few pixels saturate, the bar says so with its "≥"), where the
+#: largest error alone (a spike at one corner, a neighbour's far worse face) would leave the place pale.
+HEAT_PERCENTILE = 95
+
+
+def closeup_heat_scale(error: np.ndarray, covered: np.ndarray, own: np.ndarray) -> float:
+    """The end of a close-up's heat ramp: ``HEAT_PERCENTILE`` of ``error`` (S, S) float64 over the place's pixels
+    ``own`` (S, S) bool that split and exact both cover (``covered`` (S, S) bool), else over all covered ones."""
+    mask = covered & own if (covered & own).any() else covered
+    return float(np.percentile(error[mask], HEAT_PERCENTILE)) if mask.any() else 0.0
+
+
 def closeups_section(result: MeshResult) -> Section:
     """One close-up per flagged place, worst first: split | hybrid | exact with the place outlined, where the
     crease is faint the split with its difference from exact (or its uv error) amplified (the gain printed),
@@ -341,7 +354,7 @@ def closeups_section(result: MeshResult) -> Section:
         unit = rule.unit_for(result.settings.measure)
         error = None
         if view.error is not None:
-            scale = float(view.error[view.covered].max(initial=0.0))
+            scale = closeup_heat_scale(view.error, view.covered, view.own)
             error = {"src": heatmap_uri(view.error, view.covered, scale),
                      "bar": heat_bar(scale, f"split error against exact ({view.unit})")}
         amplified = (None if view.amplified is None
