@@ -323,17 +323,22 @@ def face_ranges(faces) -> str:
     return ",".join(f"{a}" if a == b else f"{a}-{b}" for a, b in zip(starts.tolist(), ends.tolist()))
 
 
-#: A close-up's error map ends its ramp at this percentile of the error on the place's own pixels: the crease
-#: across the place spans the ramp (the worst few pixels saturate, the bar says so with its "≥"), where the
-#: largest error alone (a spike at one corner, a neighbour's far worse face) would leave the place pale.
+#: A close-up's error map ends its ramp at this percentile of the error on the place's own pixels, or on the whole
+#: picture where that is larger: the crease across the place spans the ramp (its worst few pixels saturate, the
+#: bar says so with its "≥"), where the largest error alone (a spike at one corner) would leave it pale, and a
+#: far worse neighbour does not flood the picture.
 HEAT_PERCENTILE = 95
 
 
 def closeup_heat_scale(error: np.ndarray, covered: np.ndarray, own: np.ndarray) -> float:
-    """The end of a close-up's heat ramp: ``HEAT_PERCENTILE`` of ``error`` (S, S) float64 over the place's pixels
-    ``own`` (S, S) bool that split and exact both cover (``covered`` (S, S) bool), else over all covered ones."""
-    mask = covered & own if (covered & own).any() else covered
-    return float(np.percentile(error[mask], HEAT_PERCENTILE)) if mask.any() else 0.0
+    """The end of a close-up's heat ramp: the larger ``HEAT_PERCENTILE`` of ``error`` (S, S) float64 over the
+    place's pixels ``own`` (S, S) bool and over every pixel, counting those split and exact both cover
+    (``covered`` (S, S) bool) only."""
+    if not covered.any():
+        return 0.0
+    place = covered & own
+    return float(max(np.percentile(error[covered], HEAT_PERCENTILE),
+                     np.percentile(error[place], HEAT_PERCENTILE) if place.any() else 0.0))
 
 
 def closeups_section(result: MeshResult) -> Section:
