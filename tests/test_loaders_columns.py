@@ -95,7 +95,13 @@ def test_column_path_matches_python_and_the_token_reader(tmp_path, monkeypatch, 
     path.write_bytes(text.encode())
     taken = []
     real = obj._alike_part
-    monkeypatch.setattr(obj, "_alike_part", lambda chunk: taken.append(real(chunk)) or taken[-1])
+
+    def spied(chunk):  # on the worker threads: return this chunk's part, not whichever was appended last
+        part = real(chunk)
+        taken.append(part)
+        return part
+
+    monkeypatch.setattr(obj, "_alike_part", spied)
     meshes = [load_obj(path, chunk_bytes=size) for size in CHUNK_SIZES]
     assert any(part is not None for part in taken), "the column path was never taken"
     _token_reader_only(monkeypatch)
