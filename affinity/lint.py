@@ -34,7 +34,13 @@ BATCH_SIZE = 16384
 
 
 class CornerTables:
-    """A mesh's attribute tables and their corner indices, shared by every batch."""
+    """A mesh's attribute tables and their corner indices, shared by every batch.
+
+    Each table is kept by component, (D, V) float64 (component d of value v at
+    [d, v]), so a batch gathers each component straight into its own row of the
+    (D, 4, Q) layout the measures compute in; direction tables (normals) are
+    scaled to unit length here, once per value rather than once per corner.
+    """
 
     def __init__(self, mesh: Mesh):
         self.mesh = mesh
@@ -42,41 +48,56 @@ class CornerTables:
                              **{a.field: getattr(mesh, a.corner_index) for a in ATTRIBUTES.values()}}
         self.tables: dict[str, np.ndarray | None] = {}
         self.has_nan: dict[str, bool] = {}
+        self.has_absent: dict[str, bool] = {}  # some corner lacks the attribute (index -1)
 
     def prepare(self, name: str) -> None:
-        """Look table ``name`` over once (NaN rows mark missing values) before the batches share it."""
+        """Lay table ``name`` out by component and look it over once (NaN rows mark
+        missing values, index -1 a corner without one) before the batches share it."""
         if name in self.tables:
             return
-        values = getattr(self.mesh, name)
-        if values is None or len(values) == 0 or self.corner_index[name] is None:
+        values, index = getattr(self.mesh, name), self.corner_index[name]
+        if values is None or len(values) == 0 or index is None:
             self.tables[name] = None
             return
-        self.tables[name] = np.asarray(values, dtype=np.float64)
-        self.has_nan[name] = name != "positions" and bool(np.isnan(self.tables[name]).any())
+        table = np.ascontiguousarray(np.asarray(values, dtype=np.float64).T)
+        if name in ATTRIBUTES and ATTRIBUTES[name].unit_length:
+            table = _unit_rows(table)
+        self.tables[name] = table
+        self.has_nan[name] = name != "positions" and bool(np.isnan(table).any())
+        self.has_absent[name] = len(index) > 0 and int(index.min()) < 0
 
     def gather(self, name: str, corners: np.ndarray,
                complete: bool = True) -> tuple[np.ndarray | slice, np.ndarray] | None:
         """Attribute ``name`` at the (4, Q) corners: ``rows`` of the quads that have
         it at all four corners (a slice when all do, or without ``complete``) and
-        their values laid out by component, (D, 4, n); normals scaled to unit
-        length (zero ones kept). None when the mesh has no such attribute."""
+        their values laid out by component, (D, 4, n); normals of unit length
+        (zero ones kept). None when the mesh has no such attribute."""
         table = self.tables[name]
         if table is None:
             return None
-        index = self.corner_index[name][corners]
-        missing = index < 0
-        np.maximum(index, 0, out=index)
-        values = np.ascontiguousarray(np.transpose(table.take(index, axis=0), (2, 0, 1)))
-        if name in ATTRIBUTES and ATTRIBUTES[name].unit_length:
-            length = np.sqrt(squared_lengths(values))
-            length[length == 0] = 1.0  # zero normals are kept as they are
-            values /= length
-        if complete and (self.has_nan[name] or missing.any()):
-            has_all = ~(missing.any(axis=0) | np.isnan(values).any(axis=(0, 1)))
-            if not has_all.all():
-                rows = np.flatnonzero(has_all)
+        index = self.corner_index[name].take(corners)
+        missing = None
+        if self.has_absent[name]:
+            missing = index < 0
+            np.maximum(index, 0, out=index)
+        values = np.empty((len(table), *index.shape))
+        for component, row in zip(table, values):
+            component.take(index, out=row, mode="clip")  # indices checked by the loader; clip: no buffering
+        if complete and (self.has_nan[name] or (missing is not None and missing.any())):
+            lacking = np.isnan(values).any(axis=(0, 1))
+            if missing is not None:
+                lacking |= missing.any(axis=0)
+            if lacking.any():
+                rows = np.flatnonzero(~lacking)
                 return rows, values[:, :, rows]
         return slice(None), values
+
+
+def _unit_rows(table: np.ndarray) -> np.ndarray:
+    """(D, V) float64 vectors laid out by component, scaled to unit length; zero ones kept as they are."""
+    length = np.sqrt(squared_lengths(table))
+    length[length == 0] = 1.0
+    return table / length
 
 
 class QuadBatch:
