@@ -35,7 +35,6 @@ whole file.
 
 from __future__ import annotations
 
-import io
 import os
 import re
 from dataclasses import dataclass, field
@@ -48,7 +47,7 @@ from .columns import Group, alike_groups
 from .faces import check_indices, color_note, ragged_positions
 from .numbers import PAD, parse_floats, parse_ints
 from .resources import obj_resources, uncommented
-from .text import Tokens, floats_or_raise, read_chunks, tokenize
+from .text import BufferReader, Tokens, floats_or_raise, read_chunks, tokenize
 
 _V, _VT, _VN, _F = 1, 2, 3, 4
 #: Numbers a line of each kind may carry: ``v x y z [w]``, ``v x y z r g b [a]``,
@@ -108,7 +107,7 @@ def load_obj(path, chunk_bytes: int | None = None, source: bytes | None = None) 
     pending = []
     with ThreadPoolExecutor(_WORKERS) as pool:
         assembly = _Assembly(len(source))
-        for chunk in read_chunks(io.BytesIO(source), continuations=True, size=chunk_bytes, count_lines=False):
+        for chunk in read_chunks(BufferReader(source), continuations=True, size=chunk_bytes, count_lines=False):
             pending.append(pool.submit(_parse_chunk, chunk, path))
             if len(pending) > 2 * _WORKERS:  # bound the chunks held in memory
                 assembly.add(assembly.result(pending.pop(0)))
