@@ -66,20 +66,20 @@ class CornerTables:
         self.has_nan[name] = name != "positions" and bool(np.isnan(table).any())
         self.has_absent[name] = len(index) > 0 and int(index.min()) < 0
 
-    def gather(self, name: str, corners: np.ndarray,
+    def gather(self, name: str, index: np.ndarray,
                complete: bool = True) -> tuple[np.ndarray | slice, np.ndarray] | None:
-        """Attribute ``name`` at the (4, Q) corners: ``rows`` of the quads that have
-        it at all four corners (a slice when all do, or without ``complete``) and
-        their values laid out by component, (D, 4, n); normals of unit length
-        (zero ones kept). None when the mesh has no such attribute."""
+        """Attribute ``name`` at the (4, Q) corners whose indices into its table are
+        ``index`` (-1: the corner lacks it): ``rows`` of the quads that have it at all
+        four corners (a slice when all do, or without ``complete``) and their values
+        laid out by component, (D, 4, n); normals of unit length (zero ones kept).
+        None when the mesh has no such attribute."""
         table = self.tables[name]
         if table is None:
             return None
-        index = self.corner_index[name].take(corners)
         missing = None
         if self.has_absent[name]:
             missing = index < 0
-            np.maximum(index, 0, out=index)
+            index = np.maximum(index, 0)
         values = np.empty((len(table), *index.shape))
         for component, row in zip(table, values):
             component.take(index, out=row, mode="clip")  # indices checked by the loader; clip: no buffering
@@ -116,19 +116,31 @@ class QuadBatch:
         self.faces = faces  # (Q,) face indices in file order
         self.corners = corners  # (4, Q) corner indices
         self.texture_size = texture_size
+        self._indices = {}  # id of a corner index array -> its (4, Q) entries at the batch's corners
 
     def __len__(self) -> int:
         return len(self.faces)
 
+    def corner_indices(self, name: str) -> np.ndarray | None:
+        """(4, Q) int64 indices into table ``name`` at the batch's corners; taken once per
+        index array (OBJ ``f 7/7/7`` corners and OFF/PLY meshes share one for all tables)."""
+        array = self.tables.corner_index[name]
+        if array is None:
+            return None
+        if id(array) not in self._indices:
+            self._indices[id(array)] = array.take(self.corners)
+        return self._indices[id(array)]
+
     @cached_property
     def planar(self) -> PlanarQuads:
-        return planar_quads_by_component(self.tables.gather("positions", self.corners, complete=False)[1])
+        return planar_quads_by_component(self.tables.gather("positions", self.corner_indices("positions"),
+                                                            complete=False)[1])
 
     def complete(self, name: str) -> tuple[np.ndarray | slice, np.ndarray]:
         """Quads that have attribute ``name`` at all four corners: ``rows`` (a slice
         over every quad when all have it, else indices into the batch) and the
         attribute (K, 4, n) of those quads."""
-        found = self.tables.gather(name, self.corners)
+        found = self.tables.gather(name, self.corner_indices(name))
         if found is None:
             width = ATTRIBUTES[name].width if name in ATTRIBUTES else 3
             return np.zeros(0, dtype=np.int64), np.zeros((width, 4, 0))
