@@ -59,9 +59,9 @@ class CornerTables:
         if values is None or len(values) == 0 or index is None:
             self.tables[name] = None
             return
-        table = np.ascontiguousarray(np.asarray(values, dtype=np.float64).T)
+        table = np.array(np.asarray(values, dtype=np.float64).T, order="C")  # a copy: scaled in place below
         if name in ATTRIBUTES and ATTRIBUTES[name].unit_length:
-            table = _unit_rows(table)
+            _scale_to_unit_length(table)
         self.tables[name] = table
         self.has_nan[name] = name != "positions" and bool(np.isnan(table).any())
         self.has_absent[name] = len(index) > 0 and int(index.min()) < 0
@@ -93,11 +93,11 @@ class CornerTables:
         return slice(None), values
 
 
-def _unit_rows(table: np.ndarray) -> np.ndarray:
-    """(D, V) float64 vectors laid out by component, scaled to unit length; zero ones kept as they are."""
+def _scale_to_unit_length(table: np.ndarray) -> None:
+    """Scale (D, V) float64 vectors laid out by component to unit length, in place; zero ones stay zero."""
     length = np.sqrt(squared_lengths(table))
     length[length == 0] = 1.0
-    return table / length
+    table /= length
 
 
 class QuadBatch:
@@ -186,8 +186,7 @@ def _map_quad_batches(mesh: Mesh, settings: Settings, measure, attributes=()) ->
     parallel threads (NumPy releases the GIL in its loops); results in file order.
     ``attributes`` names the tables the measure reads besides the positions."""
     tables = CornerTables(mesh)
-    for name in ("positions", *attributes):
-        tables.prepare(name)
+    names = ("positions", *attributes)
     texture_size = texture_grid(mesh, settings)[0] if "texcoords" in attributes else None
     quads = np.flatnonzero(mesh.face_sizes == 4)
 
@@ -198,8 +197,11 @@ def _map_quad_batches(mesh: Mesh, settings: Settings, measure, attributes=()) ->
 
     starts = range(0, len(quads), BATCH_SIZE)
     if len(starts) <= 1:
+        for name in names:
+            tables.prepare(name)
         return [run(start) for start in starts]
     with ThreadPoolExecutor(max_workers=os.cpu_count()) as pool:
+        list(pool.map(tables.prepare, names))  # each table laid out on a thread of its own
         return list(pool.map(run, starts))
 
 
