@@ -334,12 +334,12 @@ def _in_file_order(kind, which, blocks, empty_shape, dtype) -> np.ndarray:
     if not blocks:
         return np.zeros(empty_shape, dtype)
     rank = np.cumsum(kind == which) - 1
-    out = np.empty((blocks[0][1].shape[1], int(rank[-1]) + 1), dtype)  # (T, n): along the lines
+    out = np.empty((int(rank[-1]) + 1, blocks[0][1].shape[1]), dtype)  # (n, T): rows in memory order
     for rows, values in blocks:
         at = rank[rows]
-        for column, numbers in zip(out, values.T):  # 1-D scatters: several times faster than one 2-D
-            column[at] = numbers
-    return out.T
+        for column in range(out.shape[1]):  # 1-D scatters: several times faster than one 2-D
+            out[:, column][at] = values[:, column]
+    return out
 
 
 def _line_kinds(tokens: Tokens, counts) -> np.ndarray:

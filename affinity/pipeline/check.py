@@ -37,7 +37,7 @@ def load_and_check(path: str, settings: Settings, usd=None,
 
     try:
         if reads_whole(path):
-            source = _whole_source(path) if source is None else source
+            source = whole_source(path) if source is None else source
         else:
             source = None  # the other loaders read their files themselves
         mesh = load(path, usd, source)
@@ -63,7 +63,7 @@ def load_and_check(path: str, settings: Settings, usd=None,
     return report, mesh
 
 
-def _whole_source(path: str):
+def whole_source(path: str):
     """The bytes of the file at ``path`` for a loader that parses them whole: mapped when the
     file can be (no copy of a big file), else read (MeshError when it cannot be)."""
     from ..loaders import read_source
