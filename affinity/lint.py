@@ -34,7 +34,13 @@ BATCH_SIZE = 16384
 
 
 class CornerTables:
-    """A mesh's attribute tables and their corner indices, shared by every batch."""
+    """A mesh's attribute tables and their corner indices, shared by every batch.
+
+    Each table is kept by component, (D, V) float64 (component d of value v at
+    [d, v]), so a batch gathers each component straight into its own row of the
+    (D, 4, Q) layout the measures compute in; direction tables (normals) are
+    scaled to unit length here, once per value rather than once per corner.
+    """
 
     def __init__(self, mesh: Mesh):
         self.mesh = mesh
@@ -42,41 +48,56 @@ class CornerTables:
                              **{a.field: getattr(mesh, a.corner_index) for a in ATTRIBUTES.values()}}
         self.tables: dict[str, np.ndarray | None] = {}
         self.has_nan: dict[str, bool] = {}
+        self.has_absent: dict[str, bool] = {}  # some corner lacks the attribute (index -1)
 
     def prepare(self, name: str) -> None:
-        """Look table ``name`` over once (NaN rows mark missing values) before the batches share it."""
+        """Lay table ``name`` out by component and look it over once (NaN rows mark
+        missing values, index -1 a corner without one) before the batches share it."""
         if name in self.tables:
             return
-        values = getattr(self.mesh, name)
-        if values is None or len(values) == 0 or self.corner_index[name] is None:
+        values, index = getattr(self.mesh, name), self.corner_index[name]
+        if values is None or len(values) == 0 or index is None:
             self.tables[name] = None
             return
-        self.tables[name] = np.asarray(values, dtype=np.float64)
-        self.has_nan[name] = name != "positions" and bool(np.isnan(self.tables[name]).any())
+        table = np.array(np.asarray(values, dtype=np.float64).T, order="C")  # a copy: scaled in place below
+        if name in ATTRIBUTES and ATTRIBUTES[name].unit_length:
+            _scale_to_unit_length(table)
+        self.tables[name] = table
+        self.has_nan[name] = name != "positions" and bool(np.isnan(table).any())
+        self.has_absent[name] = len(index) > 0 and int(index.min()) < 0
 
-    def gather(self, name: str, corners: np.ndarray,
+    def gather(self, name: str, index: np.ndarray,
                complete: bool = True) -> tuple[np.ndarray | slice, np.ndarray] | None:
-        """Attribute ``name`` at the (4, Q) corners: ``rows`` of the quads that have
-        it at all four corners (a slice when all do, or without ``complete``) and
-        their values laid out by component, (D, 4, n); normals scaled to unit
-        length (zero ones kept). None when the mesh has no such attribute."""
+        """Attribute ``name`` at the (4, Q) corners whose indices into its table are
+        ``index`` (-1: the corner lacks it): ``rows`` of the quads that have it at all
+        four corners (a slice when all do, or without ``complete``) and their values
+        laid out by component, (D, 4, n); normals of unit length (zero ones kept).
+        None when the mesh has no such attribute."""
         table = self.tables[name]
         if table is None:
             return None
-        index = self.corner_index[name][corners]
-        missing = index < 0
-        np.maximum(index, 0, out=index)
-        values = np.ascontiguousarray(np.transpose(table.take(index, axis=0), (2, 0, 1)))
-        if name in ATTRIBUTES and ATTRIBUTES[name].unit_length:
-            length = np.sqrt(squared_lengths(values))
-            length[length == 0] = 1.0  # zero normals are kept as they are
-            values /= length
-        if complete and (self.has_nan[name] or missing.any()):
-            has_all = ~(missing.any(axis=0) | np.isnan(values).any(axis=(0, 1)))
-            if not has_all.all():
-                rows = np.flatnonzero(has_all)
+        missing = None
+        if self.has_absent[name]:
+            missing = index < 0
+            index = np.maximum(index, 0)
+        values = np.empty((len(table), *index.shape))
+        for component, row in zip(table, values):
+            component.take(index, out=row, mode="clip")  # indices checked by the loader; clip: no buffering
+        if complete and (self.has_nan[name] or (missing is not None and missing.any())):
+            lacking = np.isnan(values).any(axis=(0, 1))
+            if missing is not None:
+                lacking |= missing.any(axis=0)
+            if lacking.any():
+                rows = np.flatnonzero(~lacking)
                 return rows, values[:, :, rows]
         return slice(None), values
+
+
+def _scale_to_unit_length(table: np.ndarray) -> None:
+    """Scale (D, V) float64 vectors laid out by component to unit length, in place; zero ones stay zero."""
+    length = np.sqrt(squared_lengths(table))
+    length[length == 0] = 1.0
+    table /= length
 
 
 class QuadBatch:
@@ -95,19 +116,31 @@ class QuadBatch:
         self.faces = faces  # (Q,) face indices in file order
         self.corners = corners  # (4, Q) corner indices
         self.texture_size = texture_size
+        self._indices = {}  # id of a corner index array -> its (4, Q) entries at the batch's corners
 
     def __len__(self) -> int:
         return len(self.faces)
 
+    def corner_indices(self, name: str) -> np.ndarray | None:
+        """(4, Q) int64 indices into table ``name`` at the batch's corners; taken once per
+        index array (OBJ ``f 7/7/7`` corners and OFF/PLY meshes share one for all tables)."""
+        array = self.tables.corner_index[name]
+        if array is None:
+            return None
+        if id(array) not in self._indices:
+            self._indices[id(array)] = array.take(self.corners)
+        return self._indices[id(array)]
+
     @cached_property
     def planar(self) -> PlanarQuads:
-        return planar_quads_by_component(self.tables.gather("positions", self.corners, complete=False)[1])
+        return planar_quads_by_component(self.tables.gather("positions", self.corner_indices("positions"),
+                                                            complete=False)[1])
 
     def complete(self, name: str) -> tuple[np.ndarray | slice, np.ndarray]:
         """Quads that have attribute ``name`` at all four corners: ``rows`` (a slice
         over every quad when all have it, else indices into the batch) and the
         attribute (K, 4, n) of those quads."""
-        found = self.tables.gather(name, self.corners)
+        found = self.tables.gather(name, self.corner_indices(name))
         if found is None:
             width = ATTRIBUTES[name].width if name in ATTRIBUTES else 3
             return np.zeros(0, dtype=np.int64), np.zeros((width, 4, 0))
@@ -153,8 +186,7 @@ def _map_quad_batches(mesh: Mesh, settings: Settings, measure, attributes=()) ->
     parallel threads (NumPy releases the GIL in its loops); results in file order.
     ``attributes`` names the tables the measure reads besides the positions."""
     tables = CornerTables(mesh)
-    for name in ("positions", *attributes):
-        tables.prepare(name)
+    names = ("positions", *attributes)
     texture_size = texture_grid(mesh, settings)[0] if "texcoords" in attributes else None
     quads = np.flatnonzero(mesh.face_sizes == 4)
 
@@ -165,8 +197,11 @@ def _map_quad_batches(mesh: Mesh, settings: Settings, measure, attributes=()) ->
 
     starts = range(0, len(quads), BATCH_SIZE)
     if len(starts) <= 1:
+        for name in names:
+            tables.prepare(name)
         return [run(start) for start in starts]
     with ThreadPoolExecutor(max_workers=os.cpu_count()) as pool:
+        list(pool.map(tables.prepare, names))  # each table laid out on a thread of its own
         return list(pool.map(run, starts))
 
 

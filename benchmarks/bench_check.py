@@ -50,7 +50,7 @@ PHASES = """
 import io, sys, time
 from affinity.commands.allocator import keep_freed_memory
 keep_freed_memory()
-from affinity.pipeline.check import check_file
+from affinity.pipeline.check import check_file, whole_source
 from affinity.lint import lint_mesh
 from affinity.loaders import load
 from affinity.output import CheckRun
@@ -63,7 +63,7 @@ def timed(step):
     return result, time.perf_counter() - wall, time.process_time() - cpu
 
 settings = Settings()
-mesh, *load_times = timed(lambda: load(sys.argv[1]))
+mesh, *load_times = timed(lambda: load(sys.argv[1], None, whole_source(sys.argv[1])))  # read as the check reads it
 _, *lint_times = timed(lambda: lint_mesh(mesh, settings))
 del mesh
 report = check_file(sys.argv[1], settings)

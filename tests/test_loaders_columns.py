@@ -134,3 +134,33 @@ def test_lines_the_column_path_leaves_to_the_token_reader(tmp_path, line, error)
     with pytest.raises(MeshError) as raised:
         load_obj(path)
     assert raised.value.line == 41 and error in raised.value.reason
+
+
+@pytest.mark.parametrize("runs", [("same", "other", "same"), ("other", "same"), ("same", "plain", "same")])
+def test_slots_that_repeat_the_vertex_index(tmp_path, runs):
+    """``f 7/7/7`` corners (attributes stored per vertex) give the texcoord and normal slots the
+    vertex slot's array; a later run of corners that differ (or lack the slots) parts them,
+    at every chunk size, and the indices are those of the text."""
+    count = 50
+    lines = [f"v {k}.5 {k % 7}.25 -{k % 3}.0" for k in range(count)]
+    lines += [f"vt 0.{k:02d} 0.5" for k in range(count)] + [f"vn 0 0 {k + 1}.0" for k in range(count)]
+    truth = []  # (v, vt, vn) per corner, 0-based, -1 where absent
+    for run in runs:
+        for face in range(30):
+            corners = [((face + k) % count, (face + (run != "same") * (3 * k + 1) + k) % count) for k in range(4)]
+            if run == "plain":
+                lines.append("f " + " ".join(f"{v + 1}" for v, _ in corners))
+                truth += [(v, -1, -1) for v, _ in corners]
+            else:
+                lines.append("f " + " ".join(f"{v + 1}/{t + 1}/{t + 1}" for v, t in corners))
+                truth += [(v, t, t) for v, t in corners]
+    path = tmp_path / "twins.obj"
+    path.write_text("\n".join(lines) + "\n")
+    expected = np.array(truth).T
+    for size in CHUNK_SIZES:
+        mesh = load_obj(path, chunk_bytes=size)
+        for index, slot in zip((mesh.corner_vertex, mesh.corner_texcoord, mesh.corner_normal), expected):
+            assert np.array_equal(index, slot), size
+    whole = load_obj(path, chunk_bytes=1 << 20)
+    if set(runs) == {"same"}:
+        assert whole.corner_texcoord is whole.corner_vertex

@@ -56,6 +56,12 @@ class Group:
         """(S, n) uint64 value of the digits in each span ``spans[s] = (start, end)``
         (byte offsets in the line, at most 8 bytes) but the one at ``dots[s]`` (-1: none),
         a decimal point."""
+        return eight_digits(self.windows(spans, dots))
+
+    def windows(self, spans, dots=None) -> np.ndarray:
+        """(S, n) uint64 digit values of each span as :meth:`numbers` reads them (the
+        span's last digit in the highest byte, 0 bytes before its first): equal
+        windows are equal numbers."""
         end = np.array([e for _, e in spans], dtype=np.int64)
         length = (end - np.array([s for s, _ in spans], dtype=np.int64)).astype(np.uint64)
         # The 8 bytes ending at the span's end, from two words; before a line's first
@@ -76,7 +82,7 @@ class Group:
             low ^= before
             before <<= _U(8)
             low |= before
-        return eight_digits(low)
+        return low
 
 
 def alike_groups(buf: np.ndarray, begin: np.ndarray, end: np.ndarray, limit: int) -> list[Group] | None:

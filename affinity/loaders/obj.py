@@ -35,7 +35,6 @@ whole file.
 
 from __future__ import annotations
 
-import io
 import os
 import re
 from dataclasses import dataclass, field
@@ -46,9 +45,9 @@ from ..errors import MeshError
 from ..mesh import Mesh
 from .columns import Group, alike_groups
 from .faces import check_indices, color_note, ragged_positions
-from .numbers import PAD, parse_floats, parse_ints
+from .numbers import PAD, eight_digits, parse_floats, parse_ints
 from .resources import obj_resources, uncommented
-from .text import Tokens, floats_or_raise, read_chunks, tokenize
+from .text import BufferReader, Tokens, floats_or_raise, read_chunks, tokenize
 
 _V, _VT, _VN, _F = 1, 2, 3, 4
 #: Numbers a line of each kind may carry: ``v x y z [w]``, ``v x y z r g b [a]``,
@@ -108,7 +107,7 @@ def load_obj(path, chunk_bytes: int | None = None, source: bytes | None = None) 
     pending = []
     with ThreadPoolExecutor(_WORKERS) as pool:
         assembly = _Assembly(len(source))
-        for chunk in read_chunks(io.BytesIO(source), continuations=True, size=chunk_bytes, count_lines=False):
+        for chunk in read_chunks(BufferReader(source), continuations=True, size=chunk_bytes, count_lines=False):
             pending.append(pool.submit(_parse_chunk, chunk, path))
             if len(pending) > 2 * _WORKERS:  # bound the chunks held in memory
                 assembly.add(assembly.result(pending.pop(0)))
@@ -274,15 +273,10 @@ def _alike_part(chunk) -> _Part | None:
         return None
     corners, bounds = [None] * 3, [None] * 3
     if faces:
-        layout = faces[0][1]
-        blocks = [(g.rows, g.numbers(own.spans).view(np.int64).T) for g, own in faces]
-        indices = _in_file_order(kind, _F, blocks, (0, len(layout.slots)), np.int64)
-        if not indices.all():  # index 0: the token reader says where
+        found = _alike_corners(kind, faces)
+        if found is None:  # index 0: the token reader says where
             return None
-        slots = np.array(layout.slots)
-        for which in set(layout.slots):
-            picked = indices[:, slots == which].reshape(-1) - 1
-            corners[which], bounds[which] = picked, (int(picked.min()), int(picked.max()))
+        corners, bounds = found
     return _Part(
         elements=elements,
         face_sizes=faces[0][1].size if faces else 0,
@@ -293,6 +287,34 @@ def _alike_part(chunk) -> _Part | None:
         lines=len(end),
         bytes=len(buf) - 2 * PAD,
     )
+
+
+def _alike_corners(kind, faces) -> tuple[list, list] | None:
+    """``corners`` and ``bounds`` (see :class:`_Part`) of the chunk's ``f`` lines, ``faces``
+    (group, layout) pairs of one corner form; None when some index is 0.
+
+    A slot whose digits are those of the vertex slot in every corner (``f 7/7/7 ...``:
+    attributes stored per vertex, as many exporters write them) is not parsed again:
+    it gets the vertex slot's array itself.
+    """
+    slots = np.array(faces[0][1].slots)
+    windows = [(g.rows, g.windows(layout.spans)) for g, layout in faces]  # (T, n) digits of each index
+    vertex = slots == 0
+    twins = [which for which in (1, 2) if (slots == which).any()
+             and all(np.array_equal(digits[slots == which], digits[vertex]) for _, digits in windows)]
+    parsed = ~np.isin(slots, twins)
+    blocks = [(rows, eight_digits(digits if parsed.all() else digits[parsed]).view(np.int64).T)
+              for rows, digits in windows]
+    indices = _in_file_order(kind, _F, blocks, (0, int(parsed.sum())), np.int64)
+    if not indices.all():
+        return None
+    corners, bounds = [None] * 3, [None] * 3
+    for which in set(slots[parsed].tolist()):
+        picked = indices[:, slots[parsed] == which].reshape(-1) - 1
+        corners[which], bounds[which] = picked, (int(picked.min()), int(picked.max()))
+    for which in twins:
+        corners[which], bounds[which] = corners[0], bounds[0]
+    return corners, bounds
 
 
 def _alike_numbers(group: Group, layout: _Layout) -> np.ndarray:
@@ -312,12 +334,12 @@ def _in_file_order(kind, which, blocks, empty_shape, dtype) -> np.ndarray:
     if not blocks:
         return np.zeros(empty_shape, dtype)
     rank = np.cumsum(kind == which) - 1
-    out = np.empty((blocks[0][1].shape[1], int(rank[-1]) + 1), dtype)  # (T, n): along the lines
+    out = np.empty((int(rank[-1]) + 1, blocks[0][1].shape[1]), dtype)  # (n, T): rows in memory order
     for rows, values in blocks:
         at = rank[rows]
-        for column, numbers in zip(out, values.T):  # 1-D scatters: several times faster than one 2-D
-            column[at] = numbers
-    return out.T
+        for column in range(out.shape[1]):  # 1-D scatters: several times faster than one 2-D
+            out[:, column][at] = values[:, column]
+    return out
 
 
 def _line_kinds(tokens: Tokens, counts) -> np.ndarray:
@@ -753,6 +775,7 @@ class _Assembly:
         self.n_corners = 0
         self.n_lines = 0  # lines of the chunks added so far
         self.corners = [None, None, None]  # slot -> _Growing, once a chunk has the slot
+        self.twins = set()  # slots whose indices so far are the vertex slot's: its array serves them
         self.bounds = [(0, -1)] * 3
         self.events = []
         self.nan_colors = []  # (vertices, line) with a NaN colour, in file order
@@ -785,29 +808,48 @@ class _Assembly:
             return
         n_corners = self._add_sizes(part.face_sizes, n_faces)
         for which in range(3):
-            index = part.corners[which]
-            if index is None:
-                if self.corners[which] is not None:
-                    self.corners[which].fill(n_corners, -1)
-                    self.bounds[which] = (min(self.bounds[which][0], -1), self.bounds[which][1])
-                continue
-            if self.corners[which] is None:
-                self.corners[which] = self._growing(np.int64)
-                self.corners[which].fill(self.n_corners, -1)
-                if self.n_corners:
-                    self.bounds[which] = (-1, -1)
-            low, high = part.bounds[which]
-            back = part.relative[which]
-            if back is not None and len(back):
-                index[back] += before[_ELEMENT_OF_SLOT[which]]
-                index[back[index[back] < 0]] = -2  # counted back past the first element
-                low, high = min(low, int(index[back].min())), max(high, int(index[back].max()))
-            self.corners[which].append(index)
-            self.bounds[which] = (min(self.bounds[which][0], low), max(self.bounds[which][1], high))
+            self._add_slot(which, part, n_corners, before[_ELEMENT_OF_SLOT[which]])
         self.face_line.append(part.face_line)
         self.events += [(face + self.n_faces, key, name) for face, key, name in part.events]
         self.n_faces += n_faces
         self.n_corners += n_corners
+
+    def _add_slot(self, which: int, part: _Part, n_corners: int, elements_before: int) -> None:
+        """Append the part's ``n_corners`` indices of slot ``which`` (the vertex slot's first)."""
+        index = part.corners[which]
+        twin = which > 0 and index is not None and index is part.corners[0]
+        if which in self.twins:
+            if twin:
+                self._widen_bounds(which, *part.bounds[which])
+                return
+            self.twins.discard(which)  # the slot parts from the vertex slot: it gets its own array
+            self.corners[which] = self._growing(np.int64)
+            self.corners[which].append(self.corners[0].array()[: self.n_corners])
+        if index is None:
+            if self.corners[which] is not None:
+                self.corners[which].fill(n_corners, -1)
+                self._widen_bounds(which, -1, -1)
+            return
+        if twin and self.n_corners == 0:
+            self.twins.add(which)
+            self.bounds[which] = part.bounds[which]
+            return
+        if self.corners[which] is None:
+            self.corners[which] = self._growing(np.int64)
+            self.corners[which].fill(self.n_corners, -1)
+            if self.n_corners:
+                self.bounds[which] = (-1, -1)
+        low, high = part.bounds[which]
+        back = part.relative[which]
+        if back is not None and len(back):
+            index[back] += elements_before
+            index[back[index[back] < 0]] = -2  # counted back past the first element
+            low, high = min(low, int(index[back].min())), max(high, int(index[back].max()))
+        self.corners[which].append(index)
+        self._widen_bounds(which, low, high)
+
+    def _widen_bounds(self, which: int, low: int, high: int) -> None:
+        self.bounds[which] = (min(self.bounds[which][0], low), max(self.bounds[which][1], high))
 
     def _add_sizes(self, sizes, n_faces: int) -> int:
         """Record the chunk's face sizes; return its number of corners."""
@@ -844,10 +886,13 @@ class _Assembly:
         for which, name in enumerate(_SLOT_NAMES):
             total = len(elements[_ELEMENT_OF_SLOT[which]])
             grown = self.corners[which]
-            if grown is None:  # no face names this slot: every corner lacks it
+            if which in self.twins:
+                index = corners[0]  # the same array: OFF and PLY meshes share theirs alike
+            elif grown is None:  # no face names this slot: every corner lacks it
                 corners.append(np.full(self.n_corners, -1, dtype=np.int64) if total or which == 0 else None)
                 continue
-            index = grown.array()
+            else:
+                index = grown.array()
             low, high = self.bounds[which]
             if low < -1 or high >= total:
                 check_indices(path, index, total, face_start, face_line, name, absent=-1)

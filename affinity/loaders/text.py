@@ -8,6 +8,7 @@ knows its first token and its 1-based number in the file.
 
 from __future__ import annotations
 
+import mmap
 from dataclasses import dataclass
 
 import numpy as np
@@ -15,9 +16,11 @@ import numpy as np
 from ..errors import MeshError
 from .numbers import PAD, parse_floats
 
-#: Bytes read per chunk: large enough that per-chunk overhead vanishes, small
-#: enough that the per-token temporaries stay in cache-friendly sizes.
-CHUNK_BYTES = 1 << 19
+#: Bytes read per chunk: large enough that per-chunk overhead (and the GIL it holds,
+#: against the other parsing threads) vanishes, small enough that the per-token
+#: temporaries stay in cache-friendly sizes. Measured on a 166 MB OBJ on 2 cores:
+#: 2 MB parses in 15% less CPU than 512 KB, and 4 MB gains little more.
+CHUNK_BYTES = 1 << 21
 
 _NEWLINE, _CR, _SLASH, _HASH, _BACKSLASH = (ord(c) for c in "\n\r/#\\")
 
@@ -47,6 +50,46 @@ class Chunk:
             return base.find(byte, 0, len(self.buf))
         hits = np.flatnonzero(self.buf == byte[0])
         return int(hits[0]) if len(hits) else -1
+
+
+class Mapped(mmap.mmap):
+    """A read-only file map with the bytes methods the readers of a source use (``mmap`` lacks ``count``)."""
+
+    def count(self, sub: bytes, start: int = 0, end: int | None = None) -> int:
+        with memoryview(self) as view:
+            return bytes(view[start:end]).count(sub)
+
+
+def mapped_file(path) -> Mapped | None:
+    """The bytes of the file at ``path`` as a read-only memory map (the page cache's own pages:
+    no copy, no fresh memory to fault in), or None where the file cannot be mapped (empty, not
+    a regular file, unreadable: :func:`affinity.loaders.read_source` then reads it, or says why not).
+
+    A map shows the file as it is while it is read: a file truncated meanwhile ends the
+    process (SIGBUS) instead of reading short; a check reads a file once, right after mapping it.
+    """
+    try:
+        with open(path, "rb") as fh:
+            if hasattr(mmap, "MAP_POPULATE"):  # Linux: every page mapped in one call, not one fault each
+                return Mapped(fh.fileno(), 0, flags=mmap.MAP_SHARED | mmap.MAP_POPULATE, prot=mmap.PROT_READ)
+            return Mapped(fh.fileno(), 0, access=mmap.ACCESS_READ)
+    except (OSError, ValueError):
+        return None
+
+
+class BufferReader:
+    """``readinto`` over a bytes-like buffer, for :func:`read_chunks` (``io.BytesIO`` copies
+    any buffer but ``bytes`` whole first)."""
+
+    def __init__(self, data):
+        self.view = memoryview(data)
+        self.offset = 0
+
+    def readinto(self, into) -> int:
+        count = min(len(into), len(self.view) - self.offset)
+        into[:count] = self.view[self.offset : self.offset + count]
+        self.offset += count
+        return count
 
 
 def read_chunks(fh, first_line: int = 1, continuations: bool = False, size: int | None = None,

@@ -33,15 +33,16 @@ def load_and_check(path: str, settings: Settings, usd=None,
                    source: bytes | None = None) -> tuple[FileReport, Mesh | None]:
     """:func:`check_file`, also handing back the loaded mesh (None when it could not be read)."""
     from ..lint import lint_mesh
-    from ..loaders import load, read_source, reads_whole
+    from ..loaders import load, reads_whole
 
     try:
         if reads_whole(path):
-            source = read_source(path) if source is None else source
+            source = whole_source(path) if source is None else source
         else:
             source = None  # the other loaders read their files themselves
         mesh = load(path, usd, source)
         ignores = _inline_ignores(source, mesh) if reads_whole(path) else []
+        del source  # not needed past here: a big file's bytes are not held while its mesh is linted
         report = FileReport(
             path,
             counts=mesh.counts(),
@@ -60,6 +61,16 @@ def load_and_check(path: str, settings: Settings, usd=None,
         reason = " ".join(f"internal error: {type(err).__name__}: {err}".split())
         return FileReport(path, error=reason[:300], error_line=0, transient=True), None
     return report, mesh
+
+
+def whole_source(path: str):
+    """The bytes of the file at ``path`` for a loader that parses them whole: mapped when the
+    file can be (no copy of a big file), else read (MeshError when it cannot be)."""
+    from ..loaders import read_source
+    from ..loaders.text import mapped_file
+
+    mapped = mapped_file(path)
+    return read_source(path) if mapped is None else mapped
 
 
 def _inline_ignores(source: bytes, mesh: Mesh) -> list:
