@@ -352,3 +352,12 @@ def test_the_cache_and_the_loader_read_the_libraries_the_obj_rule_names(tmp_path
     assert deps == expected
     resources = obj_resources(str(path), text)  # what load_obj puts in Mesh.resources
     assert [os.path.abspath(r.path) for r in resources if r.role == "mtllib"] == expected
+
+
+def test_a_nul_byte_in_an_mtllib_name_is_one_clear_line_with_the_cache_on(tmp_path):
+    """No file is named with a NUL byte (os.stat raises ValueError, not OSError): the cache's key treats the
+    resource as missing, and the loader refuses the binary byte naming the line (found by the fuzzer)."""
+    (tmp_path / "nul.obj").write_bytes(b"mtllib a\0b.mtl\n" + quad_obj([(SQUARE, UNIT_UV)]).encode())
+    done = run("check", "nul.obj", cwd=tmp_path)
+    assert done.returncode != 0 and "Traceback" not in done.stderr
+    assert "nul.obj:1:" in done.stdout + done.stderr and "0x00" in done.stdout + done.stderr

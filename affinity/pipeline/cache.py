@@ -220,7 +220,7 @@ class ResultCache:
         """A file's content hash and the files it pulls in, from its pre-key when it is unchanged."""
         try:
             st = os.stat(path)
-        except OSError:
+        except (OSError, ValueError):  # ValueError: a name with a NUL byte (an mtllib's), which no file has
             return None
         if not os.path.isfile(path):
             return None
