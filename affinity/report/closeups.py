@@ -61,7 +61,6 @@ class Closeup:
     covered : (S, S) bool, the pixels where split and exact show the same face
     own : (S, S) bool, the pixels where the split picture shows the place's faces
     view : the :class:`affinity.draw.closeup.CloseupView` drawn (camera, up, drawn faces)
-    place_pixels : the pixels the place's faces cover in the split picture
     seen : (K,) int64, the mesh faces covering at least ``SEEN_PIXELS`` pixels of the split picture
     amplified : (S, S, 3) float, the split with its difference from exact (colours, normals) or its uv error
         times ``gain``, where that is faint (a gain above 1), else None; ``amplified_label`` says which
@@ -78,12 +77,16 @@ class Closeup:
     own: np.ndarray | None = None
     unit: str = ""
     view: object = None
-    place_pixels: int = 0
     dropped: str | None = None
     amplified: np.ndarray | None = None
     gain: float = 1.0
     amplified_label: str = ""
     seen: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+
+    @property
+    def place_pixels(self) -> int:
+        """The pixels the place's faces cover in the split picture (0 before it is drawn)."""
+        return 0 if self.own is None else int(self.own.sum())
 
 
 def _show_for(mesh: Mesh, code: str) -> str:
@@ -248,7 +251,7 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
             image[covered] = line_colours(drawn.frame.attrs[covered], footprint,
                                           local_footprints(drawn.frame.attrs)[covered], glyphs)
         if method == "split":
-            result.place_pixels, result.own, split_outline = int(own.sum()), own, edge
+            result.own, split_outline = own, edge
             result.seen = view.drawn[np.bincount(sub_face[covered], minlength=len(view.drawn)) >= SEEN_PIXELS]
         plain[method] = image.copy()
         image[edge] = OVERLAY_TINT
