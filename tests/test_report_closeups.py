@@ -218,6 +218,31 @@ def test_a_long_place_is_framed_on_its_worst_face_and_a_compact_one_whole(tmp_pa
     assert pair.framed == "the place's faces and their neighbours"
 
 
+def test_a_compact_place_whose_worst_face_is_hidden_from_every_side_is_framed_on_that_face(tmp_path):
+    """A flagged pair (worst quad 465 at x, y in [15, 16]) under two flaps, 2.6 wide at z = +-2 over the worst
+    quad: framed whole (radius sqrt(5)), the flaps are drawn and hide it from all six candidate directions
+    (a 20-degree tilt moves a flap's shadow by 2 tan 20 = 0.73 < its 0.8 margin), while the other quad still
+    shows. Framed on the worst quad (radius sqrt(2) < 2 cos 20), the flaps are not drawn and it shows."""
+    from affinity.draw.closeup import place_pixels
+    from affinity.report.build import collect_mesh
+    from affinity.report.demo import MeshInput
+    from affinity.settings import Settings
+
+    path = tmp_path / "flaps.obj"
+    write_obj(welded_grid(30, bent=[(15, 14), (15, 15), (15, 15)]), path)  # 961 v, 3600 vt
+    corners = [(14.2, 14.2), (16.8, 14.2), (16.8, 16.8), (14.2, 16.8)]
+    flaps = [f"v {x} {y} {z}" for z in (2.0, -2.0) for x, y in corners]
+    flaps += ["vt 0 0", "vt 1 0", "vt 1 1", "vt 0 1", "f 962/3601 963/3602 964/3603 965/3604",
+              "f 969/3604 968/3603 967/3602 966/3601"]
+    with open(path, "a", encoding="utf-8") as file:
+        file.write("\n".join(flaps) + "\n")
+    first = collect_mesh(MeshInput(str(path), "flaps.obj"), Settings()).closeups[0]
+    assert first.place.faces.tolist() == [464, 465] and first.place.worst == 465
+    assert first.framed == "face 465 and its neighbours"
+    worst_pixels = place_pixels(load(str(path)), first.view, np.array([465]), 240, 240).sum()
+    assert worst_pixels >= 300
+
+
 def test_a_closeup_s_error_map_spans_its_ramp_over_the_place(tmp_path):
     """A bent quad's split error peaks along its diagonal and falls to 0 at its edges: with the ramp ending at the
     place's largest error only that pixel would be dark red. It ends where the place's worst 5 % begin, so about

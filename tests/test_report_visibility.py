@@ -20,7 +20,8 @@ import pytest
 
 from affinity.loaders import load
 
-#: The pixels a close-up's place must cover, and the share of a uv / colour close-up where split and exact differ.
+#: The pixels a close-up's place and its worst face must each cover, and the share of a uv / colour close-up
+#: where split and exact differ.
 PLACE_PIXELS = 300
 DIFFERENT_SHARE = 0.01
 FIGURE = re.compile(r'<figure class="closeup"(?P<attrs>[^>]*)>(?P<body>.*?)</figure>', re.S)
@@ -64,8 +65,9 @@ def faces_of(ranges: str) -> np.ndarray:
     return np.array(faces, dtype=np.int64)
 
 
-def place_pixels(mesh, figure: dict, size: int) -> int:
-    """The pixels the figure's place covers in a depth-tested face-id render of its drawn faces at its camera."""
+def place_pixels(mesh, figure: dict, size: int, faces: str | None = None) -> int:
+    """The pixels the figure's place (or ``faces``, ranges as in ``data-place``) covers in a depth-tested
+    face-id render of its drawn faces at its camera."""
     from affinity.draw.closeup import face_subset
     from affinity.draw.drawing import RenderOptions, render_mesh
 
@@ -76,7 +78,7 @@ def place_pixels(mesh, figure: dict, size: int) -> int:
                                                                   height=size, camera=camera, up=figure["up"]))
     face = result.frame.face
     mesh_face = np.where(face >= 0, drawn[result.faces[np.maximum(face, 0)]], -1)
-    return int(np.isin(mesh_face, faces_of(figure["place"])).sum())
+    return int(np.isin(mesh_face, faces_of(faces or figure["place"])).sum())
 
 
 def check_figures(mesh_path: Path, figures: list[dict]) -> None:
@@ -88,6 +90,7 @@ def check_figures(mesh_path: Path, figures: list[dict]) -> None:
         label = f"{mesh_path.name} face {figure['face']} {figure['rule']}"
         size = figure["panels"]["split"].shape[0]
         assert place_pixels(mesh, figure, size) >= PLACE_PIXELS, label
+        assert place_pixels(mesh, figure, size, figure["face"]) >= PLACE_PIXELS, label  # the face it is named by
         place = set(faces_of(figure["place"]).tolist())
         assert len(place) <= 64 and not place & seen, label
         seen |= place

@@ -43,6 +43,7 @@ class CloseupView:
     drawn : (D,) int64, the mesh faces to draw (the place, its ring and what lies around them)
     ring : (N,) int64, the place's faces and every face sharing a vertex with them
     visible : the fraction of the pre-pass picture (``PREPASS_SIZE`` squared) the place's faces cover
+    focus_visible : the fraction of it the focus faces cover (:func:`closeup_view`; the place's by default)
     """
 
     camera: tuple
@@ -50,6 +51,7 @@ class CloseupView:
     drawn: np.ndarray
     ring: np.ndarray
     visible: float = 0.0
+    focus_visible: float = 0.0
 
 
 def face_vertices(mesh: Mesh, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -164,37 +166,47 @@ def _view_along(around: _Surroundings, direction: np.ndarray, aspect: float) -> 
     return CloseupView((tuple(eye.tolist()), tuple(around.target.tolist()), CLOSEUP_FOV), up, drawn, around.ring)
 
 
-def place_pixels(mesh: Mesh, view: CloseupView, place: np.ndarray, width: int, height: int) -> np.ndarray:
-    """(H, W) bool: the pixels where ``place``'s faces are the nearest of ``view.drawn`` (a depth-tested render)."""
+def _nearest_faces(mesh: Mesh, view: CloseupView, width: int, height: int) -> np.ndarray:
+    """(H, W) int64: the mesh face nearest the camera of ``view`` among ``view.drawn`` at each pixel, -1 where
+    none (a depth-tested render)."""
     from .drawing import RenderOptions, render_mesh
 
     drawn = render_mesh(face_subset(mesh, view.drawn), RenderOptions(
         method="split", show="shaded", width=width, height=height, camera=view.camera, up=view.up))
     face = drawn.frame.face
-    covered = face >= 0
-    own = np.isin(view.drawn, place)
-    return covered & own[drawn.faces[np.maximum(face, 0)]]
+    return np.where(face >= 0, view.drawn[drawn.faces[np.maximum(face, 0)]], -1)
 
 
-def closeup_view(mesh: Mesh, place: np.ndarray, aspect: float = 1.0) -> CloseupView:
+def place_pixels(mesh: Mesh, view: CloseupView, place: np.ndarray, width: int, height: int) -> np.ndarray:
+    """(H, W) bool: the pixels where ``place``'s faces are the nearest of ``view.drawn`` (a depth-tested render)."""
+    return np.isin(_nearest_faces(mesh, view, width, height), place)
+
+
+def closeup_view(mesh: Mesh, place: np.ndarray, aspect: float = 1.0, focus: np.ndarray | None = None,
+                 focus_floor: float = 0.0) -> CloseupView:
     """Frame a camera on ``place`` (P,) int64 mesh faces from the side it is seen from.
 
     Each of :func:`candidate_directions` of the place's mean normal is drawn at
-    ``PREPASS_SIZE`` pixels (:func:`place_pixels`); the direction where the place
-    covers the most pixels wins, the first on a tie. The distance fits the
-    bounding sphere of the place's ring (:func:`ring_of`), at most ``RING_RADII``
-    times the place's own, into ``FILL`` of the narrower half field of view.
+    ``PREPASS_SIZE`` pixels (:func:`place_pixels`). The direction where the place
+    covers the most pixels wins, the first on a tie, among those where the ``focus``
+    faces (F,) int64 (the place's worst face, say; default the place) cover at least
+    ``focus_floor`` of the picture, when any does. The distance fits the bounding
+    sphere of the place's ring (:func:`ring_of`), at most ``RING_RADII`` times the
+    place's own, into ``FILL`` of the narrower half field of view.
     """
+    focus = place if focus is None else focus
     around = _surroundings(mesh, place, ring_of(mesh, place))
     views = [_view_along(around, direction, aspect) for direction in candidate_directions(mean_normal(mesh, place))]
     height = max(1, round(PREPASS_SIZE / aspect))
     for k, view in enumerate(views):
         try:
-            seen = place_pixels(mesh, view, place, PREPASS_SIZE, height)
+            nearest = _nearest_faces(mesh, view, PREPASS_SIZE, height)
         except ValueError:  # everything is behind this camera: it sees nothing
             continue
-        views[k] = replace(view, visible=float(seen.mean()))
-    return max(views, key=lambda view: view.visible)  # max keeps the first of equals
+        views[k] = replace(view, visible=float(np.isin(nearest, place).mean()),
+                           focus_visible=float(np.isin(nearest, focus).mean()))
+    # max keeps the first of equals
+    return max(views, key=lambda view: (view.focus_visible >= focus_floor, view.visible))
 
 
 def face_subset(mesh: Mesh, faces: np.ndarray) -> Mesh:

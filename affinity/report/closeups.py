@@ -177,22 +177,30 @@ def _area(mesh: Mesh, faces: np.ndarray) -> float:
 def _framed_view(mesh: Mesh, place: Place):
     """The view of ``place`` and the faces it is framed on (see :data:`WHOLE_PLACE`).
 
-    The whole place when its frame is at most ``WHOLE_PLACE`` times as wide as its worst face's, else the worst
-    face and its neighbours; the other of the two when the pre-pass sees it better and the first covers less
-    than ``PLACE_FLOOR`` of it from every side.
+    The whole place when its frame is at most ``WHOLE_PLACE`` times as wide as its worst face's and, from the
+    side that shows the worst face best, the place and its worst face each cover ``PLACE_FLOOR`` of the pre-pass
+    (a close-up of a place whose worst face is hidden shows the wrong crease); else the worst face and its
+    neighbours. When that covers less than the floor too (a sliver), the one of the two where the worst face is
+    seen more, then the place.
     """
     from ..draw.closeup import closeup_view, frame_radius
 
     worst = np.array([place.worst])
     if len(place.faces) == 1:
         return closeup_view(mesh, worst), worst
-    whole = frame_radius(mesh, place.faces) <= WHOLE_PLACE * frame_radius(mesh, worst)
-    first, second = (place.faces, worst) if whole else (worst, place.faces)
-    view = closeup_view(mesh, first)
-    if view.visible >= PLACE_FLOOR:
-        return view, first
-    other = closeup_view(mesh, second)
-    return (other, second) if other.visible > view.visible else (view, first)
+    whole = None
+    if frame_radius(mesh, place.faces) <= WHOLE_PLACE * frame_radius(mesh, worst):
+        whole = closeup_view(mesh, place.faces, focus=worst, focus_floor=PLACE_FLOOR)
+        if min(whole.visible, whole.focus_visible) >= PLACE_FLOOR:
+            return whole, place.faces
+    near = closeup_view(mesh, worst, focus=place.faces)
+    if near.visible >= PLACE_FLOOR:
+        return near, worst
+    whole = whole or closeup_view(mesh, place.faces, focus=worst, focus_floor=PLACE_FLOOR)
+    # The one that shows the worst face more, then the place (a sliver shows in neither)
+    if (whole.focus_visible, whole.visible) > (near.visible, near.focus_visible):
+        return whole, place.faces
+    return near, worst
 
 
 def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_tolerance: float,
