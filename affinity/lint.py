@@ -39,7 +39,8 @@ class CornerTables:
     Each table is kept by component, (D, V) float64 (component d of value v at
     [d, v]), so a batch gathers each component straight into its own row of the
     (D, 4, Q) layout the measures compute in; direction tables (normals) are
-    scaled to unit length here, once per value rather than once per corner.
+    scaled to unit length here, once per value rather than once per corner. A mesh
+    array stored by component already (the OBJ reader's) is used as it is, not copied.
     """
 
     def __init__(self, mesh: Mesh):
@@ -59,9 +60,11 @@ class CornerTables:
         if values is None or len(values) == 0 or index is None:
             self.tables[name] = None
             return
-        table = np.array(np.asarray(values, dtype=np.float64).T, order="C")  # a copy: scaled in place below
+        table = np.asarray(values, dtype=np.float64).T
         if name in ATTRIBUTES and ATTRIBUTES[name].unit_length:
-            _scale_to_unit_length(table)
+            table = _unit_length(table)
+        elif table.strides[1] != table.itemsize:  # components not contiguous: laid out by component once
+            table = np.ascontiguousarray(table)
         self.tables[name] = table
         self.has_nan[name] = name != "positions" and bool(np.isnan(table).any())
         self.has_absent[name] = len(index) > 0 and int(index.min()) < 0
@@ -93,11 +96,12 @@ class CornerTables:
         return slice(None), values
 
 
-def _scale_to_unit_length(table: np.ndarray) -> None:
-    """Scale (D, V) float64 vectors laid out by component to unit length, in place; zero ones stay zero."""
+def _unit_length(table: np.ndarray) -> np.ndarray:
+    """(D, V) float64 vectors laid out by component, scaled to unit length (a new array, each
+    component contiguous); zero ones stay zero."""
     length = np.sqrt(squared_lengths(table))
     length[length == 0] = 1.0
-    table /= length
+    return np.divide(table, length, out=np.empty(table.shape))
 
 
 class QuadBatch:
