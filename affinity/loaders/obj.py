@@ -85,6 +85,9 @@ class _Part:
     bytes: int  # bytes of the chunk's lines
     events: list = field(default_factory=list)  # (face in chunk, keyword, name)
     nan_colors: list = field(default_factory=list)  # (vertices, first line) with a NaN colour
+    #: The chunk may hold an ``mtllib`` statement. The column reader's chunks cannot (every line of
+    #: theirs starts with v, vt, vn, f or '#'); the token reader's say so when the word is in their bytes.
+    mtllib: bool = False
 
 
 #: Chunks parsed in parallel (NumPy releases the GIL inside its loops).
@@ -113,7 +116,8 @@ def load_obj(path, chunk_bytes: int | None = None, source: bytes | None = None) 
                 assembly.add(assembly.result(pending.pop(0)))
         for future in pending:
             assembly.add(assembly.result(future))
-    return assembly.mesh(path, obj_resources(os.fspath(path), source))
+    # Only a file with an mtllib statement has resources: the others' bytes are not searched again.
+    return assembly.mesh(path, obj_resources(os.fspath(path), source) if assembly.mtllib else [])
 
 
 def _parse_chunk(chunk, path) -> _Part:
@@ -145,6 +149,7 @@ def _parse_chunk(chunk, path) -> _Part:
         lines=len(tokens.end) + len(chunk.joined),
         bytes=len(chunk.buf) - 2 * PAD,
         nan_colors=nan_colors,
+        mtllib=chunk.mentions(b"mtllib"),
     )
     statements = np.flatnonzero((counts > 0) & (kind == 0))
     if len(statements):
@@ -791,6 +796,7 @@ class _Assembly:
         self.bounds = [(0, -1)] * 3
         self.events = []
         self.nan_colors = []  # (vertices, line) with a NaN colour, in file order
+        self.mtllib = False  # some chunk may hold an mtllib statement
 
     def _growing(self, dtype, width=None) -> _Growing:
         return _Growing(dtype, self.progress, width)
@@ -814,6 +820,7 @@ class _Assembly:
         for k in _WIDTHS:
             self.elements[k].append(part.elements[k])
         self.nan_colors += part.nan_colors
+        self.mtllib |= part.mtllib
         n_faces = len(part.face_line)
         if n_faces == 0:
             self.events += [(face + self.n_faces, key, name) for face, key, name in part.events]
