@@ -31,6 +31,8 @@ from .settings import Settings
 #: of the caches; batches of this size keep them in, and let the batches run on
 #: parallel threads.
 BATCH_SIZE = 16384
+#: Table values looked over (scaled, searched for NaN) together, so that the threads share a table's work.
+TABLE_BLOCK = 1 << 18
 
 
 class CornerTables:
@@ -39,7 +41,8 @@ class CornerTables:
     Each table is kept by component, (D, V) float64 (component d of value v at
     [d, v]), so a batch gathers each component straight into its own row of the
     (D, 4, Q) layout the measures compute in; direction tables (normals) are
-    scaled to unit length here, once per value rather than once per corner.
+    scaled to unit length here, once per value rather than once per corner. A mesh
+    array stored by component already (the OBJ reader's) is used as it is, not copied.
     """
 
     def __init__(self, mesh: Mesh):
@@ -49,22 +52,33 @@ class CornerTables:
         self.tables: dict[str, np.ndarray | None] = {}
         self.has_nan: dict[str, bool] = {}
         self.has_absent: dict[str, bool] = {}  # some corner lacks the attribute (index -1)
+        self._lacking: dict[int, bool] = {}  # id of a corner index array -> has_absent of its tables
 
-    def prepare(self, name: str) -> None:
+    def prepare(self, name: str, map=map) -> None:
         """Lay table ``name`` out by component and look it over once (NaN rows mark
-        missing values, index -1 a corner without one) before the batches share it."""
+        missing values, index -1 a corner without one) before the batches share it.
+        ``map`` runs that work over blocks of :data:`TABLE_BLOCK` values (a thread pool's
+        ``map`` spreads it over the threads)."""
         if name in self.tables:
             return
         values, index = getattr(self.mesh, name), self.corner_index[name]
         if values is None or len(values) == 0 or index is None:
             self.tables[name] = None
             return
-        table = np.array(np.asarray(values, dtype=np.float64).T, order="C")  # a copy: scaled in place below
+        table = np.asarray(values, dtype=np.float64).T
+        blocks = [slice(start, start + TABLE_BLOCK) for start in range(0, table.shape[1], TABLE_BLOCK)]
         if name in ATTRIBUTES and ATTRIBUTES[name].unit_length:
-            _scale_to_unit_length(table)
+            scaled = np.empty(table.shape)
+            list(map(lambda block: _unit_length(table[:, block], scaled[:, block]), blocks))
+            table = scaled
+        elif table.strides[1] != table.itemsize:  # components not contiguous: laid out by component once
+            table = np.ascontiguousarray(table)
         self.tables[name] = table
-        self.has_nan[name] = name != "positions" and bool(np.isnan(table).any())
-        self.has_absent[name] = len(index) > 0 and int(index.min()) < 0
+        self.has_nan[name] = name != "positions" and any(map(lambda block: bool(np.isnan(table[:, block]).any()),
+                                                             blocks))
+        if id(index) not in self._lacking:  # OBJ 'f 7/7/7' corners and OFF/PLY meshes share one index array
+            self._lacking[id(index)] = len(index) > 0 and int(index.min()) < 0
+        self.has_absent[name] = self._lacking[id(index)]
 
     def gather(self, name: str, index: np.ndarray,
                complete: bool = True) -> tuple[np.ndarray | slice, np.ndarray] | None:
@@ -93,11 +107,12 @@ class CornerTables:
         return slice(None), values
 
 
-def _scale_to_unit_length(table: np.ndarray) -> None:
-    """Scale (D, V) float64 vectors laid out by component to unit length, in place; zero ones stay zero."""
+def _unit_length(table: np.ndarray, out: np.ndarray) -> None:
+    """(D, V) float64 vectors laid out by component, scaled to unit length into ``out`` (D, V);
+    zero ones stay zero."""
     length = np.sqrt(squared_lengths(table))
     length[length == 0] = 1.0
-    table /= length
+    np.divide(table, length, out=out)
 
 
 class QuadBatch:
@@ -201,7 +216,8 @@ def _map_quad_batches(mesh: Mesh, settings: Settings, measure, attributes=()) ->
             tables.prepare(name)
         return [run(start) for start in starts]
     with ThreadPoolExecutor(max_workers=os.cpu_count()) as pool:
-        list(pool.map(tables.prepare, names))  # each table laid out on a thread of its own
+        for name in names:
+            tables.prepare(name, pool.map)
         return list(pool.map(run, starts))
 
 

@@ -132,3 +132,24 @@ def test_quads_after_a_mixed_chunk_are_kept(tmp_path):
     for size in (None, 1 << 12, 100):
         counts = load_obj(path, chunk_bytes=size).counts()
         assert counts == {"faces": 5000, "quads": 1000, "triangles": 4000, "ngons": 0}, size
+
+
+def test_a_material_library_is_found_in_any_chunk(tmp_path):
+    """The reader searches the bytes for ``mtllib`` statements only when a chunk may hold one: the
+    libraries are those :func:`~affinity.loaders.resources.mtllib_statements` finds in the whole file,
+    wherever the chunks end, and a comment naming the word is no statement."""
+    from affinity.loaders.resources import mtllib_statements
+
+    (tmp_path / "late.mtl").write_text("newmtl red\nKd 1 0 0\n")
+    grid = "".join(f"v {k % 10}.5 {k // 10}.25 0.0\n" for k in range(400))
+    faces = "".join(f"f {k + 1} {k + 2} {k + 12} {k + 11}\n" for k in range(0, 380, 2))
+    text = "# mtllib commented.mtl\n" + grid + faces + "mtllib late.mtl\nusemtl red\n" + faces
+    path = tmp_path / "late_library.obj"
+    path.write_text(text)
+    assert [name for _, name in mtllib_statements(text.encode())] == ["late.mtl"]
+    for size in (None, 1 << 12, 257, 61):
+        resources = load_obj(path, chunk_bytes=size).resources
+        assert [(r.role, r.name, r.line) for r in resources] == [("mtllib", "late.mtl", 592)], size
+    plain = tmp_path / "no_library.obj"
+    plain.write_text(grid + faces)
+    assert load_obj(plain).resources == []

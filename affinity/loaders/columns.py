@@ -25,7 +25,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from .numbers import eight_digits
-from .numbers import words as unaligned_words
 
 _U = np.uint64
 _ONES = _U((1 << 64) - 1)
@@ -126,10 +125,20 @@ def _line_words(buf: np.ndarray, begin: np.ndarray, width: int) -> np.ndarray:
     if begin[-1] - begin[0] == width * (len(begin) - 1):  # consecutive lines: a strided view
         for k in range(count):
             words[k] = np.ndarray((len(begin),), "<u8", buffer=buf, offset=int(begin[0]) + 8 * k, strides=(width,))
-    else:
-        every = unaligned_words(buf)
+    else:  # word k from aligned words k and k + 1 of each line's start, all shifted alike
+        offset = -buf.ctypes.data % 8
+        aligned = buf[offset : offset + 8 * ((len(buf) - offset) // 8)].view("<u8")
+        start = begin - offset
+        index = start >> 3
+        shift = (start & 7).astype(np.uint64) << _U(3)
+        back = _U(64) - shift  # a shift by 64 gives 0 in NumPy
+        following = aligned.take(index, mode="clip")
         for k in range(count):
-            words[k] = every[begin + 8 * k]
+            word = following
+            following = aligned.take(index + (k + 1), mode="clip")  # clip: past the buffer only past the line
+            np.right_shift(word, shift, out=words[k])
+            word = following << back
+            words[k] |= word
     return words
 
 

@@ -75,7 +75,7 @@ class _Part:
     Line numbers count from the chunk's first line (see :meth:`_Assembly.result`).
     """
 
-    elements: dict  # kind -> (n, width) float64
+    elements: dict  # kind -> (width, n) float64, by component
     face_sizes: np.ndarray | int
     face_line: np.ndarray
     corners: list
@@ -85,6 +85,9 @@ class _Part:
     bytes: int  # bytes of the chunk's lines
     events: list = field(default_factory=list)  # (face in chunk, keyword, name)
     nan_colors: list = field(default_factory=list)  # (vertices, first line) with a NaN colour
+    #: The chunk may hold an ``mtllib`` statement. The column reader's chunks cannot (every line of
+    #: theirs starts with v, vt, vn, f or '#'); the token reader's say so when the word is in their bytes.
+    mtllib: bool = False
 
 
 #: Chunks parsed in parallel (NumPy releases the GIL inside its loops).
@@ -113,7 +116,8 @@ def load_obj(path, chunk_bytes: int | None = None, source: bytes | None = None) 
                 assembly.add(assembly.result(pending.pop(0)))
         for future in pending:
             assembly.add(assembly.result(future))
-    return assembly.mesh(path, obj_resources(os.fspath(path), source))
+    # Only a file with an mtllib statement has resources: the others' bytes are not searched again.
+    return assembly.mesh(path, obj_resources(os.fspath(path), source) if assembly.mtllib else [])
 
 
 def _parse_chunk(chunk, path) -> _Part:
@@ -127,6 +131,7 @@ def _parse_chunk(chunk, path) -> _Part:
     nan_colors = []
     elements = {k: _elements(tokens, path, lines, k, nan_colors) for k, lines in element_lines.items()}
     _check_colors(tokens, path, element_lines[_V], elements[_V])
+    elements = {k: rows.T for k, rows in elements.items()}  # by component, as the column reader gives them
     face_lines = np.flatnonzero(kind == _F)
     sizes, corners, relative, bounds, face_slashes = _faces(tokens, path, kind, face_lines)
     if tokens.slashes != face_slashes:
@@ -144,6 +149,7 @@ def _parse_chunk(chunk, path) -> _Part:
         lines=len(tokens.end) + len(chunk.joined),
         bytes=len(chunk.buf) - 2 * PAD,
         nan_colors=nan_colors,
+        mtllib=chunk.mentions(b"mtllib"),
     )
     statements = np.flatnonzero((counts > 0) & (kind == 0))
     if len(statements):
@@ -266,8 +272,7 @@ def _alike_part(chunk) -> _Part | None:
         if len({len(layout.divisor) for _, layout in own}) > 1:
             return None
         blocks = [(g.rows, _alike_numbers(g, layout)) for g, layout in own]
-        # (n, T) rows in memory order here on the worker: the reading thread's append is then a plain copy
-        elements[which] = np.ascontiguousarray(_in_file_order(kind, which, blocks, (0, _WIDTHS[which][0]), np.float64))
+        elements[which] = _in_file_order(kind, which, blocks, (_WIDTHS[which][0], 0), np.float64)
     faces = [(g, layout) for g, layout in zip(groups, layouts) if layout.kind == _F]
     if len({layout.slots for _, layout in faces}) > 1:
         return None
@@ -299,18 +304,22 @@ def _alike_corners(kind, faces) -> tuple[list, list] | None:
     """
     slots = np.array(faces[0][1].slots)
     windows = [(g.rows, g.windows(layout.spans)) for g, layout in faces]  # (T, n) digits of each index
-    vertex = slots == 0
+    vertex = np.flatnonzero(slots == 0)
     twins = [which for which in (1, 2) if (slots == which).any()
-             and all(np.array_equal(digits[slots == which], digits[vertex]) for _, digits in windows)]
+             and all(np.array_equal(digits[own], digits[first])  # row by row: views, no copies
+                     for _, digits in windows for own, first in zip(np.flatnonzero(slots == which), vertex))]
     parsed = ~np.isin(slots, twins)
-    blocks = [(rows, eight_digits(digits if parsed.all() else digits[parsed]).view(np.int64).T)
+    blocks = [(rows, eight_digits(digits if parsed.all() else digits[parsed]).view(np.int64))
               for rows, digits in windows]
-    indices = _in_file_order(kind, _F, blocks, (0, int(parsed.sum())), np.int64)
+    indices = _in_file_order(kind, _F, blocks, (int(parsed.sum()), 0), np.int64)  # (T, n)
     if not indices.all():
         return None
     corners, bounds = [None] * 3, [None] * 3
     for which in set(slots[parsed].tolist()):
-        picked = indices[:, slots[parsed] == which].reshape(-1) - 1
+        own = slots[parsed] == which
+        picked = np.empty((indices.shape[1], int(own.sum())), np.int64)  # corner-major: (faces, corners)
+        np.subtract((indices if own.all() else indices[own]).T, 1, out=picked)
+        picked = picked.reshape(-1)
         corners[which], bounds[which] = picked, (int(picked.min()), int(picked.max()))
     for which in twins:
         corners[which], bounds[which] = corners[0], bounds[0]
@@ -318,27 +327,28 @@ def _alike_corners(kind, faces) -> tuple[list, list] | None:
 
 
 def _alike_numbers(group: Group, layout: _Layout) -> np.ndarray:
-    """(n, T) float64 numbers of a group of ``v``/``vt``/``vn`` lines."""
+    """(T, n) float64 numbers of a group of ``v``/``vt``/``vn`` lines, by component."""
     runs = group.numbers(layout.spans, layout.dots).view(np.int64).astype(np.float64)
     values = runs if len(layout.last) == len(layout.spans) else runs[layout.last]
     for run, column, weight in layout.extra:  # exact: integers below 2**53
         values[column] += runs[run] * weight
     values /= layout.divisor[:, None]
-    return values.T
+    return values
 
 
 def _in_file_order(kind, which, blocks, empty_shape, dtype) -> np.ndarray:
-    """The rows of the ``which`` lines, from ``blocks`` of (line indices, (n, T) values), in file order."""
+    """(T, n) values of the ``which`` lines, by component, from ``blocks`` of (line indices, (T, n)
+    values), in file order."""
     if len(blocks) == 1:
         return blocks[0][1]
     if not blocks:
         return np.zeros(empty_shape, dtype)
     rank = np.cumsum(kind == which) - 1
-    out = np.empty((int(rank[-1]) + 1, blocks[0][1].shape[1]), dtype)  # (n, T): rows in memory order
+    out = np.empty((blocks[0][1].shape[0], int(rank[-1]) + 1), dtype)
     for rows, values in blocks:
         at = rank[rows]
-        for column in range(out.shape[1]):  # 1-D scatters: several times faster than one 2-D
-            out[:, column][at] = values[:, column]
+        for column, value in zip(out, values):  # 1-D scatters: several times faster than one 2-D
+            column[at] = value
     return out
 
 
@@ -696,7 +706,8 @@ class _Progress:
 
 
 class _Growing:
-    """An array filled block by block along its first axis.
+    """An array filled block by block: a 1-D array, or rows of ``width`` numbers stored by
+    component ((width, capacity): component d of row i at [d, i]).
 
     When full, the capacity grows to a quarter more than the rows expected by
     the end of the file (extrapolated from the rows per byte since the first
@@ -712,12 +723,16 @@ class _Growing:
         self.width = width
         self.size = 0
         self.first_byte = None  # file offset of the chunk that brought the first rows
-        self.data = np.empty((0,) if width is None else (0, width), dtype)
+        self.data = np.empty((0,) if width is None else (width, 0), dtype)
+
+    @property
+    def capacity(self) -> int:
+        return self.data.shape[-1]
 
     def __len__(self) -> int:
         return self.size
 
-    def _capacity(self, needed: int) -> int:
+    def _grown_capacity(self, needed: int) -> int:
         progress = self.progress
         if self.first_byte is None:
             self.first_byte = progress.before
@@ -728,28 +743,29 @@ class _Growing:
     def _reserve(self, rows: int, width: int | None) -> None:
         needed = self.size + rows
         wider = width is not None and width > self.width
-        if needed <= len(self.data) and not wider:
+        if needed <= self.capacity and not wider:
             return
-        capacity = self._capacity(needed) if needed > len(self.data) else len(self.data)
+        capacity = self._grown_capacity(needed) if needed > self.capacity else self.capacity
         if width is None:
             data = np.empty(capacity, self.dtype)
             data[: self.size] = self.data[: self.size]
         else:
             self.width = max(width, self.width)
-            data = np.empty((capacity, self.width), self.dtype)
-            data[: self.size, : self.data.shape[1]] = self.data[: self.size]
-            data[: self.size, self.data.shape[1] :] = np.nan
+            data = np.empty((self.width, capacity), self.dtype)
+            data[: len(self.data), : self.size] = self.data[:, : self.size]
+            data[len(self.data) :, : self.size] = np.nan
         self.data = data
 
     def append(self, block: np.ndarray) -> None:
-        width = None if self.width is None else block.shape[1]
-        self._reserve(len(block), width)
-        end = self.size + len(block)
+        """Add ``block``: (n,) values, or (width, n) rows by component."""
+        width = None if self.width is None else block.shape[0]
+        self._reserve(block.shape[-1], width)
+        end = self.size + block.shape[-1]
         if width is None or width == self.width:
-            self.data[self.size : end] = block
+            self.data[..., self.size : end] = block
         else:
-            self.data[self.size : end, :width] = block
-            self.data[self.size : end, width:] = np.nan
+            self.data[:width, self.size : end] = block
+            self.data[width:, self.size : end] = np.nan
         self.size = end
 
     def fill(self, rows: int, value) -> None:
@@ -758,7 +774,8 @@ class _Growing:
         self.size += rows
 
     def array(self) -> np.ndarray:
-        return self.data[: self.size]
+        """The filled rows: (size,), or (size, width) (a view of the storage by component)."""
+        return self.data[: self.size] if self.width is None else self.data[:, : self.size].T
 
 
 class _Assembly:
@@ -779,6 +796,7 @@ class _Assembly:
         self.bounds = [(0, -1)] * 3
         self.events = []
         self.nan_colors = []  # (vertices, line) with a NaN colour, in file order
+        self.mtllib = False  # some chunk may hold an mtllib statement
 
     def _growing(self, dtype, width=None) -> _Growing:
         return _Growing(dtype, self.progress, width)
@@ -802,6 +820,7 @@ class _Assembly:
         for k in _WIDTHS:
             self.elements[k].append(part.elements[k])
         self.nan_colors += part.nan_colors
+        self.mtllib |= part.mtllib
         n_faces = len(part.face_line)
         if n_faces == 0:
             self.events += [(face + self.n_faces, key, name) for face, key, name in part.events]
@@ -906,7 +925,7 @@ class _Assembly:
             notes.append(color_note(sum(count for count, _ in self.nan_colors), 0, self.nan_colors[0][1]))
         return Mesh(
             path=os.fspath(path),
-            positions=vertices if vertices.shape[1] == 3 else np.ascontiguousarray(vertices[:, :3]),
+            positions=vertices[:, :3],  # by component underneath, as the lint gathers them (affinity.lint.CornerTables)
             face_start=face_start,
             corner_vertex=corners[0],
             face_line=face_line,

@@ -42,14 +42,24 @@ class Chunk:
     first_line: int
     joined: np.ndarray
 
-    def find(self, byte: bytes) -> int:
-        """Offset of the first ``byte`` in ``buf`` (-1: none), at C speed."""
+    def _bytearray(self) -> bytearray | None:
+        """The bytearray ``buf`` views (as :func:`read_chunks` makes it), else None."""
         base = self.buf.base
         base = base.obj if isinstance(base, memoryview) else base  # NumPy 2 keeps a memoryview of it
-        if isinstance(base, bytearray):
+        return base if isinstance(base, bytearray) else None
+
+    def find(self, byte: bytes) -> int:
+        """Offset of the first ``byte`` in ``buf`` (-1: none), at C speed."""
+        base = self._bytearray()
+        if base is not None:
             return base.find(byte, 0, len(self.buf))
         hits = np.flatnonzero(self.buf == byte[0])
         return int(hits[0]) if len(hits) else -1
+
+    def mentions(self, word: bytes) -> bool:
+        """Whether ``word`` occurs in ``buf``."""
+        base = self._bytearray()
+        return (base.find(word, 0, len(self.buf)) if base is not None else self.buf.tobytes().find(word)) >= 0
 
 
 class Mapped(mmap.mmap):
