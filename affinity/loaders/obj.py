@@ -149,7 +149,7 @@ def _parse_chunk(chunk, path) -> _Part:
         lines=len(tokens.end) + len(chunk.joined),
         bytes=len(chunk.buf) - 2 * PAD,
         nan_colors=nan_colors,
-        mtllib=chunk.mentions(b"mtllib"),
+        mtllib=chunk.find(b"mtllib") >= 0,
     )
     statements = np.flatnonzero((counts > 0) & (kind == 0))
     if len(statements):

@@ -48,18 +48,15 @@ class Chunk:
         base = base.obj if isinstance(base, memoryview) else base  # NumPy 2 keeps a memoryview of it
         return base if isinstance(base, bytearray) else None
 
-    def find(self, byte: bytes) -> int:
-        """Offset of the first ``byte`` in ``buf`` (-1: none), at C speed."""
+    def find(self, word: bytes) -> int:
+        """Offset of the first ``word`` (a byte or more) in ``buf`` (-1: none), at C speed."""
         base = self._bytearray()
         if base is not None:
-            return base.find(byte, 0, len(self.buf))
-        hits = np.flatnonzero(self.buf == byte[0])
+            return base.find(word, 0, len(self.buf))
+        if len(word) > 1:
+            return self.buf.tobytes().find(word)
+        hits = np.flatnonzero(self.buf == word[0])
         return int(hits[0]) if len(hits) else -1
-
-    def mentions(self, word: bytes) -> bool:
-        """Whether ``word`` occurs in ``buf``."""
-        base = self._bytearray()
-        return (base.find(word, 0, len(self.buf)) if base is not None else self.buf.tobytes().find(word)) >= 0
 
 
 class Mapped(mmap.mmap):
