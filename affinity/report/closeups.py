@@ -188,15 +188,20 @@ def _framed_view(mesh: Mesh, place: Place):
     worst = np.array([place.worst])
     if len(place.faces) == 1:
         return closeup_view(mesh, worst), worst
+
+    def whole_view():  # the side that shows the worst face, if one does
+        return closeup_view(mesh, place.faces, focus=worst, focus_floor=PLACE_FLOOR)
+
     whole = None
     if frame_radius(mesh, place.faces) <= WHOLE_PLACE * frame_radius(mesh, worst):
-        whole = closeup_view(mesh, place.faces, focus=worst, focus_floor=PLACE_FLOOR)
+        whole = whole_view()
         if min(whole.visible, whole.focus_visible) >= PLACE_FLOOR:
             return whole, place.faces
     near = closeup_view(mesh, worst, focus=place.faces)
     if near.visible >= PLACE_FLOOR:
         return near, worst
-    whole = whole or closeup_view(mesh, place.faces, focus=worst, focus_floor=PLACE_FLOOR)
+    if whole is None:
+        whole = whole_view()
     # The one that shows the worst face more, then the place (a sliver shows in neither)
     if (whole.focus_visible, whole.visible) > (near.visible, near.focus_visible):
         return whole, place.faces
