@@ -90,7 +90,6 @@ def _measure(text: str) -> str:
 def add_parser(sub) -> None:
     from ..loaders.formats import described
     from ..output import FORMATS
-    from ..rules import LEVELS
     from ..settings import DIAGONALS, MEASURES
 
     p = sub.add_parser(
@@ -134,14 +133,7 @@ def add_parser(sub) -> None:
                        help="record every current finding in FILE (counts per file, group and rule) and exit")
     p.add_argument("-j", "--jobs", type=_jobs, metavar="N",
                    help="check files in N processes (default: all CPUs, fewer when the files are small)")
-    p.add_argument("--fail-on", choices=LEVELS, default="error",
-                   help="the lowest level whose findings make exit 1 (default: error, a plainly visible "
-                        "crease; warning also fails on the milder ones)")
-    p.add_argument("--exit-zero", action="store_true",
-                   help="exit 0 even with findings (unreadable input and --fail-on-skip still exit 2)")
-    p.add_argument("--fail-on-skip", action="store_true",
-                   help="exit 2 when a file was skipped (a Git LFS pointer, a USD stage with no mesh), so a "
-                        "checkout without 'git lfs pull' cannot pass with nothing checked")
+    add_gate_arguments(p)
     p.add_argument("--max-findings", type=_count, metavar="N",
                    help="json/junit/sarif/github: keep the worst N findings per file and rule, and say what was "
                         "truncated (without it sarif and github keep the worst 5,000 of the whole run)")
@@ -157,11 +149,30 @@ def add_parser(sub) -> None:
     p.add_argument("--no-cache", action="store_true",
                    help="check every file again instead of reusing the results of unchanged files "
                         "(cache folder: AFFINITY_CACHE_DIR, else the user cache folder)")
+    add_display_arguments(p)
+    p.set_defaults(run=run)
+
+
+def add_gate_arguments(p) -> None:
+    """The options that decide the exit code :func:`publish` returns."""
+    from ..rules import LEVELS
+
+    p.add_argument("--fail-on", choices=LEVELS, default="error",
+                   help="the lowest level whose findings make exit 1 (default: error, a plainly visible "
+                        "crease; warning also fails on the milder ones)")
+    p.add_argument("--exit-zero", action="store_true",
+                   help="exit 0 even with findings (unreadable input and --fail-on-skip still exit 2)")
+    p.add_argument("--fail-on-skip", action="store_true",
+                   help="exit 2 when a file was skipped (a Git LFS pointer, a USD stage with no mesh), so a "
+                        "checkout without 'git lfs pull' cannot pass with nothing checked")
+
+
+def add_display_arguments(p) -> None:
+    """The options of what :func:`publish` writes besides ``--format`` and ``-o``."""
     p.add_argument("--statistics", action="store_true",
                    help="text: counts per rule instead of findings; json/sarif/github/junit: counts added")
     p.add_argument("--verbose", action="store_true", help="show every finding in text output")
     p.add_argument("-q", "--quiet", action="store_true", help="print findings and nothing else")
-    p.set_defaults(run=run)
 
 
 def _overrides(args) -> dict:

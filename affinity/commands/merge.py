@@ -12,7 +12,7 @@ from . import EXIT_ERROR
 
 def add_parser(sub) -> None:
     from ..output import FORMATS
-    from ..rules import LEVELS
+    from .check import add_display_arguments, add_gate_arguments
 
     p = sub.add_parser(
         "merge", help="join the JSON results of the shards of a run (check --shard K/N) into one result",
@@ -25,15 +25,8 @@ def add_parser(sub) -> None:
     p.add_argument("--format", choices=FORMATS, default="text",
                    help="text (default), json, sarif (code scanning), github (workflow annotations), junit")
     p.add_argument("-o", "--output-file", metavar="PATH", help="write the output to PATH (whole or not at all)")
-    p.add_argument("--fail-on", choices=LEVELS, default="error",
-                   help="the lowest level whose findings make exit 1 (default: error)")
-    p.add_argument("--exit-zero", action="store_true",
-                   help="exit 0 even with findings (unreadable files and --fail-on-skip still exit 2)")
-    p.add_argument("--fail-on-skip", action="store_true", help="exit 2 when a shard skipped a file")
-    p.add_argument("--statistics", action="store_true",
-                   help="text: counts per rule instead of findings; json/sarif/github/junit: counts added")
-    p.add_argument("--verbose", action="store_true", help="show every finding in text output")
-    p.add_argument("-q", "--quiet", action="store_true", help="print findings and nothing else")
+    add_gate_arguments(p)
+    add_display_arguments(p)
     p.set_defaults(run=run)
 
 
