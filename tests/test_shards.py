@@ -168,13 +168,14 @@ def test_merged_sarif_is_one_valid_run_and_shard_logs_have_their_own_category(li
 
 @pytest.fixture(scope="module")
 def gate_library(tmp_path_factory) -> Path:
-    """Eight files, one with an error-level finding, one with warnings only, the others clean."""
+    """Nine files: one with an error, one with a warning, one with both (a ramp of creases), six clean."""
     root = tmp_path_factory.mktemp("gate")
     write(root, "affinity.toml", "texture-size = 4\n")  # texels of a 4x4 texture: the creases 0.79 and 2.5
     for i in range(6):
         write(root, f"clean-{i}.obj", SQUARE)
     write(root, "crease.obj", trapezoids([0.1]))
     write(root, "mild.obj", trapezoids([0.9]))
+    write(root, "ramp.obj", trapezoids([0.9, 0.5, 0.1, 0.02]))  # 0.79 and 1.3 texels: warnings; 2.5, 3.3: errors
     return root
 
 
@@ -225,13 +226,33 @@ def _refused(gate_library, gate_shards, tmp_path, case) -> tuple[list[str], str]
     if case == "a SARIF log":
         sarif = write(tmp_path, "log.sarif", run("check", "--format", "sarif", ".", cwd=gate_library).stdout)
         return [one, two, three, str(sarif)], f"{sarif}: not an affinity check result"
+    if case == "damaged positions":
+        doc = json.loads(Path(two).read_text())
+        doc["shard"]["positions"] = json.loads(Path(one).read_text())["shard"]["positions"][:len(doc["files"])]
+        damaged = write(tmp_path, "damaged.json", json.dumps(doc))
+        return [one, str(damaged), three], f"{damaged}: its files do not fit the run's file list"
+    if case == "damaged numbers":
+        doc = json.loads(Path(two).read_text())
+        doc["shard"]["positions"] = ["first"] * len(doc["files"])
+        damaged = write(tmp_path, "damaged.json", json.dumps(doc))
+        return [one, str(damaged), three], f"{damaged}: a damaged affinity check result"
+    if case == "damaged levels":  # ramp.obj's worst error made a warning: above an error, no threshold explains it
+        docs = [json.loads(path.read_text()) for path in gate_shards]
+        (doc,) = [doc for doc in docs if any(f["path"] == "ramp.obj" for f in doc["findings"])]
+        ramp = [f for f in doc["findings"] if f["path"] == "ramp.obj"]
+        assert [f["level"] for f in ramp] == ["warning", "warning", "error", "error"]
+        ramp[-1]["level"] = "warning"
+        damaged = write(tmp_path, "damaged.json", json.dumps(doc))
+        others = [str(path) for path, other in zip(gate_shards, docs) if other is not doc]
+        return [str(damaged), *others], f"{damaged}: a damaged affinity check result"
     assert case == "unsharded"
     whole = write(tmp_path, "whole.json", run("check", "--format", "json", ".", cwd=gate_library).stdout)
     return [str(whole)], f"{whole}: not a shard's result (checked without --shard K/N)"
 
 
 @pytest.mark.parametrize("case", ["missing", "twice", "another run", "truncated", "other settings", "no such file",
-                                  "not JSON", "a SARIF log", "unsharded"])
+                                  "not JSON", "a SARIF log", "unsharded", "damaged positions", "damaged numbers",
+                                  "damaged levels"])
 def test_merge_refuses_what_is_not_one_whole_run(gate_library, gate_shards, tmp_path, case):
     inputs, line = _refused(gate_library, gate_shards, tmp_path, case)
     output = tmp_path / "merged.sarif"

@@ -67,12 +67,23 @@ def read_result(path: str) -> CheckResult:
             path=path,
             reports=_reports(doc["files"], doc["findings"]),
             settings=_settings(doc["settings"]),
-            shard=None if "shard" not in doc else ShardRecord(**doc["shard"]),
+            shard=None if "shard" not in doc else _shard_record(doc["shard"]),
             truncated="truncated" in doc,
             baselined=int(doc["summary"]["baselined"]),
         )
     except (KeyError, TypeError, ValueError, AttributeError, IndexError) as err:
         raise ResultError(f"a damaged affinity check result ({type(err).__name__}: {err})") from None
+
+
+def _shard_record(entry: dict) -> ShardRecord:
+    """The :class:`ShardRecord` of a JSON ``shard`` entry, its numbers checked."""
+    record = ShardRecord(**entry)
+    numbers = (record.index, record.of, record.run_files, *record.positions)
+    if not all(type(number) is int for number in numbers) or not 1 <= record.index <= record.of:
+        raise ValueError(f"shard numbers that are not a shard K/N with file positions: {entry}")
+    if not isinstance(record.run_digest, str) or not isinstance(record.version, str):
+        raise ValueError("a shard record without its run's digest or tool version")
+    return record
 
 
 def _settings(entry: dict) -> Settings:
