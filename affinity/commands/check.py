@@ -13,9 +13,13 @@ import contextlib
 import math
 import os
 import sys
+from typing import TYPE_CHECKING
 
 from ..errors import UsageError
 from . import EXIT_CLEAN, EXIT_ERROR, EXIT_FINDINGS
+
+if TYPE_CHECKING:
+    from ..shards.selection import Shard, ShardRecord
 
 
 def _codes(text: str) -> list[str]:
@@ -61,7 +65,7 @@ def _jobs(text: str) -> int:
     return int(text)
 
 
-def _shard(text: str):
+def _shard(text: str) -> Shard:
     from ..shards.selection import parse_shard
 
     return parse_shard(text)
@@ -284,7 +288,7 @@ def _tasks(resolver, paths: list[str]) -> list:
     ]
 
 
-def _shard_tasks(tasks: list, shard, resolver, baseline: bool) -> tuple[list, object]:
+def _shard_tasks(tasks: list, shard: Shard, resolver, baseline: bool) -> tuple[list, ShardRecord]:
     """The tasks of shard ``shard`` (:mod:`affinity.shards.selection`), in run order, and the record its
     result carries. Paths are hashed relative to the folder of the configuration file governing the
     working directory, else to the working directory."""
@@ -314,7 +318,7 @@ def run(args) -> int:
 
     if args.baseline and args.write_baseline:
         raise UsageError("--baseline and --write-baseline exclude each other")
-    if args.shard and args.write_baseline:
+    if args.shard is not None and args.write_baseline:
         raise UsageError("--write-baseline records the whole run's findings: run it without --shard")
     resolver = Resolver(_overrides(args), config=args.config, isolated=args.isolated)
     paths = list(args.paths)
