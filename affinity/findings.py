@@ -164,13 +164,14 @@ def report_to_bytes(report: FileReport) -> bytes:
 
 
 def report_from_bytes(data: bytes) -> FileReport:
-    """The report :func:`report_to_bytes` stored; a damaged blob raises ValueError."""
+    """The report :func:`report_to_bytes` stored; anything else (a damaged blob, a value that is not
+    bytes) raises ValueError."""
     import json
     import math
     import zlib
 
     try:
-        if not data.startswith(_BLOB_MAGIC):
+        if not isinstance(data, bytes) or not data.startswith(_BLOB_MAGIC):
             raise ValueError("no report header")
         body = bytearray(zlib.decompress(data[len(_BLOB_MAGIC):]))  # writable, so the arrays are
         size = int.from_bytes(body[:4], "little")
@@ -189,7 +190,7 @@ def report_from_bytes(data: bytes) -> FileReport:
         ]
         prim_face_start = arrays[4 * len(hits)] if len(arrays) > 4 * len(hits) else None
         return FileReport(**meta, hits=hits, prim_face_start=prim_face_start)
-    except (zlib.error, KeyError, TypeError, IndexError, UnicodeDecodeError) as err:
+    except (zlib.error, KeyError, TypeError, IndexError, AttributeError) as err:
         raise ValueError(f"not a stored report: {type(err).__name__}: {err}") from None
 
 
