@@ -8,6 +8,12 @@
   named pipe) cannot be replaced: the whole output is built in memory and
   written to it once, so a failure while producing it writes nothing.
 - A directory is refused (``IsADirectoryError``) before anything is produced.
+
+The temporary file is ``.NAME.PID-RANDOM.tmp``: it is removed when the
+writer fails, is interrupted or gets SIGTERM (see
+:func:`affinity.cli.console_main`); one left by a writer that was killed
+outright (SIGKILL, a power cut) is removed by the next write to NAME, once no
+process PID is running.
 """
 
 from __future__ import annotations
@@ -54,7 +60,8 @@ def atomic_write(path: str | os.PathLike, binary: bool = False):
     target = Path(os.path.realpath(path))
     import tempfile  # here, not at import: it pulls in shutil, random and the compression modules
 
-    fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
+    _remove_stale_temporaries(target)
+    fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.{os.getpid()}-", suffix=".tmp")
     try:
         os.fchmod(fd, stat.S_IMODE(mode) if mode is not None else 0o666 & ~_umask())
         with os.fdopen(fd, "wb" if binary else "w", **({} if binary else {"encoding": "utf-8", "newline": "\n"})) as f:
@@ -64,6 +71,29 @@ def atomic_write(path: str | os.PathLike, binary: bool = False):
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
         raise
+
+
+def _remove_stale_temporaries(target: Path) -> None:
+    """Remove the ``.NAME.PID-RANDOM.tmp`` files beside ``target`` whose writer PID is no longer running."""
+    if os.name != "posix":  # os.kill(pid, 0) would end the process on Windows
+        return
+    prefix = f".{target.name}."
+    try:
+        names = [entry.name for entry in os.scandir(target.parent)
+                 if entry.name.startswith(prefix) and entry.name.endswith(".tmp")]
+    except OSError:
+        return  # mkstemp says what is wrong with the folder
+    for name in names:
+        pid = name[len(prefix) : -len(".tmp")].partition("-")[0]
+        if not pid.isdigit() or int(pid) == os.getpid():
+            continue  # not one of ours, or this process's own
+        try:
+            os.kill(int(pid), 0)
+        except ProcessLookupError:
+            with contextlib.suppress(OSError):
+                os.unlink(target.parent / name)
+        except OSError:
+            pass  # running under another user
 
 
 @contextlib.contextmanager

@@ -84,9 +84,22 @@ def console_main() -> int:
     """
     import gc
 
+    _unwind_on_sigterm()
     code = main()
     gc.freeze()
     return code
+
+
+def _unwind_on_sigterm() -> None:
+    """SIGTERM ends the program as an exception does: ``finally`` blocks run, so a half-written output's
+    temporary file is removed and the ``--jobs`` workers are stopped; a second SIGTERM ends it at once."""
+    import signal
+
+    def terminated(signum, frame):
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        raise SystemExit(128 + signum)
+
+    signal.signal(signal.SIGTERM, terminated)
 
 
 if __name__ == "__main__":

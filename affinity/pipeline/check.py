@@ -191,13 +191,12 @@ def _check_here(tasks: list[tuple[str, Settings]], jobs: int | None, usd) -> Ite
         yield from map(check, paths, settings)
         return
 
-    from concurrent.futures import ProcessPoolExecutor
-
     from .. import lint, loaders  # noqa: F401  imported before the workers fork, so each inherits them
+    from .workers import local_pool
 
     # Small chunks balance uneven file sizes; a few per worker keep the pickling overhead low.
     chunksize = max(1, len(tasks) // (workers * 8))
-    with ProcessPoolExecutor(max_workers=workers) as pool:
+    with local_pool(workers) as pool:
         yield from pool.map(check, paths, settings, chunksize=chunksize)
 
 
