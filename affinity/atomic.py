@@ -8,6 +8,8 @@
   named pipe) cannot be replaced: the whole output is built in memory and
   written to it once, so a failure while producing it writes nothing.
 - A directory is refused (``IsADirectoryError``) before anything is produced.
+- ``-`` is standard output (the command-line convention: ``-o -``), written
+  once like a device; a file named ``-`` is ``./-``.
 
 The temporary file is ``.NAME.PID-RANDOM.tmp``: it is removed when the
 writer fails, is interrupted or gets SIGTERM (see
@@ -23,7 +25,11 @@ import errno
 import io
 import os
 import stat
+import sys
 from pathlib import Path
+
+#: The output path that means standard output.
+STDOUT = "-"
 
 
 def _umask() -> int:
@@ -49,6 +55,10 @@ def atomic_write(path: str | os.PathLike, binary: bool = False):
     is not writable, or ``path`` is a directory, so callers can turn it into
     one clear line.
     """
+    if os.fspath(path) == STDOUT:
+        with _write_once(None, binary) as out:
+            yield out
+        return
     mode = _existing_mode(Path(path))
     if mode is not None and stat.S_ISDIR(mode):
         raise IsADirectoryError(errno.EISDIR, "is a directory, not a file", os.fspath(path))
@@ -97,11 +107,20 @@ def _remove_stale_temporaries(target: Path) -> None:
 
 
 @contextlib.contextmanager
-def _write_once(target: Path, binary: bool):
-    """Collect the output in memory, then write it to the device or pipe ``target`` in one go."""
+def _write_once(target: Path | None, binary: bool):
+    """Collect the output in memory, then write it to the device or pipe ``target`` (None: standard
+    output) in one go."""
     buffer = io.BytesIO() if binary else io.StringIO(newline="\n")
     yield buffer
     data = buffer.getvalue()
+    if target is None:
+        if binary:
+            sys.stdout.flush()  # what was printed before comes first
+            sys.stdout.buffer.write(data)
+            sys.stdout.buffer.flush()
+        else:
+            sys.stdout.write(data)
+        return
     data = data if binary else data.encode("utf-8")
     with open(target, "wb", buffering=0) as out:
         view = memoryview(data)

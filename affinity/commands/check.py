@@ -145,7 +145,8 @@ def add_parser(sub) -> None:
     p.add_argument("--shard", type=_shard, metavar="K/N",
                    help="check only shard K of N (1-based): each file in exactly one shard, the same on every "
                         "machine; affinity merge joins the shards' --format json results into one")
-    p.add_argument("-o", "--output-file", metavar="PATH", help="write the output to PATH (whole or not at all)")
+    p.add_argument("-o", "--output-file", metavar="PATH",
+                   help="write the output to PATH (whole or not at all); - is standard output")
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="check the files on a Dask cluster: a scheduler address, env (DASK_SCHEDULER_ADDRESS) "
                         "or local:N (N local worker processes); needs the distributed extra. "
@@ -199,13 +200,16 @@ def _overrides(args) -> dict:
 def report_problems(reports, quiet: bool, skips_fail: bool = False) -> None:
     """Unreadable files (always), skipped files (unless quiet; always when they fail the run) and the
     loader's notes (unless quiet), one line each on stderr."""
+    from ..output.names import printable
+
     for report in reports:
+        path = printable(report.path)
         if report.error is not None:
-            sys.stderr.write(f"{report.path}:{report.error_line}: Q901 unreadable: {report.error}\n")
+            sys.stderr.write(f"{path}:{report.error_line}: Q901 unreadable: {report.error}\n")
         elif report.skipped is not None and (skips_fail or not quiet):
-            sys.stderr.write(f"{report.path}: skipped ({report.skipped})\n")
+            sys.stderr.write(f"{path}: skipped ({report.skipped})\n")
         for note in [] if quiet else report.notes:
-            sys.stderr.write(f"{report.path}: note: {note}\n")
+            sys.stderr.write(f"{path}: note: {note}\n")
 
 
 def _progress_bar():
@@ -306,8 +310,11 @@ def _write_baseline(reports, path: str, quiet: bool) -> None:
     recorded = baseline.record(reports, path)
     baseline.write(recorded, path)
     if not quiet:
+        from ..output.names import printable
+
         files = len({key[0] for key in recorded.counts})
-        sys.stderr.write(f"Wrote {sum(recorded.counts.values())} findings in {files} files to the baseline {path}.\n")
+        sys.stderr.write(f"Wrote {sum(recorded.counts.values())} findings in {files} files to the baseline "
+                         f"{printable(path)}.\n")
 
 
 def run(args) -> int:
@@ -329,7 +336,7 @@ def run(args) -> int:
     if args.show_settings:
         from ..output.show_settings import write_settings
 
-        write_settings(resolver, paths or [os.curdir], sys.stdout)
+        _write_output_file(args.output_file, lambda out: write_settings(resolver, paths or [os.curdir], out))
         return EXIT_CLEAN
     if args.baseline:
         from ..pipeline import baseline
@@ -341,7 +348,9 @@ def run(args) -> int:
     if args.shard is not None:
         tasks, shard = _shard_tasks(tasks, args.shard, resolver, bool(args.baseline))
     if args.show_files:
-        _write_output_file(args.output_file, lambda out: out.writelines(path + "\n" for path, _ in tasks))
+        from ..output.names import printable
+
+        _write_output_file(args.output_file, lambda out: out.writelines(printable(path) + "\n" for path, _ in tasks))
         return EXIT_CLEAN
     run_options = resolver.run_options()
     show_progress = len(tasks) > 1 and sys.stderr.isatty()
@@ -384,7 +393,8 @@ def _fails(reports, fail_on: str) -> bool:
 
 
 def _write_output_file(path: str | None, write) -> None:
-    """``write(out)`` to stdout, or to ``path`` atomically (a failed run leaves no partial file)."""
+    """``write(out)`` to stdout, or to ``path`` atomically (a failed run leaves no partial file; ``-`` is
+    standard output, written whole too)."""
     if path is None:
         write(sys.stdout)
         return
@@ -394,7 +404,9 @@ def _write_output_file(path: str | None, write) -> None:
         with atomic_write(path) as out:
             write(out)
     except OSError as err:
-        raise UsageError(f"{path}: cannot write the output: {err.strerror or err}") from None
+        from ..output.names import printable
+
+        raise UsageError(f"{printable(path)}: cannot write the output: {err.strerror or err}") from None
 
 
 def _write_output(check_run, args, out) -> None:

@@ -143,15 +143,17 @@ def run(args) -> int:
     _write(args.output, html)
     finished = time.perf_counter()
 
+    from ..output.names import printable
+
     failed = [result.file for result in report.meshes if result.file.error is not None]
     for file in failed:
-        sys.stderr.write(f"{file.path}:{file.error_line}: Q901 unreadable: {file.error}\n")
+        sys.stderr.write(f"{printable(file.path)}:{file.error_line}: Q901 unreadable: {file.error}\n")
     for file in skipped:
-        sys.stderr.write(f"{file.path}: skipped ({file.skipped})\n")
+        sys.stderr.write(f"{printable(file.path)}: skipped ({file.skipped})\n")
     if not args.quiet:
         unreadable = f", {len(failed)} unreadable" if failed else ""
         unreadable += f", {len(skipped)} skipped" if skipped else ""
-        sys.stderr.write(f"affinity report: wrote {args.output} "
+        sys.stderr.write(f"affinity report: wrote {printable(args.output)} "
                          f"({len(inputs)} file{'s' * (len(inputs) != 1)}{unreadable}, "
                          f"{len(html.encode()) / 1e6:.1f} MB, {finished - start:.1f} s wall: "
                          f"{report.seconds:.1f} s collecting, {finished - collected:.1f} s writing the page)\n")

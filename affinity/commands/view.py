@@ -48,15 +48,16 @@ def _scores(mesh, path: str, attribute: str | None):
 
 def run(args) -> int:
     from ..loaders import load
+    from ..output.names import printable
     from ..view import overview_image, show
 
     require(("pyvista",), "view")
     try:
         mesh = load(args.mesh)
     except MeshError as err:
-        raise UsageError(f"{err.path}:{err.line}: {err.reason}") from None
+        raise UsageError(f"{printable(err.path)}:{err.line}: {err.reason}") from None
     except SkippedFile as skip:
-        raise UsageError(f"{skip.path}: skipped ({skip.reason})") from None
+        raise UsageError(f"{printable(skip.path)}: skipped ({skip.reason})") from None
     scores = _scores(mesh, args.mesh, args.attribute)
     if args.screenshot is None:
         show(mesh, scores, args.up)

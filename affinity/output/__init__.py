@@ -276,10 +276,12 @@ def located(f: Finding) -> str:
 def text_line(f: Finding) -> str:
     """The ruff-style line ``path:line:col: CODE name: message (value vs threshold unit) [face F]``
     (design.md); ``path:prim:face N: ...`` in USD, no ``[face]`` for file-level findings."""
+    from .names import printable
+
     if f.prim is not None:
-        return f"{f.path}:{f.prim}:face {f.face}: {f.code} {f.name}: {describe(f)}"
+        return f"{printable(f.path)}:{f.prim}:face {f.face}: {f.code} {f.name}: {describe(f)}"
     face = f" [face {f.face}]" if f.face >= 0 else ""
-    return f"{f.path}:{f.line}:{f.column}: {f.code} {f.name}: {describe(f)}{face}"
+    return f"{printable(f.path)}:{f.line}:{f.column}: {f.code} {f.name}: {describe(f)}{face}"
 
 
 def working_relative(path: str) -> str | None:

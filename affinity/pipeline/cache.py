@@ -222,7 +222,9 @@ class ResultCache:
         """One warning line a run (the first problem); ``off`` also closes the cache for the rest of it."""
         if not self._warned:
             action = "; checking without it" if off else ""
-            sys.stderr.write(f"affinity: warning: result cache {self.path}: {reason}{action}\n")
+            from ..output.names import printable
+
+            sys.stderr.write(f"affinity: warning: result cache {printable(self.path)}: {reason}{action}\n")
             self._warned = True
         if off:
             self._close_quietly()
