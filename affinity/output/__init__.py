@@ -18,6 +18,7 @@ import numpy as np
 from ..findings import FileReport, RuleHits
 from ..rules import LEVELS, RULES, with_unit
 from ..settings import Settings
+from .names import printable
 
 if TYPE_CHECKING:
     from ..shards.selection import ShardRecord
@@ -276,8 +277,6 @@ def located(f: Finding) -> str:
 def text_line(f: Finding) -> str:
     """The ruff-style line ``path:line:col: CODE name: message (value vs threshold unit) [face F]``
     (design.md); ``path:prim:face N: ...`` in USD, no ``[face]`` for file-level findings."""
-    from .names import printable
-
     if f.prim is not None:
         return f"{printable(f.path)}:{f.prim}:face {f.face}: {f.code} {f.name}: {describe(f)}"
     face = f" [face {f.face}]" if f.face >= 0 else ""

@@ -140,23 +140,22 @@ def _json(value) -> str:
     return json.dumps(value, sort_keys=True, separators=(",", ":"))
 
 
-def _checksum(*fields: str | bytes) -> str:
-    """BLAKE2 of a row's fields (text or bytes), each prefixed by its length so no two rows share one."""
-    digest = blake2b(digest_size=16)
-    for field in fields:
-        data = field.encode("utf-8", "surrogateescape") if isinstance(field, str) else field
-        digest.update(len(data).to_bytes(8, "little"))
-        digest.update(data)
-    return digest.hexdigest()
+def _checksum(key: str | bytes, data: str | bytes) -> str:
+    """A row's checksum: BLAKE2 of its ``data`` keyed with its primary key (at most 64 bytes of it, the
+    rest hashed in), so a row moved under another key fails too."""
+    key = key.encode("utf-8", "surrogateescape") if isinstance(key, str) else key
+    data = data.encode("utf-8", "surrogateescape") if isinstance(data, str) else data
+    return blake2b(key[64:] + b"\0" + data, key=key[:64], digest_size=16).hexdigest()
+
+
+def _file_checksum(name: bytes, signature: tuple, digest: str, deps: str) -> str:
+    """The checksum of a ``files`` row (ASCII JSON of its fields: the same text on every Python)."""
+    return _checksum(name, json.dumps([*signature, digest, deps]))
 
 
 def _signature(st: os.stat_result) -> tuple[int, int, int, int, int]:
     """What tells a file's versions apart without reading it: (size, mtime_ns, ctime_ns, inode, device)."""
     return st.st_size, st.st_mtime_ns, st.st_ctime_ns, st.st_ino, st.st_dev
-
-
-def _is_digest(value) -> bool:
-    return isinstance(value, str) and len(value) == 40 and all(c in "0123456789abcdef" for c in value)
 
 
 class _DamagedRow(ValueError):
@@ -350,20 +349,21 @@ class ResultCache:
                 deps = _json({"readers": readers, "deps": found[1]})
                 self._write("INSERT OR REPLACE INTO files VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
                             (os.fsencode(path), *signature, found[0], deps, self._now,
-                             _checksum(os.fsencode(path), _json(signature), found[0], deps)))
+                             _file_checksum(os.fsencode(path), signature, found[0], deps)))
         read.append((path, signature, found[0] if racy else None))
         return found
 
     def _stored_digest(self, path: str, signature: tuple, readers: str) -> tuple[str, list[str]] | None:
         """The stored hash and dependencies of ``path`` when its row has ``signature`` and passes its checks."""
+        name = os.fsencode(path)
         row = self._fetch("SELECT size, mtime_ns, ctime_ns, inode, device, digest, deps, checksum FROM files "
-                          "WHERE path = ?", (os.fsencode(path),))
+                          "WHERE path = ?", (name,))
         if row is None or tuple(row[:5]) != signature:
             return None  # a new or changed file (or a damaged signature: the same outcome)
         digest, deps, checksum = row[5:]
         try:
-            if not (isinstance(deps, str) and isinstance(checksum, str) and _is_digest(digest)
-                    and checksum == _checksum(os.fsencode(path), _json(signature), digest, deps)):
+            if not (isinstance(digest, str) and isinstance(deps, str) and isinstance(checksum, str)
+                    and checksum == _file_checksum(name, signature, digest, deps)):
                 raise _DamagedRow("a file's row fails its checksum")
             stored = json.loads(deps)
         except ValueError as err:
