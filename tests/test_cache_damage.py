@@ -152,3 +152,16 @@ def run_cached(folder: Path, cache: Path) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--format", "json", str(folder)],
                           capture_output=True, text=True, timeout=120,
                           env={**os.environ, "AFFINITY_CACHE_DIR": str(cache)})
+
+
+def test_files_of_other_layouts_and_set_aside_ones_go_after_a_month(filled, library, capsys):
+    month = 31 * 86_400
+    folder = filled.parent
+    stale = [folder / "results-v1.sqlite", folder / "results-v1.sqlite-wal", folder / f"{DB_NAME}{DAMAGED_SUFFIX}"]
+    kept = [folder / "results-v3-0123abcd.sqlite", folder / "notes.txt"]  # a newer version in use; not ours
+    for path in stale + kept:
+        path.write_bytes(b"")
+    for path in stale + kept[1:]:
+        os.utime(path, (path.stat().st_atime - month, path.stat().st_mtime - month))
+    check(library, capsys)
+    assert sorted(os.listdir(folder)) == sorted([DB_NAME, "results-v3-0123abcd.sqlite", "notes.txt"])

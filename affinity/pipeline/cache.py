@@ -46,11 +46,13 @@ A run writes at most one warning line about its cache, naming the file. Reports
 that say more about the run than about the file (``FileReport.transient``: an
 internal error, a Dask worker that cannot see the path) are never stored.
 Entries unused for :data:`MAX_AGE_DAYS` days go, and the oldest go first when the
-entries exceed :data:`MAX_BYTES`.
+entries exceed :data:`MAX_BYTES`; so do the files of other layouts (other versions of
+the tool) and set-aside ones that nothing has written for as long.
 """
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import json
 import os
@@ -62,6 +64,7 @@ import time
 from ..errors import MeshError
 from ..findings import FileReport, report_from_bytes, report_to_bytes
 from ..loaders.formats import format_named
+from ..output.names import printable
 from ..settings import Settings
 
 try:  # the BLAKE2 module itself: hashlib would load OpenSSL first, a few ms of every start
@@ -80,15 +83,21 @@ COMMIT_EVERY = 200
 _DAY = 86_400.0
 _CHUNK = 1 << 20
 
-#: The tables, exactly as SQLite keeps their statements in ``sqlite_master``.
+#: The tables, exactly as SQLite keeps their statements in ``sqlite_master``. WITHOUT ROWID: one
+#: b-tree a table, keyed by the primary key, so no separate index can disagree with its table (a
+#: damaged index entry made an INSERT OR REPLACE add a second row for one path, which SQLite
+#: reported as a malformed database only in the run after).
 _TABLES = {
     "files": "CREATE TABLE files (path BLOB PRIMARY KEY, size INTEGER, mtime_ns INTEGER, ctime_ns INTEGER, "
-             "inode INTEGER, device INTEGER, digest TEXT, deps TEXT, used REAL, checksum TEXT)",
-    "results": "CREATE TABLE results (key TEXT PRIMARY KEY, report BLOB, used REAL, checksum TEXT)",
+             "inode INTEGER, device INTEGER, digest TEXT, deps TEXT, used REAL, checksum TEXT) WITHOUT ROWID",
+    "results": "CREATE TABLE results (key TEXT PRIMARY KEY, report BLOB, used REAL, checksum TEXT) WITHOUT ROWID",
 }
 _LAYOUT = blake2b(json.dumps([SCHEMA, _TABLES], sort_keys=True).encode(), digest_size=4).hexdigest()
 DB_NAME = f"results-v{SCHEMA}-{_LAYOUT}.sqlite"
 DAMAGED_SUFFIX = ".damaged"
+#: What a call into SQLite raises: its errors, and a UnicodeDecodeError when Python decodes an error
+#: message quoting damaged bytes of the schema.
+_DATABASE_ERRORS = (sqlite3.Error, UnicodeDecodeError)
 
 
 def cache_folder() -> str:
@@ -184,7 +193,7 @@ class ResultCache:
         self._now = time.time()
         try:
             self._db = self._open(self.path)
-        except sqlite3.Error as err:
+        except _DATABASE_ERRORS as err:
             if _is_damage(err):
                 self._set_aside(err)
             else:
@@ -197,11 +206,11 @@ class ResultCache:
         """The database at ``path``, created when new; DatabaseError when its tables are not :data:`_TABLES`."""
         os.makedirs(os.path.dirname(path), exist_ok=True)
         db = sqlite3.connect(path, timeout=10)
+        db.text_factory = _text  # damaged text is a row that fails its checks, not an error of the whole file
         try:
             db.execute("PRAGMA journal_mode=WAL")
             db.execute("PRAGMA synchronous=NORMAL")
             db.execute("PRAGMA cell_size_check=ON")  # a damaged page is an error, not a wrong row
-            db.text_factory = _text  # damaged text is a row that fails its checks, not an error of the whole file
             tables = _tables(db)
             if not tables:
                 with db:
@@ -221,8 +230,6 @@ class ResultCache:
         """One warning line a run (the first problem); ``off`` also closes the cache for the rest of it."""
         if not self._warned:
             action = "; checking without it" if off else ""
-            from ..output.names import printable
-
             sys.stderr.write(f"affinity: warning: result cache {printable(self.path)}: {reason}{action}\n")
             self._warned = True
         if off:
@@ -232,7 +239,7 @@ class ResultCache:
         if self._db is not None:
             try:
                 self._db.close()
-            except sqlite3.Error:
+            except _DATABASE_ERRORS:
                 pass
             self._db = None
 
@@ -250,13 +257,13 @@ class ResultCache:
                 if os.path.exists(self.path + suffix):
                     os.replace(self.path + suffix, self.path + DAMAGED_SUFFIX + suffix)
             self._db = self._open(self.path)
-        except (OSError, sqlite3.Error) as again:
+        except (OSError, *_DATABASE_ERRORS) as again:
             self._warn(f"cannot replace it ({again})")
             return
         for key, report in self._kept.items():
             self._store(key, report)
 
-    def _failed(self, err: sqlite3.Error, doing: str) -> None:
+    def _failed(self, err: Exception, doing: str) -> None:
         """A database call failed: damage sets the file aside; anything else (locked, full, read-only)
         ends the cache for this run."""
         if _is_damage(err):
@@ -274,7 +281,7 @@ class ResultCache:
             return None
         try:
             return self._db.execute(sql, values).fetchone()
-        except sqlite3.Error as err:
+        except _DATABASE_ERRORS as err:
             self._failed(err, "read")
             return None
 
@@ -423,7 +430,7 @@ class ResultCache:
             if self._pending >= COMMIT_EVERY:
                 self._db.commit()
                 self._pending = 0
-        except sqlite3.Error as err:
+        except _DATABASE_ERRORS as err:
             self._failed(err, "write")
 
     def close(self) -> None:
@@ -443,9 +450,25 @@ class ResultCache:
                     "OVER (ORDER BY used DESC, key) AS running FROM results) WHERE running > ?)", (MAX_BYTES,))
                 self._db.commit()
                 break
-            except sqlite3.Error as err:
+            except _DATABASE_ERRORS as err:
                 self._failed(err, "write")
         self._close_quietly()
+        self._remove_unused_files(old)
+
+    def _remove_unused_files(self, old: float) -> None:
+        """Delete the databases of other layouts (other versions of the tool) and set-aside ones that
+        nothing has written for :data:`MAX_AGE_DAYS` days: an upgrade must not leave 200 MB behind for good."""
+        ours = {DB_NAME, f"{DB_NAME}-wal", f"{DB_NAME}-shm"}
+        try:
+            with os.scandir(self.folder) as entries:
+                unused = [entry.path for entry in entries if entry.name.startswith("results-v")
+                          and ".sqlite" in entry.name and entry.name not in ours
+                          and entry.stat(follow_symlinks=False).st_mtime < old]
+        except OSError:
+            return
+        for path in unused:
+            with contextlib.suppress(OSError):
+                os.remove(path)
 
 
 def _text(data: bytes) -> str:
@@ -458,10 +481,11 @@ def _tables(db: sqlite3.Connection) -> dict[str, str]:
     return dict(db.execute("SELECT name, sql FROM sqlite_master WHERE type = 'table'").fetchall())
 
 
-def _is_damage(err: sqlite3.Error) -> bool:
+def _is_damage(err: Exception) -> bool:
     """Whether SQLite says the file is damaged or no database (SQLITE_CORRUPT, SQLITE_NOTADB), rather than
-    locked, full or read-only: Python raises the plain DatabaseError for exactly those."""
-    return type(err) is sqlite3.DatabaseError
+    locked, full or read-only: Python raises the plain DatabaseError for exactly those, and a
+    UnicodeDecodeError when the message quotes damaged schema text."""
+    return type(err) is sqlite3.DatabaseError or isinstance(err, UnicodeDecodeError)
 
 
 def _unchanged(read: list[tuple[str, tuple | None, str | None]]) -> bool:
