@@ -110,40 +110,38 @@ def test_no_process_of_a_two_job_run_outlives_a_signal(big_meshes, tmp_path, sig
     assert temporaries(tmp_path) == [] and not (tmp_path / "out.json").exists()
 
 
-def test_sigterm_while_writing_the_output_removes_the_temporary_file(big_meshes, tmp_path):
-    out = tmp_path / "out.json"
-    out.write_text("the previous result\n")
-    run = start("check", "--no-cache", "--format", "json", "-o", str(out), "grid0.obj", cwd=big_meshes)
+def signal_while_writing(out: Path, signum: int, cwd: Path) -> subprocess.Popen:
+    """``check -o OUT`` of the 90,000-quad grid, sent ``signum`` once its temporary file exists; finished."""
+    run = start("check", "--no-cache", "--format", "json", "-o", str(out), "grid0.obj", cwd=cwd)
     try:
-        assert wait_for(lambda: temporaries(tmp_path), 60), "the output was never written"
-        os.kill(run.pid, signal.SIGTERM)
+        assert wait_for(lambda: temporaries(out.parent), 60), "the output was never written"
+        os.kill(run.pid, signum)
         run.wait(timeout=5)
     finally:
         run.kill()
         run.wait()
+    return run
+
+
+def test_sigterm_while_writing_the_output_removes_the_temporary_file(big_meshes, tmp_path):
+    out = tmp_path / "out.json"
+    out.write_text("the previous result\n")
+    run = signal_while_writing(out, signal.SIGTERM, big_meshes)
     assert run.returncode == 128 + signal.SIGTERM and "Traceback" not in run.stderr.read()
     assert temporaries(tmp_path) == [] and out.read_text() == "the previous result\n"
 
 
 def test_the_next_write_removes_a_temporary_file_left_by_a_killed_run(big_meshes, tmp_path):
     out = tmp_path / "out.json"
-    run = start("check", "--no-cache", "--format", "json", "-o", str(out), "grid0.obj", cwd=big_meshes)
-    try:
-        assert wait_for(lambda: temporaries(tmp_path), 60), "the output was never written"
-        os.kill(run.pid, signal.SIGKILL)
-        run.wait(timeout=5)
-    finally:
-        run.kill()
-        run.wait()
+    run = signal_while_writing(out, signal.SIGKILL, big_meshes)
     [stale] = temporaries(tmp_path)
     assert stale.startswith(f".out.json.{run.pid}-")
     mine = tmp_path / f".out.json.{os.getpid()}-live.tmp"  # a writer still running: this test
     foreign = tmp_path / ".out.json.notes.tmp"  # not a name this tool writes
     mine.write_text("")
     foreign.write_text("")
-    (big_meshes / "small.obj").write_text("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n")
+    (tmp_path / "small.obj").write_text("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n")
     done = subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--no-cache", "-o", str(out), "small.obj"],
-                          cwd=big_meshes, capture_output=True, text=True, timeout=120)
-    (big_meshes / "small.obj").unlink()
+                          cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     assert temporaries(tmp_path) == sorted([mine.name, foreign.name]) and out.is_file()
