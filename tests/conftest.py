@@ -48,13 +48,15 @@ def result_cache_folder(tmp_path_factory):
 
 
 @pytest.fixture
-def an_hour_later(monkeypatch):
+def an_hour_later():
     """The result cache runs an hour after the test wrote its files, so none is in its racy window
     (which reads a file's ctime: that, unlike the mtime, cannot be dated back)."""
     from affinity.pipeline import cache as cache_module
 
     clock = time.time
-    monkeypatch.setattr(cache_module, "time", SimpleNamespace(time=lambda: clock() + 3600))
+    with pytest.MonkeyPatch.context() as patch:  # its own: a test's monkeypatch.undo() leaves it
+        patch.setattr(cache_module, "time", SimpleNamespace(time=lambda: clock() + 3600))
+        yield
 
 
 class Counting:

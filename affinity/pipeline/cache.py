@@ -357,7 +357,9 @@ class ResultCache:
                 self._write("INSERT OR REPLACE INTO files VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
                             (os.fsencode(path), *signature, found[0], deps, self._now,
                              _file_checksum(os.fsencode(path), signature, found[0], deps)))
-        read.append((path, signature, found[0] if racy else None))
+        # A racy file is hashed again before its report is stored, unless the check parses the very
+        # bytes hashed here (``source``).
+        read.append((path, signature, found[0] if racy and source is None else None))
         return found
 
     def _stored_digest(self, path: str, signature: tuple, readers: str) -> tuple[str, list[str]] | None:
