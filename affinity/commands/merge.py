@@ -24,7 +24,8 @@ def add_parser(sub) -> None:
     p.add_argument("results", nargs="+", metavar="RESULT.json", help="the shards' JSON results, in any order")
     p.add_argument("--format", choices=FORMATS, default="text",
                    help="text (default), json, sarif (code scanning), github (workflow annotations), junit")
-    p.add_argument("-o", "--output-file", metavar="PATH", help="write the output to PATH (whole or not at all)")
+    p.add_argument("-o", "--output-file", metavar="PATH",
+                   help="write the output to PATH (whole or not at all); - is standard output")
     add_gate_arguments(p)
     add_display_arguments(p)
     p.set_defaults(run=run)
