@@ -72,7 +72,7 @@ def run(args) -> int:
     try:
         result.save_png(args.output)
     except OSError as err:
-        raise UsageError(f"{args.output}: cannot write ({err.strerror or err})") from None
+        raise UsageError(f"{printable(args.output)}: cannot write ({err.strerror or err})") from None
     if not args.quiet:
         sys.stderr.write(result.summary() + f"; wrote {printable(args.output)}\n")
     return EXIT_CLEAN
