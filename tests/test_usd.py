@@ -121,6 +121,8 @@ def test_notes_name_what_was_not_checked():
         "2 mesh prims skipped (invisible, or guide/proxy purpose)",
         ("PointInstancer /World/Scatter: 3 copies of 1 prototype not expanded "
          "(each prototype mesh is checked once, where it is defined)"),
+        ("6 of 6 mesh prims subdivide (subdivisionScheme catmullClark, authored or USD's default): the findings "
+         "are for the cage, which is what Storm draws at its default complexity and what game engines draw"),
     ]
 
 
@@ -335,7 +337,7 @@ def test_json_carries_prim_and_stage_metadata():
     doc = json.loads(check("--format", "json", str(SCENE)).stdout)
     [entry] = doc["files"]
     assert (entry["up_axis"], entry["meters_per_unit"], entry["faces"]) == ("Z", 0.01, 11)
-    assert len(entry["notes"]) == 2
+    assert len(entry["notes"]) == 3  # hidden prims, the PointInstancer, the subdivision surfaces
     first = doc["findings"][0]
     assert {k: first[k] for k in ("line", "column", "face", "prim", "group", "code")} == {
         "line": 0, "column": 0, "face": 0, "prim": "/World/Panel", "group": "/World/Panel", "code": "Q102"}
