@@ -14,7 +14,7 @@ from contextlib import AbstractContextManager, nullcontext
 from functools import partial
 
 from ..errors import MeshError, SkippedFile
-from ..findings import FileReport, settle
+from ..findings import FileReport, settle, share_authored_geometry
 from ..mesh import Mesh
 from ..settings import Settings
 
@@ -43,10 +43,13 @@ def load_and_check(path: str, settings: Settings, usd=None,
         mesh = load(path, usd, source)
         ignores = _inline_ignores(source, mesh) if reads_whole(path) else []
         del source  # not needed past here: a big file's bytes are not held while its mesh is linted
+        hits, shared = share_authored_geometry(
+            settle(lint_mesh(mesh, settings), settings, list(mesh.group_names), ignores), mesh)
         report = FileReport(
             path,
             counts=mesh.counts(),
-            hits=settle(lint_mesh(mesh, settings), settings, list(mesh.group_names), ignores),
+            hits=hits,
+            shared=shared,
             group_names=list(mesh.group_names),
             prim_face_start=mesh.prim_face_start,
             up_axis=mesh.up_axis,
