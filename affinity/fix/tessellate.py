@@ -1,0 +1,87 @@
+"""Transition faces: a face beside refined quads, re-cut so it meets every new edge point.
+
+A face whose edges carry new points (an edge shared with a refined quad, split into n)
+is replaced by triangles (and quads) over its *ring*: its corners and, after each
+corner, the points on the edge that leaves it, in the face's own order. No vertex is
+added inside the face except in the last resort below, so the values on the shared
+edge are the edge's own linear blend on both sides and nothing cracks.
+
+Three cuts, the first that applies:
+
+* a fan from an *apex*, a corner whose two edges carry no point (for a concave quad
+  only its reflex corner, from which the whole quad is seen): M - 2 triangles for a
+  ring of M points, so a quad with one edge split in n gains n faces;
+* a quad whose two opposite edges carry points (and the other two none): a strip
+  between them, quads where the two edges carry as many points, else a zipper of
+  triangles that advances along whichever edge lags in its parameter;
+* otherwise a fan from the face's centre (the bilinear centre of a quad, the corner
+  mean of another face), M triangles.
+
+A cut depends only on the face's size, its edges' point counts and where an apex may
+stand, so it is built once per such *pattern* as local polygons over ring positions
+(:func:`transition_polygons`) and applied to every face of the pattern at once.
+"""
+
+from __future__ import annotations
+
+from functools import cache
+
+#: Ring position of the centre vertex: one past the ring (``len(ring)``) in a pattern's polygons.
+CENTRE = -1
+
+
+def ring_corners(counts: tuple[int, ...]) -> list[int]:
+    """Ring position of every corner: corner i follows its predecessors' edges' points."""
+    positions, at = [], 0
+    for m in counts:
+        positions.append(at)
+        at += m
+    return positions
+
+
+@cache
+def transition_polygons(counts: tuple[int, ...], apex_allowed: tuple[bool, ...]) -> tuple[tuple[int, ...], ...]:
+    """The cut of a face with ``counts[i]`` segments on edge i (corner i to corner i + 1).
+
+    Parameters
+    ----------
+    counts : (k,) segments per edge, 1 for an edge without points.
+    apex_allowed : (k,) which corners may be a fan's apex.
+
+    Returns
+    -------
+    Polygons as ring positions (0 .. M - 1, M = sum(counts)), :data:`CENTRE` for the
+    centre vertex; each keeps the face's orientation.
+    """
+    k, M = len(counts), sum(counts)
+    corner = ring_corners(counts)
+    for i in range(k):
+        if apex_allowed[i] and counts[i] == 1 and counts[i - 1] == 1:
+            apex = corner[i]
+            return tuple((apex, (apex + r) % M, (apex + r + 1) % M) for r in range(1, M - 1))
+    if k == 4:
+        for first in (0, 1):
+            if counts[first + 1] == 1 and counts[(first + 3) % 4] == 1:
+                return _strip(counts, corner, first)
+    return tuple((r, (r + 1) % M, CENTRE) for r in range(M))
+
+
+def _strip(counts: tuple[int, ...], corner: list[int], first: int) -> tuple[tuple[int, ...], ...]:
+    """A quad's cut between its split edges ``first`` and ``first + 2``: quads when they carry
+    as many segments, else a zipper of triangles."""
+    M = sum(counts)
+    a_count, b_count = counts[first], counts[first + 2]
+    along_a = [corner[first] + i for i in range(a_count + 1)]  # corner first -> corner first + 1
+    # edge first + 2 runs corner first + 2 -> first + 3; read backwards it runs beside edge first
+    along_b = [(corner[first + 2] + b_count - j) % M for j in range(b_count + 1)]
+    if a_count == b_count:
+        return tuple((along_a[i], along_a[i + 1], along_b[i + 1], along_b[i]) for i in range(a_count))
+    polygons, i, j = [], 0, 0
+    while i < a_count or j < b_count:
+        if j == b_count or (i < a_count and (i + 1) * b_count <= (j + 1) * a_count):
+            polygons.append((along_a[i], along_a[i + 1], along_b[j]))
+            i += 1
+        else:
+            polygons.append((along_a[i], along_b[j + 1], along_b[j]))
+            j += 1
+    return tuple(polygons)
