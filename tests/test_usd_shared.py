@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 from helpers.cli import run
 from helpers.sarif import assert_valid
-from helpers.usd_stages import SMALL, UNIT, referenced_stage
+from helpers.usd_stages import BIG, SMALL, ST, referenced_stage
 
 pytest.importorskip("pxr", reason="needs the usd extra (usd-core)")
 
@@ -39,11 +39,9 @@ def test_four_prims_referencing_one_layer_report_each_finding_once(tmp_path):
 
 
 def test_prims_with_their_own_uv_carry_the_worst_and_each_value(tmp_path):
-    """Prim C authors face 1's uv as face 0's unit square (an error), B face 0's as the small square:
+    """Prim C authors face 1's uv as face 0's bigger square (an error), B face 0's as the small square:
     the finding takes the worst and lists each prim's value; truth is each variant checked alone."""
-    from helpers.usd_stages import ST
-
-    bigger = [*ST[:4], *UNIT, *ST[8:]]
+    bigger = [*ST[:4], *BIG, *ST[8:]]
     smaller = [*SMALL, *ST[4:]]
     stage = referenced_stage(tmp_path, override_st={"B": smaller, "C": bigger})
     big_value = check_json(tmp_path / "knight.usda")["findings"][0]["value"]

@@ -122,7 +122,7 @@ def load_usd(path, options: UsdOptions | None = None) -> Mesh:
     try:
         stage = Usd.Stage.Open(os.fspath(path))
     except Tf.ErrorException as error:
-        reason = _pxr_reason(error)
+        reason = pxr_reason(error)
         line = _TEXT_LINE.search(reason)  # .usda parse errors say where: "file.usda:7:9: ..."
         raise MeshError(path, int(line.group(1)) if line else 0, f"cannot open the stage: {reason}") from None
     mesh = load_stage(stage, os.fspath(path), options)
@@ -131,11 +131,14 @@ def load_usd(path, options: UsdOptions | None = None) -> Mesh:
     return mesh
 
 
-def load_stage(stage, path: str, options: UsdOptions | None = None, prim_paths: list[str] | None = None) -> Mesh:
+def load_stage(stage, path: str, options: UsdOptions | None = None, prim_paths: list[str] | None = None,
+               world: bool = True, bad_prims: dict[str, str] | None = None) -> Mesh:
     """The drawn mesh prims of an open ``Usd.Stage`` as one mesh named ``path``: all of them, or those
-    of ``prim_paths`` (in that order), as :func:`load_usd` reads a file.
+    of ``prim_paths`` (in that order), as :func:`load_usd` reads a file; with ``world`` False each
+    prim in its own local space (points and normals as authored, for writing back).
 
-    Raises MeshError and SkippedFile as :func:`load_usd` does.
+    Raises MeshError and SkippedFile as :func:`load_usd` does. With ``bad_prims`` (a dict) a prim
+    that cannot be read is left out and its path mapped to the reason there instead of raising.
     """
     from pxr import Tf, Usd, UsdGeom
 
@@ -148,17 +151,26 @@ def load_stage(stage, path: str, options: UsdOptions | None = None, prim_paths: 
         else:
             prims, notes = [stage.GetPrimAtPath(prim_path) for prim_path in prim_paths], []
     except Tf.ErrorException as error:
-        raise MeshError(path, 0, f"cannot read the stage: {_pxr_reason(error)}") from None
+        raise MeshError(path, 0, f"cannot read the stage: {pxr_reason(error)}") from None
     if not prims:  # a material, light or layout layer: nothing of ours to check
         raise SkippedFile(path, "no-mesh")
-    parts, sources = [], []
+    parts, sources, read = [], [], []
     for prim in prims:
         try:
-            parts.append(_read_prim(prim, time, xforms, options.uv_primvar))
-            sources.append(geometry_source(prim, time))
+            part, source = _read_prim(prim, time, xforms if world else None, options.uv_primvar), \
+                geometry_source(prim, time)
         except (_BadPrim, Tf.ErrorException) as error:
-            reason = str(error) if isinstance(error, _BadPrim) else _pxr_reason(error)
-            raise MeshError(path, 0, f"{prim.GetPath()}: {reason}") from None
+            reason = str(error) if isinstance(error, _BadPrim) else pxr_reason(error)
+            if bad_prims is None:
+                raise MeshError(path, 0, f"{prim.GetPath()}: {reason}") from None
+            bad_prims[str(prim.GetPath())] = reason
+            continue
+        parts.append(part)
+        sources.append(source)
+        read.append(prim)
+    if not read:  # every prim asked for was bad (and reported in bad_prims)
+        raise SkippedFile(path, "no-mesh")
+    prims = read
     subdivided = _subdivision_note(prims, time)
     if subdivided:
         notes.append(subdivided)
@@ -221,12 +233,12 @@ def _stage_metadata(stage, name: str, read, notes: list[str]):
     try:
         return read()
     except (Tf.ErrorException, TypeError, ValueError) as error:
-        reason = _pxr_reason(error) if isinstance(error, Tf.ErrorException) else str(error)
+        reason = pxr_reason(error) if isinstance(error, Tf.ErrorException) else str(error)
         notes.append(f"the stage's {name} cannot be read ({reason}): not recorded")
         return None
 
 
-def _pxr_reason(error) -> str:
+def pxr_reason(error) -> str:
     """The first (most specific) message of a ``Tf.ErrorException``, on one line."""
     text = getattr(error.args[0], "commentary", str(error)) if error.args else str(error)
     return " ".join(_INTERNAL_NAME.sub("", text).split())
@@ -271,7 +283,8 @@ def _finite(name: str, values: np.ndarray) -> np.ndarray:
 
 
 def _read_prim(prim, time, xforms, uv_primvar: str | None) -> Mesh:
-    """One mesh prim in world space, corners in right-handed order (see the module docstring)."""
+    """One mesh prim in world space (in its own space when ``xforms`` is None), corners in
+    right-handed order (see the module docstring)."""
     from pxr import UsdGeom
 
     usd_mesh = UsdGeom.Mesh(prim)
@@ -280,7 +293,7 @@ def _read_prim(prim, time, xforms, uv_primvar: str | None) -> Mesh:
     corner_vertex = _array(usd_mesh.GetFaceVertexIndicesAttr().Get(time), np.int64)
     _check_topology(sizes, corner_vertex, len(points))
     face_start = np.concatenate(([0], np.cumsum(sizes)))
-    matrix = np.array(xforms.GetLocalToWorldTransform(prim))  # (4, 4), row vectors: p' = p M
+    matrix = np.eye(4) if xforms is None else np.array(xforms.GetLocalToWorldTransform(prim))  # row vectors: p' = p M
     topology = (len(points), sizes, corner_vertex)
 
     primvars = UsdGeom.PrimvarsAPI(prim)
@@ -364,6 +377,15 @@ def _uv_primvar(primvars, time, name: str | None) -> _Primvar | None:
         chosen = next((pv for pv in primvars.FindPrimvarsWithInheritance()
                        if str(pv.GetTypeName()) in _TEXCOORD2 and pv.HasValue()), None)
     return _primvar(chosen, time, width=2)
+
+
+def uv_primvar_name(prim, time, name: str | None = None) -> str | None:
+    """The attribute name (``primvars:st``) of the primvar the loader reads as ``prim``'s texture
+    coordinates, with :attr:`UsdOptions.uv_primvar` ``name``; None when it has none."""
+    from pxr import UsdGeom
+
+    uv = _uv_primvar(UsdGeom.PrimvarsAPI(prim), time, name)
+    return None if uv is None else uv.name
 
 
 def _normals(usd_mesh, primvars, time) -> _Primvar | None:
