@@ -4,8 +4,9 @@ The stage is read in memory (what the host application shows, saved or not) by t
 USD loader, linted with the settings that govern its root layer's file (the
 defaults for a stage that has none), and a mesh that several prims reference from
 one geometry layer is reported once, at the first of them
-(:func:`affinity.findings.share_authored_geometry`). A prim that cannot be read is
-kept aside with its reason instead of failing the stage.
+(:func:`affinity.findings.share_authored_geometry`). A prim that cannot be read (a
+malformed mesh, a reference or payload that cannot be opened) is kept aside with its
+reason instead of failing the stage.
 
 Each validator runs once per mesh prim, and several validators run on one stage:
 the check is made once per stage and time and kept until the stage changes
@@ -58,6 +59,7 @@ def check_stage(stage, time: float | None = None) -> StageCheck:
     path = layer.realPath or layer.identifier
     settings = file_settings(layer.realPath)  # the defaults for a layer in memory
     check = StageCheck(path)
+    check.bad_prims.update(composition_errors(stage))
     try:
         mesh = load_stage(stage, path, UsdOptions(time), bad_prims=check.bad_prims)
     except SkippedFile:
@@ -74,6 +76,15 @@ def check_stage(stage, time: float | None = None) -> StageCheck:
     for finding in file_findings(report)[0]:
         check.findings.setdefault(finding.prim or finding.group, []).append(finding)
     return check
+
+
+def composition_errors(stage) -> dict[str, str]:
+    """Prim path -> what composing it failed on (a reference, payload or sublayer that cannot be
+    opened, ...), the first error of each prim, on one line."""
+    errors: dict[str, str] = {}
+    for error in stage.GetCompositionErrors():
+        errors.setdefault(str(error.rootSite.path), " ".join(str(error).split()))
+    return errors
 
 
 _checks: dict[tuple, tuple[StageCheck, object]] = {}
