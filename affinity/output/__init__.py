@@ -315,7 +315,7 @@ def authored_where(f: Finding) -> str:
     values = f.prim_values or [None] * len(f.prims)
     prims = ", ".join(p if v is None and f.prim_values is None else f"{p} ({'-' if v is None else format_value(v)})"
                       for p, v in zip(f.prims, values))
-    return f" [authored in {f.layer}:{f.layer_prim}, referenced by {prims}]"
+    return f" [authored in {working_relative(f.layer) or f.layer}:{f.layer_prim}, referenced by {prims}]"
 
 
 def working_relative(path: str) -> str | None:
