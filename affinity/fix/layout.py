@@ -61,9 +61,15 @@ class Layout:
 
 
 def edge_keys(welded_start: np.ndarray, welded_end: np.ndarray, n_vertices: int) -> np.ndarray:
-    """(E,) int64 one key per undirected edge between welded ids."""
+    """(E,) int64 one key per undirected edge between welded ids.
+
+    A collapsed edge (both ends at one position: a pole quad's) is a point, which the
+    faces around the pole all touch without sharing an edge there: each gets a key of its
+    own (negative), so refining one pole quad splits no other face.
+    """
     low, high = np.minimum(welded_start, welded_end), np.maximum(welded_start, welded_end)
-    return low * max(n_vertices, 1) + high
+    own = -1 - np.arange(low.size).reshape(low.shape)
+    return np.where(low == high, own, low * max(n_vertices, 1) + high)
 
 
 def layout(mesh: Mesh, refine_faces: np.ndarray, refine_n: np.ndarray) -> Layout:
