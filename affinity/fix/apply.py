@@ -157,9 +157,9 @@ def refine_mesh(mesh: Mesh, plan: FixPlan) -> Refined:
         chosen = plan.refine_faces[plan.refine_n == n]
         faces.add(np.repeat(chosen, n * n), {name: _refined_grid(table, edges[name], mesh, chosen, n)
                                              for name, table in tables.items()})
-    for counts, apexes, chosen in transition_patterns(mesh, placed):
-        polygons = transition_polygons(counts, apexes)
-        rings = {name: _ring(table, edges[name], mesh, chosen, counts, polygons) for name, table in tables.items()}
+    for pattern, chosen in transition_patterns(mesh, placed):
+        polygons = transition_polygons(*pattern)
+        rings = {name: _ring(table, edges[name], mesh, chosen, pattern[0], polygons) for name, table in tables.items()}
         for size in sorted({len(p) for p in polygons}):
             picked = [p for p in polygons if len(p) == size]
             faces.add(np.repeat(chosen, len(picked)),

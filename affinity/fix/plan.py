@@ -237,7 +237,7 @@ def _face_counts(mesh: Mesh, placed: Layout, refine_n: np.ndarray) -> tuple[int,
     """Faces the refinement adds, and the issue's bound on them (:attr:`FixPlan.faces_added_bound`)."""
     added = int(np.sum(refine_n * refine_n - 1))
     bound = added
-    for counts, apexes, faces in transition_patterns(mesh, placed):
-        added += (len(transition_polygons(counts, apexes)) - 1) * len(faces)
-        bound += 2 * sum(m for m in counts if m > 1) * len(faces)
+    for pattern, faces in transition_patterns(mesh, placed):
+        added += (len(transition_polygons(*pattern)) - 1) * len(faces)
+        bound += 2 * sum(m for m in pattern[0] if m > 1) * len(faces)
     return added, bound
