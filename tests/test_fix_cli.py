@@ -35,7 +35,7 @@ def test_dry_run_json_lists_refined_and_left_faces_and_writes_nothing(tmp_path):
     result = run("fix", "--dry-run", "--format", "json", str(path))
     assert result.returncode == 1  # the trapezoid needs n = 23 > 8: left, needing a re-UV
     entry = json.loads(result.stdout)["files"][0]
-    assert entry["refine"] == [] and entry["left"] == [{"face": 0, "reason": "over-cap", "line": 9}]
+    assert entry["refine"] == [] and entry["left"] == [{"face": 0, "reason": "over-cap", "line": 9, "where": f"{path}:9:1"}]
     result = run("fix", "--dry-run", "--format", "json", "--max-refine", "24", str(path))
     assert result.returncode == 0
     entry = json.loads(result.stdout)["files"][0]

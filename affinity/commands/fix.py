@@ -106,20 +106,25 @@ def _fix_one(path: str, resolver, args) -> dict:
     except MeshError as err:
         sys.stderr.write(f"{path}:{err.line}: Q901 unreadable: {err.reason}\n")
         return {"path": path, "error": err.reason, "line": err.line}
-    plan = plan_fix(mesh, FixSettings(lint=settings, level=args.fix_level, max_refine=args.max_refine))
-    entry = plan_entry(path, mesh, plan)
-    if not args.dry_run and not plan.empty:
-        out = _output_path(path, args)
-        try:
+    try:
+        plan = plan_fix(mesh, FixSettings(lint=settings, level=args.fix_level, max_refine=args.max_refine))
+        entry = plan_entry(path, mesh, plan)
+        if not args.dry_run and not plan.empty:
             from ..fix.write import write_fixed
 
+            out = _output_path(path, args)
             write_fixed(path, out, mesh, plan, f"affinity fix: {summary(plan)}")
-        except OSError as err:
-            sys.stderr.write(f"{path}: cannot write {out}: {err.strerror or err}\n")
-            return {**entry, "error": f"cannot write {out}: {err.strerror or err}"}
-        entry["output"] = out
+            entry["output"] = out
+    except OSError as err:
+        reason = f"cannot write {_output_path(path, args)}: {err.strerror or err}"
+        sys.stderr.write(f"{path}: {reason}\n")
+        return {"path": path, "error": reason}
+    except Exception as err:  # one file's failure never stops the others, nor shows a traceback
+        reason = " ".join(f"internal error: {type(err).__name__}: {err}".split())[:300]
+        sys.stderr.write(f"{path}: {reason}\n")
+        return {"path": path, "error": reason}
     if args.format == "text":
-        write_text(entry, mesh, args.dry_run, sys.stdout)
+        write_text(entry, args.dry_run, sys.stdout)
     return entry
 
 
@@ -130,18 +135,26 @@ def summary(plan) -> str:
             f"{plan.faces_added:+d} faces{left}")
 
 
+def where(path: str, mesh, face: int) -> str:
+    """How a text line names a face: ``path:line:1`` (design.md), ``path:/prim/path:face N`` in a USD stage."""
+    if mesh.prim_face_start is None:
+        return f"{path}:{int(mesh.face_line[face])}:1"
+    group = int(mesh.face_group[face])
+    return f"{path}:{mesh.group_names[group]}:face {face - int(mesh.prim_face_start[group])}"
+
+
 def plan_entry(path: str, mesh, plan) -> dict:
     """The JSON entry of a file's plan (design.md: ``refine``, ``left``; the rest is for people)."""
     lines = mesh.face_line
     return {
         "path": path,
         "faces": mesh.n_faces,
-        "refine": [{"face": f, "n": n, "line": int(lines[f]), "code": code, "before": before, "after": after,
-                    "unit": unit}
+        "refine": [{"face": f, "n": n, "line": int(lines[f]), "where": where(path, mesh, f), "code": code,
+                    "before": before, "after": after, "unit": unit}
                    for f, n, code, before, after, unit in zip(plan.refine_faces.tolist(), plan.refine_n.tolist(),
                                                               plan.codes.tolist(), plan.before.tolist(),
                                                               plan.after.tolist(), plan.units.tolist())],
-        "left": [{"face": f, "reason": reason, "line": int(lines[f])}
+        "left": [{"face": f, "reason": reason, "line": int(lines[f]), "where": where(path, mesh, f)}
                  for f, reason in zip(plan.left_faces.tolist(), plan.left_reasons.tolist())],
         "transitions": plan.transition_faces.tolist(),
         "faces_added": plan.faces_added,
@@ -149,17 +162,17 @@ def plan_entry(path: str, mesh, plan) -> dict:
     }
 
 
-def write_text(entry: dict, mesh, dry_run: bool, out) -> None:
+def write_text(entry: dict, dry_run: bool, out) -> None:
     """The text of one file: a line per refined and per left quad (``path:line:col: ... [face F]``), then
     what was (or would be) done."""
     path = entry["path"]
     verb = "would refine" if dry_run else "refined"
     for r in entry["refine"]:
-        out.write(f"{path}:{r['line']}:1: {verb} n={r['n']}: {r['code']} {r['before']:.4g} -> {r['after']:.4g} "
+        out.write(f"{r['where']}: {verb} n={r['n']}: {r['code']} {r['before']:.4g} -> {r['after']:.4g} "
                   f"{r['unit']} [face {r['face']}]\n")
     for r in entry["left"]:
         why = "needs more than --max-refine: re-UV it" if r["reason"] == "over-cap" else "not refined"
-        out.write(f"{path}:{r['line']}:1: left ({r['reason']}): {why} [face {r['face']}]\n")
+        out.write(f"{r['where']}: left ({r['reason']}): {why} [face {r['face']}]\n")
     done = f"{verb} {len(entry['refine'])} quads, re-cut {len(entry['transitions'])} neighbours"
     added = f"{entry['faces_added']:+d} faces (at most {entry['faces_added_bound']:+d})"
     if "output" in entry:
