@@ -131,11 +131,12 @@ class _Faces:
         sizes = np.concatenate([np.full(len(s), c[self.names[0]].shape[1]) for s, c in self.chunks])
         flat = {name: np.concatenate([c[name].reshape(-1) for _, c in self.chunks]) for name in self.names}
         order = np.argsort(source, kind="stable")
-        return source[order], sizes[order], {name: values[_gather(sizes, order)] for name, values in flat.items()}
+        return source[order], sizes[order], {name: values[corner_slots(sizes, order)] for name, values in flat.items()}
 
 
-def _gather(sizes: np.ndarray, order: np.ndarray) -> np.ndarray:
-    """Flat corner positions of the faces ``order`` of a CSR with face ``sizes``."""
+def corner_slots(sizes: np.ndarray, order: np.ndarray) -> np.ndarray:
+    """(sum sizes[order],) int64 flat positions of the corners of faces ``order`` (k,) int64, in that
+    order, in a face table whose faces have ``sizes`` (F,) corners."""
     starts = np.concatenate([[0], np.cumsum(sizes)[:-1]])
     picked = sizes[order]
     return np.repeat(starts[order], picked) + np.arange(picked.sum()) - np.repeat(np.cumsum(picked) - picked, picked)
@@ -156,9 +157,9 @@ def refine_mesh(mesh: Mesh, plan: FixPlan) -> Refined:
         chosen = plan.refine_faces[plan.refine_n == n]
         faces.add(np.repeat(chosen, n * n), {name: _refined_grid(table, edges[name], mesh, chosen, n)
                                              for name, table in tables.items()})
-    for counts, apexes, chosen in transition_patterns(mesh, placed):
-        polygons = transition_polygons(counts, apexes)
-        rings = {name: _ring(table, edges[name], mesh, chosen, counts, polygons) for name, table in tables.items()}
+    for pattern, chosen in transition_patterns(mesh, placed):
+        polygons = transition_polygons(*pattern)
+        rings = {name: _ring(table, edges[name], mesh, chosen, pattern[0], polygons) for name, table in tables.items()}
         for size in sorted({len(p) for p in polygons}):
             picked = [p for p in polygons if len(p) == size]
             faces.add(np.repeat(chosen, len(picked)),
@@ -207,8 +208,8 @@ def _assemble(mesh: Mesh, plan: FixPlan, placed: Layout, tables: dict, faces: _F
         prim = np.repeat(np.arange(len(mesh.prim_face_start) - 1), np.diff(mesh.prim_face_start))
     order = np.lexsort((np.arange(len(source)), added, prim[source]))
     sizes = np.concatenate([mesh.face_sizes[kept], sizes_new])
-    kept_corners = _gather(mesh.face_sizes, kept)
-    corner_of = {name: np.concatenate([table.index[kept_corners], corners_new[name]])[_gather(sizes, order)]
+    kept_corners = corner_slots(mesh.face_sizes, kept)
+    corner_of = {name: np.concatenate([table.index[kept_corners], corners_new[name]])[corner_slots(sizes, order)]
                  for name, table in tables.items()}
     source, added, sizes = source[order], added[order], sizes[order]
     vertex_values = tables["positions"].done()

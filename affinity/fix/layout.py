@@ -61,9 +61,15 @@ class Layout:
 
 
 def edge_keys(welded_start: np.ndarray, welded_end: np.ndarray, n_vertices: int) -> np.ndarray:
-    """(E,) int64 one key per undirected edge between welded ids."""
+    """(E,) int64 one key per undirected edge between welded ids.
+
+    A collapsed edge (both ends at one position: a pole quad's) is a point, which the
+    faces around the pole all touch without sharing an edge there: each gets a key of its
+    own (negative), so refining one pole quad splits no other face.
+    """
     low, high = np.minimum(welded_start, welded_end), np.maximum(welded_start, welded_end)
-    return low * max(n_vertices, 1) + high
+    own = -1 - np.arange(low.size).reshape(low.shape)
+    return np.where(low == high, own, low * max(n_vertices, 1) + high)
 
 
 def layout(mesh: Mesh, refine_faces: np.ndarray, refine_n: np.ndarray) -> Layout:
@@ -115,14 +121,15 @@ def equal_levels(mesh: Mesh, faces: np.ndarray, n: np.ndarray) -> np.ndarray:
         n = raised
 
 
-def transition_patterns(mesh: Mesh, placed: Layout) -> list[tuple[tuple[int, ...], tuple[bool, ...], np.ndarray]]:
+def transition_patterns(mesh: Mesh, placed: Layout) -> list[tuple[tuple, np.ndarray]]:
     """The transition faces grouped by their cut's pattern (:func:`affinity.fix.tessellate.transition_polygons`).
 
     Returns
     -------
-    list of (counts, apexes, faces): ``counts`` the segments of each edge, ``apexes`` which
-    corners may be a fan's apex (every corner, but only the reflex one of a concave quad),
-    ``faces`` (n,) int64 the faces of that pattern in file order.
+    list of (pattern, faces): ``pattern`` the arguments of ``transition_polygons``: the
+    segments of each edge, which corners may be a fan's apex (every corner, but only the
+    reflex one of a concave quad) and which edges are collapsed; ``faces`` (n,) int64 the
+    faces of that pattern in file order.
     """
     from ..geometry import planar_quads
 
@@ -141,11 +148,13 @@ def transition_patterns(mesh: Mesh, placed: Layout) -> list[tuple[tuple[int, ...
         reflex = planar_quads(mesh.positions[mesh.corner_vertex[corners[quads, :4]]]).reflex
         concave = reflex.any(axis=1)
         apexes[quads[concave], :4] = reflex[concave]
-    keys = np.concatenate([counts, apexes], axis=1)
+    collapsed = present & (placed.start[corners] == placed.end[corners])
+    keys = np.concatenate([counts, apexes, collapsed], axis=1)
     patterns, which = np.unique(keys, axis=0, return_inverse=True)
     which = which.reshape(-1)
     found = []
     for p, key in enumerate(patterns.tolist()):
         size = int(np.count_nonzero(key[:width]))
-        found.append((tuple(key[:size]), tuple(bool(a) for a in key[width : width + size]), faces[which == p]))
+        flags = [tuple(bool(a) for a in key[at : at + size]) for at in (width, 2 * width)]
+        found.append(((tuple(key[:size]), *flags), faces[which == p]))
     return found

@@ -113,6 +113,17 @@ def flagged_quads(mesh: Mesh, fix: FixSettings) -> tuple[dict, dict]:
     return scored, leaving
 
 
+def pole_quads(mesh: Mesh, faces: np.ndarray) -> np.ndarray:
+    """(Q,) bool: which quads ``faces`` (Q,) int64 have exactly one collapsed edge (one repeated corner).
+
+    Q201 flags them, but they are triangles in effect whose Q101-Q103 value is exact
+    (design.md, "One finding per defect"), and their pieces are sound: refined, not left.
+    """
+    corners = mesh.positions[mesh.corner_vertex[mesh.face_start[faces, None] + np.arange(4)]]
+    collapsed = (corners == np.roll(corners, -1, axis=1)).all(axis=2)
+    return collapsed.sum(axis=1) == 1
+
+
 def piece_scores(mesh: Mesh, faces: np.ndarray, n: int, settings: Settings, code: str) -> np.ndarray:
     """The worst value of rule ``code`` over the n x n pieces of each quad ``faces`` (Q,) int64.
 
@@ -181,6 +192,7 @@ def plan_fix(mesh: Mesh, fix: FixSettings | None = None) -> FixPlan:
     reasons = np.full(len(candidates), "", dtype=object)
     for code, reason in reversed(LEFT_BY_RULE.items()):  # the first rule in the table wins
         reasons[np.isin(candidates, leaving.get(code, []))] = reason
+    reasons[(reasons == "degenerate") & pole_quads(mesh, candidates)] = ""
     need = np.zeros(len(candidates), dtype=np.int64)
     for code, (faces, values) in scored.items():
         rows = np.searchsorted(candidates, faces)
@@ -225,7 +237,7 @@ def _face_counts(mesh: Mesh, placed: Layout, refine_n: np.ndarray) -> tuple[int,
     """Faces the refinement adds, and the issue's bound on them (:attr:`FixPlan.faces_added_bound`)."""
     added = int(np.sum(refine_n * refine_n - 1))
     bound = added
-    for counts, apexes, faces in transition_patterns(mesh, placed):
-        added += (len(transition_polygons(counts, apexes)) - 1) * len(faces)
-        bound += 2 * sum(m for m in counts if m > 1) * len(faces)
+    for pattern, faces in transition_patterns(mesh, placed):
+        added += (len(transition_polygons(*pattern)) - 1) * len(faces)
+        bound += 2 * sum(m for m in pattern[0] if m > 1) * len(faces)
     return added, bound

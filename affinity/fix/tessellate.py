@@ -40,19 +40,35 @@ def ring_corners(counts: tuple[int, ...]) -> list[int]:
 
 
 @cache
-def transition_polygons(counts: tuple[int, ...], apex_allowed: tuple[bool, ...]) -> tuple[tuple[int, ...], ...]:
+def transition_polygons(counts: tuple[int, ...], apex_allowed: tuple[bool, ...],
+                        collapsed: tuple[bool, ...]) -> tuple[tuple[int, ...], ...]:
     """The cut of a face with ``counts[i]`` segments on edge i (corner i to corner i + 1).
 
     Parameters
     ----------
     counts : (k,) segments per edge, 1 for an edge without points.
     apex_allowed : (k,) which corners may be a fan's apex.
+    collapsed : (k,) edges whose two corners share a position (a pole quad's): the corners
+        count as one point, so a polygon that would hold both keeps one (a triangle holding
+        both, which covers nothing, is dropped).
 
     Returns
     -------
     Polygons as ring positions (0 .. M - 1, M = sum(counts)), :data:`CENTRE` for the
     centre vertex; each keeps the face's orientation.
     """
+    corner = ring_corners(counts)
+    same = {corner[(i + 1) % len(counts)]: corner[i] for i in range(len(counts)) if collapsed[i]}
+    kept = []
+    for polygon in _cut(counts, apex_allowed):
+        distinct = [r for r in polygon if not (r in same and same[r] in polygon)]
+        if len(distinct) >= 3:
+            kept.append(tuple(distinct))
+    return tuple(kept)
+
+
+def _cut(counts: tuple[int, ...], apex_allowed: tuple[bool, ...]) -> tuple[tuple[int, ...], ...]:
+    """:func:`transition_polygons` before collapsed edges are merged."""
     k, M = len(counts), sum(counts)
     corner = ring_corners(counts)
     for i in range(k):
