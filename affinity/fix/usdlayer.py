@@ -60,8 +60,6 @@ def write_override_layer(path: str, out: str, mesh: Mesh, refined: Refined, head
     """Write the override layer of ``refined`` (the fix of ``mesh``, read from the stage ``path``) to ``out``."""
     from pxr import Sdf, Usd, UsdGeom
 
-    from ..loaders.usd import _uv_primvar, reversed_winding
-
     stage = Usd.Stage.Open(os.fspath(path))
     time = Usd.TimeCode.EarliestTime()
     xforms = UsdGeom.XformCache(time)
@@ -73,55 +71,10 @@ def write_override_layer(path: str, out: str, mesh: Mesh, refined: Refined, head
             layer.pseudoRoot.SetInfo(key, source_root.pseudoRoot.GetInfo(key))
     layer.subLayerPaths.append(os.path.relpath(os.path.abspath(path), os.path.dirname(os.path.abspath(out))))
     fixed = refined.mesh
-    changed = np.unique(mesh.face_group[refined.replaced])
     blocked = []
-    for group in changed.tolist():
+    for group in np.unique(mesh.face_group[refined.replaced]).tolist():
         prim = stage.GetPrimAtPath(mesh.group_names[group])
-        faces = np.arange(fixed.prim_face_start[group], fixed.prim_face_start[group + 1])
-        sizes = fixed.face_sizes[faces]
-        corners = np.arange(fixed.face_start[faces[0]], fixed.face_start[faces[-1] + 1])
-        usd_mesh = UsdGeom.Mesh(prim)
-        if usd_mesh.GetOrientationAttr().Get(time) == UsdGeom.Tokens.leftHanded:
-            corners = corners[reversed_winding(np.concatenate([[0], np.cumsum(sizes)]))]
-        matrix = np.array(xforms.GetLocalToWorldTransform(prim))
-        inverse = np.linalg.inv(matrix)
-        used, vertex = np.unique(fixed.corner_vertex[corners], return_inverse=True)
-        points = np.einsum("ij,jk->ik", fixed.positions[used], inverse[:3, :3]) + inverse[3, :3]
-        spec = Sdf.CreatePrimInLayer(layer, prim.GetPath())
-        _set(spec, "points", usd_mesh.GetPointsAttr().GetTypeName(), _array("point3f[]", points))
-        _set(spec, "faceVertexCounts", Sdf.ValueTypeNames.IntArray, _array("int[]", sizes))
-        _set(spec, "faceVertexIndices", Sdf.ValueTypeNames.IntArray, _array("int[]", vertex.reshape(-1)))
-        primvars = UsdGeom.PrimvarsAPI(prim)
-        written = set()
-        uv = _uv_primvar(primvars, time, None)
-        if uv is not None and fixed.corner_texcoord is not None and (fixed.corner_texcoord[corners] >= 0).all():
-            values, index = _indexed(fixed.texcoords, fixed.corner_texcoord[corners])
-            name = uv.name if uv.name.startswith("primvars:") else f"primvars:{uv.name}"
-            type_name = prim.GetAttribute(name).GetTypeName()
-            _set(spec, name, type_name, _array(type_name, values), "faceVarying")
-            _set(spec, name + ":indices", Sdf.ValueTypeNames.IntArray, _array("int[]", index))
-            written |= {name, name + ":indices"}
-        if fixed.corner_normal is not None and (fixed.corner_normal[corners] >= 0).all():
-            values, index = _indexed(fixed.normals, fixed.corner_normal[corners])
-            local = np.einsum("ij,kj->ik", values, matrix[:3, :3])  # inverse of the world normals' transform
-            local /= np.linalg.norm(local, axis=1, keepdims=True)
-            _set(spec, "primvars:normals", Sdf.ValueTypeNames.Normal3fArray, _array("normal3f[]", local),
-                 "faceVarying")
-            _set(spec, "primvars:normals:indices", Sdf.ValueTypeNames.IntArray, _array("int[]", index))
-            written |= {"primvars:normals", "primvars:normals:indices"}
-        if fixed.colors is not None and not np.isnan(fixed.colors[used]).any():
-            _set(spec, "primvars:displayColor", Sdf.ValueTypeNames.Color3fArray,
-                 _array("color3f[]", fixed.colors[used]), "vertex")
-            written.add("primvars:displayColor")
-            if prim.HasAttribute("primvars:displayColor:indices"):
-                _set(spec, "primvars:displayColor:indices", Sdf.ValueTypeNames.IntArray, Sdf.ValueBlock())
-        for attribute in prim.GetAttributes():
-            name = attribute.GetName()
-            varying = name.startswith("primvars:") and UsdGeom.Primvar(attribute).GetInterpolation() != "constant"
-            if name not in written and attribute.HasAuthoredValue() and (
-                    varying or name in TOPOLOGY_INDICES or name == "normals"):
-                _set(spec, name, attribute.GetTypeName(), Sdf.ValueBlock())
-                blocked.append(f"{prim.GetPath()}.{name}")
+        blocked += override_prim(layer, prim.GetPath(), prim, fixed, group, time, xforms)
     if blocked:
         layer.documentation = f"{header}; blocked (they indexed the old faces): {', '.join(blocked)}"
     text = layer.ExportToString()
@@ -130,6 +83,64 @@ def write_override_layer(path: str, out: str, mesh: Mesh, refined: Refined, head
         return
     with atomic_write(out) as f:
         f.write(text)
+
+
+def override_prim(layer, spec_path, prim, fixed: Mesh, group: int, time, xforms) -> list[str]:
+    """Author the fixed geometry of mesh ``prim`` (group ``group`` of ``fixed``, in world space) as an ``over``
+    at ``spec_path`` in ``layer`` (see the module docstring); returns the attributes it blocked.
+
+    ``affinity fix`` writes each fixed prim to its override layer at the prim's path; the USD
+    validators' fixer writes to the edit target's layer at the path it maps the prim to.
+    """
+    from pxr import Sdf, UsdGeom
+
+    from ..loaders.usd import reversed_winding, uv_primvar_name
+
+    faces = np.arange(fixed.prim_face_start[group], fixed.prim_face_start[group + 1])
+    sizes = fixed.face_sizes[faces]
+    corners = np.arange(fixed.face_start[faces[0]], fixed.face_start[faces[-1] + 1])
+    usd_mesh = UsdGeom.Mesh(prim)
+    if usd_mesh.GetOrientationAttr().Get(time) == UsdGeom.Tokens.leftHanded:
+        corners = corners[reversed_winding(np.concatenate([[0], np.cumsum(sizes)]))]
+    matrix = np.array(xforms.GetLocalToWorldTransform(prim))
+    inverse = np.linalg.inv(matrix)
+    used, vertex = np.unique(fixed.corner_vertex[corners], return_inverse=True)
+    points = np.einsum("ij,jk->ik", fixed.positions[used], inverse[:3, :3]) + inverse[3, :3]
+    spec = Sdf.CreatePrimInLayer(layer, spec_path)
+    _set(spec, "points", usd_mesh.GetPointsAttr().GetTypeName(), _array("point3f[]", points))
+    _set(spec, "faceVertexCounts", Sdf.ValueTypeNames.IntArray, _array("int[]", sizes))
+    _set(spec, "faceVertexIndices", Sdf.ValueTypeNames.IntArray, _array("int[]", vertex.reshape(-1)))
+    written, blocked = set(), []
+    uv_name = uv_primvar_name(prim, time)
+    if uv_name is not None and fixed.corner_texcoord is not None and (fixed.corner_texcoord[corners] >= 0).all():
+        values, index = _indexed(fixed.texcoords, fixed.corner_texcoord[corners])
+        name = uv_name if uv_name.startswith("primvars:") else f"primvars:{uv_name}"
+        type_name = prim.GetAttribute(name).GetTypeName()
+        _set(spec, name, type_name, _array(type_name, values), "faceVarying")
+        _set(spec, name + ":indices", Sdf.ValueTypeNames.IntArray, _array("int[]", index))
+        written |= {name, name + ":indices"}
+    if fixed.corner_normal is not None and (fixed.corner_normal[corners] >= 0).all():
+        values, index = _indexed(fixed.normals, fixed.corner_normal[corners])
+        local = np.einsum("ij,kj->ik", values, matrix[:3, :3])  # inverse of the world normals' transform
+        local /= np.linalg.norm(local, axis=1, keepdims=True)
+        _set(spec, "primvars:normals", Sdf.ValueTypeNames.Normal3fArray, _array("normal3f[]", local),
+             "faceVarying")
+        _set(spec, "primvars:normals:indices", Sdf.ValueTypeNames.IntArray, _array("int[]", index))
+        written |= {"primvars:normals", "primvars:normals:indices"}
+    if fixed.colors is not None and not np.isnan(fixed.colors[used]).any():
+        _set(spec, "primvars:displayColor", Sdf.ValueTypeNames.Color3fArray,
+             _array("color3f[]", fixed.colors[used]), "vertex")
+        written.add("primvars:displayColor")
+        if prim.HasAttribute("primvars:displayColor:indices"):
+            _set(spec, "primvars:displayColor:indices", Sdf.ValueTypeNames.IntArray, Sdf.ValueBlock())
+    for attribute in prim.GetAttributes():
+        name = attribute.GetName()
+        varying = name.startswith("primvars:") and UsdGeom.Primvar(attribute).GetInterpolation() != "constant"
+        if name not in written and attribute.HasAuthoredValue() and (
+                varying or name in TOPOLOGY_INDICES or name == "normals"):
+            _set(spec, name, attribute.GetTypeName(), Sdf.ValueBlock())
+            blocked.append(f"{prim.GetPath()}.{name}")
+    return blocked
 
 
 def _export_binary(text: str, out: str) -> None:

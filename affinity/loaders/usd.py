@@ -132,10 +132,9 @@ def load_usd(path, options: UsdOptions | None = None) -> Mesh:
 
 
 def load_stage(stage, path: str, options: UsdOptions | None = None, prim_paths: list[str] | None = None,
-               world: bool = True, bad_prims: dict[str, str] | None = None) -> Mesh:
+               bad_prims: dict[str, str] | None = None) -> Mesh:
     """The drawn mesh prims of an open ``Usd.Stage`` as one mesh named ``path``: all of them, or those
-    of ``prim_paths`` (in that order), as :func:`load_usd` reads a file; with ``world`` False each
-    prim in its own local space (points and normals as authored, for writing back).
+    of ``prim_paths`` (in that order), as :func:`load_usd` reads a file.
 
     Raises MeshError and SkippedFile as :func:`load_usd` does. With ``bad_prims`` (a dict) a prim
     that cannot be read is left out and its path mapped to the reason there instead of raising.
@@ -157,7 +156,7 @@ def load_stage(stage, path: str, options: UsdOptions | None = None, prim_paths: 
     parts, sources, read = [], [], []
     for prim in prims:
         try:
-            part, source = _read_prim(prim, time, xforms if world else None, options.uv_primvar), \
+            part, source = _read_prim(prim, time, xforms, options.uv_primvar), \
                 geometry_source(prim, time)
         except (_BadPrim, Tf.ErrorException) as error:
             reason = str(error) if isinstance(error, _BadPrim) else pxr_reason(error)
@@ -283,8 +282,7 @@ def _finite(name: str, values: np.ndarray) -> np.ndarray:
 
 
 def _read_prim(prim, time, xforms, uv_primvar: str | None) -> Mesh:
-    """One mesh prim in world space (in its own space when ``xforms`` is None), corners in
-    right-handed order (see the module docstring)."""
+    """One mesh prim in world space, corners in right-handed order (see the module docstring)."""
     from pxr import UsdGeom
 
     usd_mesh = UsdGeom.Mesh(prim)
@@ -293,7 +291,7 @@ def _read_prim(prim, time, xforms, uv_primvar: str | None) -> Mesh:
     corner_vertex = _array(usd_mesh.GetFaceVertexIndicesAttr().Get(time), np.int64)
     _check_topology(sizes, corner_vertex, len(points))
     face_start = np.concatenate(([0], np.cumsum(sizes)))
-    matrix = np.eye(4) if xforms is None else np.array(xforms.GetLocalToWorldTransform(prim))  # row vectors: p' = p M
+    matrix = np.array(xforms.GetLocalToWorldTransform(prim))  # (4, 4), row vectors: p' = p M
     topology = (len(points), sizes, corner_vertex)
 
     primvars = UsdGeom.PrimvarsAPI(prim)

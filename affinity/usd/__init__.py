@@ -10,7 +10,8 @@
   class per family in the category ``quad-affinity``.
 - :mod:`affinity.usd.stage` checks an open stage as ``affinity check`` checks its file
   (same loader, settings, lint and sharing of referenced geometry);
-  :mod:`affinity.usd.fixing` writes ``affinity fix``'s refinement of a prim to an edit target.
+  :mod:`affinity.usd.fixing` writes ``affinity fix``'s refinement of a prim to an edit target
+  (through ``affinity fix``'s USD writer, :mod:`affinity.fix.usdlayer`).
 
 Both need usd-core 26.11 or newer (Python validators and constructible fixers):
 :func:`usd_too_old` says so on older ones, where ``affinity check`` keeps reading stages.

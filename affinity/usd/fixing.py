@@ -1,12 +1,13 @@
 """The validators' fixer: ``affinity fix``'s refinement of a prim, written to an edit target.
 
-For each prim of a finding (every prim that references a shared geometry layer),
-the prim is read in its own space, :func:`affinity.fix.plan_fix` picks the quads the
-finding's rule flags at the warning level or above (the fix's default), and
-:func:`affinity.fix.apply_fix` refines them crack-free; :mod:`affinity.usd.author`
-writes the result into the prim through the edit target (an opinion in that layer:
-the layers below it are not touched). The plan is made in the prim's own space; the
-affinity readings do not change under the affine map to world space.
+For each prim of a finding (every prim that references a shared geometry layer), the
+prim is read as ``affinity check`` reads it, :func:`affinity.fix.plan_fix` picks the
+quads the finding's rule flags at the warning level or above (the fix's default) and
+:func:`affinity.fix.refine_mesh` refines them crack-free. The result goes into the edit
+target's layer, at the path the edit target maps the prim to, by the writer of ``affinity
+fix``'s override layers (:func:`affinity.fix.usdlayer.override_prim`): the layers below it
+are not touched, and primvars or topology indices that no longer match the new faces
+are blocked there.
 """
 
 from __future__ import annotations
@@ -14,47 +15,37 @@ from __future__ import annotations
 from dataclasses import replace
 
 
-def refine_plan(stage, prim_path: str, code: str, time=None):
-    """``(mesh, plan, uv_name)`` for refining the quads rule ``code`` flags on the prim at ``prim_path``,
-    with the settings that govern the stage's root layer; ``(None, reason, None)`` when the prim's
-    geometry cannot be rewritten (:func:`affinity.usd.author.cannot_author`)."""
-    from pxr import Usd
-
+def refine_plan(stage, prim_path: str, code: str):
+    """``(mesh, plan)``: the prim at ``prim_path`` (world space, earliest time) and the plan that refines
+    the quads rule ``code`` flags, with the settings that govern the stage's root layer."""
     from ..config import file_settings
     from ..fix import FixSettings, plan_fix
-    from ..loaders.usd import UsdOptions, load_stage, uv_primvar_name
-    from .author import cannot_author
+    from ..loaders.usd import load_stage
 
-    usd_time = Usd.TimeCode.EarliestTime() if time is None else Usd.TimeCode(time)
-    prim = stage.GetPrimAtPath(prim_path)
-    uv_name = uv_primvar_name(prim, usd_time)
-    reason = cannot_author(prim, usd_time, uv_name)
-    if reason is not None:
-        return None, reason, None
-    settings = file_settings(stage.GetRootLayer().realPath)
     layer = stage.GetRootLayer()
-    mesh = load_stage(stage, layer.realPath or layer.identifier, UsdOptions(time), [prim_path], world=False)
-    return mesh, plan_fix(mesh, FixSettings(lint=replace(settings, select=[code], ignore=[]))), uv_name
+    settings = replace(file_settings(layer.realPath), select=[code], ignore=[])
+    mesh = load_stage(stage, layer.realPath or layer.identifier, prim_paths=[prim_path])
+    return mesh, plan_fix(mesh, FixSettings(lint=settings))
 
 
 def can_refine(stage, prim_paths: list[str], code: str) -> bool:
-    """Whether the fixer has something to refine on some prim of ``prim_paths``, and may write it."""
-    plans = [refine_plan(stage, path, code)[:2] for path in prim_paths]
-    return all(mesh is not None for mesh, _ in plans) and any(not plan.empty for _, plan in plans)
+    """Whether the fixer has something to refine on some prim of ``prim_paths``."""
+    return any(not refine_plan(stage, path, code)[1].empty for path in prim_paths)
 
 
 def refine_prims(stage, prim_paths: list[str], code: str, edit_target) -> bool:
-    """Write the refinement of every prim of ``prim_paths`` for rule ``code`` to ``edit_target``;
-    False (nothing written) when some prim's geometry cannot be rewritten."""
-    from pxr import Usd
+    """Write the refinement of every prim of ``prim_paths`` for rule ``code`` through ``edit_target``."""
+    from pxr import Usd, UsdGeom
 
-    from ..fix import apply_fix
-    from .author import author_mesh
+    from ..fix import refine_mesh
+    from ..fix.usdlayer import override_prim
 
-    plans = [(path, *refine_plan(stage, path, code)) for path in prim_paths]
-    if any(mesh is None for _, mesh, _, _ in plans):
-        return False
-    for path, mesh, plan, uv_name in plans:
-        if not plan.empty:
-            author_mesh(stage, path, apply_fix(mesh, plan), edit_target, Usd.TimeCode.EarliestTime(), uv_name)
+    time = Usd.TimeCode.EarliestTime()
+    for path in prim_paths:
+        mesh, plan = refine_plan(stage, path, code)
+        if plan.empty:
+            continue
+        prim = stage.GetPrimAtPath(path)
+        override_prim(edit_target.GetLayer(), edit_target.MapToSpecPath(prim.GetPath()), prim,
+                      refine_mesh(mesh, plan).mesh, 0, time, UsdGeom.XformCache(time))
     return True

@@ -61,9 +61,7 @@ def _refinement(code: str) -> Suggestion:
         from .fixing import refine_prims
 
         prims = at if isinstance(at, list) else [at]
-        if not refine_prims(stage, [str(prim.GetPath()) for prim in prims], code, stage.GetEditTarget()):
-            raise ValueError("the prim's geometry cannot be rewritten (animated, subsets, holes, creases "
-                             "or primvars bound to its faces)")
+        refine_prims(stage, [str(prim.GetPath()) for prim in prims], code, stage.GetEditTarget())
 
     return Suggestion(callable=refine, message=f"Refine the quads {code} flags (affinity fix)")
 

@@ -17,8 +17,8 @@ returns one ``ValidationError`` per finding:
   of ``affinity check``.
 
 The affinity families carry a fixer, ``RefineQuads``, that writes ``affinity fix``'s
-refinement of the finding's prims to the edit target (:mod:`affinity.usd.fixing`);
-``ApplyFix`` then saves that layer. Problems never reach the host application as
+refinement of the finding's prims to the edit target (:mod:`affinity.usd.fixing`, with
+``affinity fix``'s own USD writer); ``ApplyFix`` then saves that layer. Problems never reach the host application as
 exceptions: a prim that cannot be read is one ``Error`` (``unreadable``, from
 ``QuadShape``), naming the prim and why. The loader's notes (e.g. that the numbers
 are for the subdivision cage) are ``Info`` errors named ``note`` on the stage's first
@@ -102,7 +102,7 @@ def _fixer(family: Family):
 
         try:
             return refine_prims(*sites(error), code, edit_target)
-        except Exception:  # nothing written is better than an exception in the host
+        except Exception:  # a failed fix, not an exception in the host
             return False
 
     def can_apply(error, edit_target, time_code) -> bool:
