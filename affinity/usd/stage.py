@@ -15,6 +15,7 @@ the check is made once per stage and time and kept until the stage changes
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass, field
 
 from ..output import Finding
@@ -88,6 +89,8 @@ def composition_errors(stage) -> dict[str, str]:
 
 
 _checks: dict[tuple, tuple[StageCheck, object]] = {}
+#: A validation context may call validators from several threads: one of them checks a stage.
+_checking = threading.Lock()
 
 
 def cached_check(stage, time: float | None = None) -> StageCheck:
@@ -95,12 +98,14 @@ def cached_check(stage, time: float | None = None) -> StageCheck:
     from pxr import Tf, Usd
 
     key = (hash(stage), stage.GetRootLayer().identifier, time)
-    if key not in _checks:
-        while len(_checks) >= KEPT_STAGES:
-            _checks.pop(next(iter(_checks)))
-        listener = Tf.Notice.Register(Usd.Notice.ObjectsChanged, lambda notice, sender: _checks.pop(key, None), stage)
-        _checks[key] = check_stage(stage, time), listener
-    return _checks[key][0]
+    with _checking:
+        if key not in _checks:
+            while len(_checks) >= KEPT_STAGES:
+                _checks.pop(next(iter(_checks)))
+            listener = Tf.Notice.Register(Usd.Notice.ObjectsChanged, lambda notice, sender: _checks.pop(key, None),
+                                          stage)
+            _checks[key] = check_stage(stage, time), listener
+        return _checks[key][0]
 
 
 @dataclass(eq=False)
