@@ -174,7 +174,9 @@ def share_authored_geometry(hits: list[RuleHits], mesh) -> tuple[list[RuleHits],
     if (owner == np.arange(len(owner))).all():
         return hits, []
     shift = starts[owner] - starts[:-1]
-    members = {int(o): np.flatnonzero(owner == o).tolist() for o in np.unique(owner) if (owner == o).sum() > 1}
+    by_owner = np.argsort(owner, kind="stable")
+    same_source = np.split(by_owner, np.flatnonzero(np.diff(owner[by_owner])) + 1)
+    members = {int(owner[g[0]]): g.tolist() for g in same_source if len(g) > 1}  # first prim -> its prims, rising
     shared = [{"prim": mesh.group_names[o], "layer": sources[o][0], "layer_prim": sources[o][1],
                "prims": [mesh.group_names[p] for p in prims], "values": {}} for o, prims in members.items()]
     entry_of = {o: entry for o, entry in zip(members, shared)}
@@ -196,14 +198,17 @@ def share_authored_geometry(hits: list[RuleHits], mesh) -> tuple[list[RuleHits],
 
 
 def _record_prim_values(h: RuleHits, faces, prim, owner, starts, members, entry_of) -> None:
-    """Into each shared entry's ``values``: the faces of rule ``h`` whose prims measured differently."""
-    for o, prims in members.items():
-        rows = np.flatnonzero((owner[prim] == o) & (h.faces >= 0))
-        if not len(rows):
-            continue
-        column = np.searchsorted(prims, prim[rows])
+    """Into each shared entry's ``values``: the faces of rule ``h`` whose prims measured differently.
+
+    One (faces of the mesh, its prims) table per shared mesh with findings, NaN where a prim has none.
+    """
+    rows = np.flatnonzero(np.isin(owner[prim], list(members)) & (h.faces >= 0))
+    rows = rows[np.argsort(owner[prim[rows]], kind="stable")]
+    for chunk in np.split(rows, np.flatnonzero(np.diff(owner[prim[rows]])) + 1) if len(rows) else []:
+        o = int(owner[prim[chunk[0]]])
+        prims = members[o]
         table = np.full((starts[o + 1] - starts[o], len(prims)), np.nan)
-        table[faces[rows] - starts[o], column] = h.values[rows]
+        table[faces[chunk] - starts[o], np.searchsorted(prims, prim[chunk])] = h.values[chunk]
         agree = np.isclose(table, table[:, :1], rtol=1e-6, atol=0, equal_nan=True).all(axis=1)
         differ = np.flatnonzero(~np.isnan(table).all(axis=1) & ~agree)
         if len(differ):
