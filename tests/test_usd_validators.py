@@ -162,6 +162,16 @@ def test_a_mesh_four_prims_reference_is_one_error_per_finding_naming_them(tmp_pa
         assert f"referenced by {', '.join(prims)}]" in error["message"]
 
 
+def test_the_fixer_on_shared_geometry_refines_every_referencing_prim_and_not_the_geometry_layer(tmp_path):
+    stage = referenced_stage(tmp_path)
+    geometry = (tmp_path / "knight.usda").read_bytes()
+    override = tmp_path / "override.usda"
+    override.write_text('#usda 1.0\n(\n    subLayers = [@set.usda@]\n)\n')
+    assert validate(override, "--fix") == []
+    assert (tmp_path / "knight.usda").read_bytes() == geometry
+    assert_same_mesh(composed(override), fixed_by_affinity_fix(stage))
+
+
 def test_a_prim_that_cannot_be_read_is_an_error_naming_it_and_the_others_are_checked(tmp_path):
     from pxr import Usd, UsdGeom
 
@@ -251,6 +261,20 @@ def test_nvidia_fix_gives_the_composed_mesh_of_affinity_fix(tmp_path):
     assert_same_mesh(composed(stage), fixed_by_affinity_fix(original))
     assert check_json(stage)["findings"] == []
     assert nvidia_validate(tmp_path, stage) == []
+
+
+def test_nvidia_fix_on_shared_geometry_overrides_each_prim_in_the_stage(tmp_path):
+    """One issue per finding, sited at the first referencing prim; --fix refines all four in set.usda
+    (the strongest layer with an opinion on them) and leaves the geometry layer as it was."""
+    stage = referenced_stage(tmp_path)
+    expected = fixed_by_affinity_fix(stage)
+    geometry = (tmp_path / "knight.usda").read_bytes()
+    issues = nvidia_validate(tmp_path, stage)
+    assert [(i["at"]["path"], from_message(i["message"])[1:]) for i in issues] == \
+        [("/Set/A/Knight", (0, "Q101")), ("/Set/A/Knight", (1, "Q101"))]
+    nvidia_validate(tmp_path, stage, "--fix")
+    assert (tmp_path / "knight.usda").read_bytes() == geometry
+    assert_same_mesh(composed(stage), expected)
 
 
 def test_the_plug_in_is_not_imported_by_import_affinity_nor_check(tmp_path):

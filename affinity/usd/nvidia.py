@@ -4,12 +4,14 @@ The package's ``usd_validation_nvidia`` entry point is :class:`QuadAffinityPlugi
 its ``on_startup`` registers one rule class per family of
 :data:`affinity.usd.families.FAMILIES` (``UvAffinityChecker``, ...) in the category
 ``quad-affinity`` (``nvidia_usd_validate -c quad-affinity``). A rule reports each
-finding on its mesh prim (every referencing prim for a mesh several prims take from
-one geometry layer) through ``_AddError``, ``_AddWarning`` or ``_AddInfo`` by the
-finding's level, with the message of the UsdValidation plug-in. Errors and warnings
+finding at its mesh prim (for a mesh several prims take from one geometry layer, the
+first of them; the message names the layer and every referencing prim) through
+``_AddError``, ``_AddWarning`` or ``_AddInfo`` by the finding's level, with the message
+of the UsdValidation plug-in. Errors and warnings
 of the affinity families carry a ``Suggestion`` that writes ``affinity fix``'s
-refinement of the prim to the edit target the fixer chooses (``--fix``): NVIDIA's
-fixer picks the strongest layer with an opinion on the prim and saves it in place.
+refinement of the prim (of every referencing prim) to the edit target the fixer
+chooses (``--fix``): NVIDIA's fixer picks the strongest layer with an opinion on the
+prim and saves it in place.
 """
 
 from __future__ import annotations
@@ -43,25 +45,23 @@ class _FamilyChecker(BaseRuleChecker):
             self._AddInfo(message=f"note: {note}", at=prim)
         if said.unreadable is not None:
             self._AddError(message=f"{prim.GetPath()}: Q901 unreadable: {' '.join(said.unreadable.split())}", at=prim)
-        stage = prim.GetStage()
         for f in said.findings:
-            at = [stage.GetPrimAtPath(path) for path in f.prims] if f.prims else prim
             if f.level == "info":
-                self._AddInfo(message=finding_message(f), at=at)
+                self._AddInfo(message=finding_message(f), at=prim)
                 continue
-            suggestion = _refinement(f.code) if self.family.fixable else None
+            suggestion = _refinement(f.code, f.prims or [str(prim.GetPath())]) if self.family.fixable else None
             add = self._AddError if f.level == "error" else self._AddWarning
-            add(message=finding_message(f), at=at, suggestion=suggestion)
+            add(message=finding_message(f), at=prim, suggestion=suggestion)
 
 
-def _refinement(code: str) -> Suggestion:
-    """The Suggestion that refines the flagged quads of rule ``code`` on the issue's prims."""
+def _refinement(code: str, prim_paths: list[str]) -> Suggestion:
+    """The Suggestion that refines the quads rule ``code`` flags on ``prim_paths`` (every prim referencing
+    a shared mesh: the issue is sited at the first, as NVIDIA's fixer takes one site per issue)."""
 
     def refine(stage, at) -> None:
         from .fixing import refine_prims
 
-        prims = at if isinstance(at, list) else [at]
-        refine_prims(stage, [str(prim.GetPath()) for prim in prims], code, stage.GetEditTarget())
+        refine_prims(stage, prim_paths, code, stage.GetEditTarget())
 
     return Suggestion(callable=refine, message=f"Refine the quads {code} flags (affinity fix)")
 

@@ -108,8 +108,8 @@ def _fixer(family: Family):
     def can_apply(error, edit_target, time_code) -> bool:
         from .fixing import can_refine
 
-        try:
-            return edit_target.IsValid() and can_refine(*sites(error), code)
+        try:  # ApplyFix saves the target's layer: one in memory cannot take the fix
+            return edit_target.IsValid() and not edit_target.GetLayer().anonymous and can_refine(*sites(error), code)
         except Exception:
             return False
 
