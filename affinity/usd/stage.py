@@ -51,8 +51,7 @@ def check_stage(stage, time: float | None = None) -> StageCheck:
     """Lint every drawn mesh prim of ``stage`` (at ``time``; None: the earliest sample, as ``affinity check``)."""
     from ..config import file_settings
     from ..errors import MeshError, SkippedFile
-    from ..findings import FileReport, settle, share_authored_geometry
-    from ..lint import lint_mesh
+    from ..findings import mesh_report
     from ..loaders.usd import UsdOptions, load_stage
     from ..output import file_findings
 
@@ -68,12 +67,10 @@ def check_stage(stage, time: float | None = None) -> StageCheck:
     except MeshError as error:
         check.error = error.reason
         return check
-    hits, shared = share_authored_geometry(settle(lint_mesh(mesh, settings), settings, list(mesh.group_names)), mesh)
-    report = FileReport(path, counts=mesh.counts(), hits=hits, group_names=list(mesh.group_names),
-                        prim_face_start=mesh.prim_face_start, shared=shared)
-    check.notes = list(mesh.notes)
+    report = mesh_report(path, mesh, settings)
+    check.notes = report.notes
     check.reported_at = {prim: prim for prim in mesh.group_names}
-    check.reported_at.update({prim: entry["prim"] for entry in shared for prim in entry["prims"]})
+    check.reported_at.update({prim: entry["prim"] for entry in report.shared for prim in entry["prims"]})
     for finding in file_findings(report)[0]:
         check.findings.setdefault(finding.prim or finding.group, []).append(finding)
     return check
