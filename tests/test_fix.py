@@ -256,3 +256,27 @@ def test_a_fixed_closed_mesh_covers_every_pixel_an_even_number_of_times(shared_m
         assert (after % 2 == 0).all()
         # the same outline, but where a nonplanar quad's split and its bilinear surface part
         assert np.count_nonzero((after > 0) != (original > 0)) <= 0.01 * (original > 0).sum()
+
+
+def test_neighbours_refined_at_different_levels_meet_point_for_point():
+    positions = np.array([[x, y, 0.0] for y in (0, 1) for x in range(4)])
+    faces = np.array([[0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6]])
+    mesh = mesh_from_polygons("strip", positions, faces, texcoords=positions[:, :2] / 4)
+    # quads 0 and 1 carry trapezoids of uv of their own, of different strength; quad 2 stays affine
+    trapezoids = [[[0.0, 0], [0.25, 0], [0.23, 0.25], [0.02, 0.25]], [[0.5, 0], [0.75, 0], [0.74, 0.25], [0.51, 0.25]]]
+    mesh.texcoords = np.vstack([mesh.texcoords, *trapezoids])
+    mesh.corner_texcoord = mesh.corner_texcoord.copy()
+    mesh.corner_texcoord[:8] = len(positions) + np.arange(8)
+    plan = plan_fix(mesh)
+    assert plan.refine_faces.tolist() == [0, 1]
+    assert plan.refine_n[0] != plan.refine_n[1]  # each keeps its own level
+    fixed = apply_fix(mesh, plan)
+    fixed.validate()
+    assert fixed.n_faces - mesh.n_faces == plan.faces_added <= plan.faces_added_bound
+    assert not lint_mesh(fixed, Settings())
+    edge_map_agrees(mesh, fixed)
+    # the edge x = 1 shared by the two refined quads carries the points of both levels, once each
+    on_edge = np.unique(fixed.positions[np.isclose(fixed.positions[:, 0], 1)][:, 1])
+    n0, n1 = plan.refine_n.tolist()
+    expected = np.unique(np.concatenate([np.arange(n0 + 1) / n0, np.arange(n1 + 1) / n1]))
+    np.testing.assert_allclose(on_edge, expected, atol=1e-12)

@@ -53,6 +53,7 @@ def add_parser(sub) -> None:
     p.add_argument("--measure", type=_measure, metavar="{" + ",".join(MEASURES) + "}", help="as in check")
     p.add_argument("--diagonal", choices=DIAGONALS, help="as in check")
     p.add_argument("--texture-size", type=int, metavar="PX", help="as in check")
+    p.add_argument("-q", "--quiet", action="store_true", help="text: one summary line per file, no line per face")
     p.add_argument("--config", metavar="FILE", help="as in check")
     p.add_argument("--isolated", action="store_true", help="ignore configuration files")
     p.set_defaults(run=run)
@@ -124,7 +125,7 @@ def _fix_one(path: str, resolver, args) -> dict:
         sys.stderr.write(f"{path}: {reason}\n")
         return {"path": path, "error": reason}
     if args.format == "text":
-        write_text(entry, args.dry_run, sys.stdout)
+        write_text(entry, args.dry_run, sys.stdout, args.quiet)
     return entry
 
 
@@ -162,15 +163,15 @@ def plan_entry(path: str, mesh, plan) -> dict:
     }
 
 
-def write_text(entry: dict, dry_run: bool, out) -> None:
-    """The text of one file: a line per refined and per left quad (``path:line:col: ... [face F]``), then
-    what was (or would be) done."""
+def write_text(entry: dict, dry_run: bool, out, quiet: bool = False) -> None:
+    """The text of one file: a line per refined and per left quad (``path:line:col: ... [face F]``; not when
+    ``quiet``), then what was (or would be) done."""
     path = entry["path"]
     verb = "would refine" if dry_run else "refined"
-    for r in entry["refine"]:
+    for r in [] if quiet else entry["refine"]:
         out.write(f"{r['where']}: {verb} n={r['n']}: {r['code']} {r['before']:.4g} -> {r['after']:.4g} "
                   f"{r['unit']} [face {r['face']}]\n")
-    for r in entry["left"]:
+    for r in [] if quiet else entry["left"]:
         why = "needs more than --max-refine: re-UV it" if r["reason"] == "over-cap" else "not refined"
         out.write(f"{r['where']}: left ({r['reason']}): {why} [face {r['face']}]\n")
     done = f"{verb} {len(entry['refine'])} quads, re-cut {len(entry['transitions'])} neighbours"

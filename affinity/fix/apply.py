@@ -4,9 +4,10 @@ Each attribute table (positions with their vertex colours, texture coordinates,
 normals) grows by the values of its new entries, appended after the existing ones so
 no index of the input moves:
 
-* points on split edges, one run of n - 1 per distinct (start, end) pair of table
-  indices, placed at k/n along the edge in its canonical direction (so both faces on
-  an edge get bit-identical values) — the bilinear blend restricted to the edge;
+* points on edges, one run per distinct (start, end, levels) of table indices, at the
+  edge's parameters (every k/n of the levels of the refined quads on it) along the edge in
+  its canonical direction (so both faces on an edge get bit-identical values) — the
+  bilinear blend restricted to the edge;
 * the (n - 1)^2 inner points of each refined quad, its bilinear blend
   (:mod:`affinity.fix.grid`);
 * the centre of a transition face that needs one (:mod:`affinity.fix.tessellate`).
@@ -23,9 +24,9 @@ import numpy as np
 
 from ..mesh import Mesh
 from . import grid
-from .layout import Layout, layout, transition_patterns
+from .layout import Layout, edge_parameters, face_patterns, layout
 from .plan import FixPlan
-from .tessellate import CENTRE, ring_corners, transition_polygons
+from .tessellate import CENTRE, face_polygons
 
 
 @dataclass(eq=False)
@@ -79,35 +80,35 @@ class _Table:
 
 
 def _edge_points(table: _Table, placed: Layout) -> tuple[np.ndarray, np.ndarray]:
-    """New entries on every split edge of ``table``; per corner, the points of the edge that leaves it.
+    """New entries on every edge with points, in ``table``; per corner, the points of the edge that leaves it.
 
     Returns
     -------
-    start : (C + 1,) int64 corner c's points are ``points[start[c]:start[c + 1]]``, n - 1 of them
-        (none on an edge that is not split), in the direction of its face
+    start : (C + 1,) int64 corner c's points are ``points[start[c]:start[c + 1]]``
+        (:func:`affinity.fix.layout.edge_parameters` of its edge's levels), in the direction of its face
     points : (S,) int64 indices into the table, -1 where an end of the edge has no value
     """
-    per_corner = placed.segments - 1
+    per_corner = placed.points
     start = np.concatenate([[0], np.cumsum(per_corner)])
     points = np.full(start[-1], -1, dtype=np.int64)
     split = np.flatnonzero(per_corner > 0)
-    a, b, m = table.index[split], table.index[placed.following[split]], placed.segments[split]
+    a, b, bits = table.index[split], table.index[placed.following[split]], placed.levels[split]
     forward = (placed.start[split] < placed.end[split]) | ((placed.start[split] == placed.end[split]) & (a <= b))
     low, high = np.where(forward, a, b), np.where(forward, b, a)
     valued = (a >= 0) & (b >= 0)
-    keys, which = np.unique(np.stack([low, high, m], axis=1)[valued], axis=0, return_inverse=True)
+    keys, which = np.unique(np.stack([low, high, bits], axis=1)[valued], axis=0, return_inverse=True)
     which = which.reshape(-1)
     first = np.zeros(len(keys), dtype=np.int64)
-    for count in np.unique(keys[:, 2]).tolist():
-        rows = np.flatnonzero(keys[:, 2] == count)
-        k = (np.arange(1, count) / count)[None, :, None]
-        lerped = table.values[keys[rows, 0]][:, None] * (1 - k) + table.values[keys[rows, 1]][:, None] * k
-        first[rows] = table.append(lerped.reshape(-1, table.values.shape[1]))[:: count - 1]
+    for levels in np.unique(keys[:, 2]).tolist():  # one pass per set of levels on an edge
+        rows = np.flatnonzero(keys[:, 2] == levels)
+        t = np.array([float(p) for p in edge_parameters(levels)])[None, :, None]
+        lerped = table.values[keys[rows, 0]][:, None] * (1 - t) + table.values[keys[rows, 1]][:, None] * t
+        first[rows] = table.append(lerped.reshape(-1, table.values.shape[1]))[:: t.shape[1]]
     occurrence = np.flatnonzero(valued)
-    m_of, forward_of = m[occurrence], forward[occurrence]
-    j = np.arange(int(np.sum(m_of - 1))) - np.repeat(np.cumsum(m_of - 1) - (m_of - 1), m_of - 1)
-    along = np.where(np.repeat(forward_of, m_of - 1), j, np.repeat(m_of, m_of - 1) - 2 - j)
-    points[np.repeat(start[split[occurrence]], m_of - 1) + j] = np.repeat(first[which], m_of - 1) + along
+    count = per_corner[split[occurrence]]
+    j = np.arange(int(count.sum())) - np.repeat(np.cumsum(count) - count, count)
+    along = np.where(np.repeat(forward[occurrence], count), j, np.repeat(count, count) - 1 - j)
+    points[np.repeat(start[split[occurrence]], count) + j] = np.repeat(first[which], count) + along
     return start, points
 
 
@@ -153,52 +154,41 @@ def refine_mesh(mesh: Mesh, plan: FixPlan) -> Refined:
         tables["normals"] = _Table(mesh.normals, mesh.corner_normal, unit=True)
     edges = {name: _edge_points(table, placed) for name, table in tables.items()}
     faces = _Faces(list(tables))
-    for n in np.unique(plan.refine_n).tolist():
-        chosen = plan.refine_faces[plan.refine_n == n]
-        faces.add(np.repeat(chosen, n * n), {name: _refined_grid(table, edges[name], mesh, chosen, n)
-                                             for name, table in tables.items()})
-    for pattern, chosen in transition_patterns(mesh, placed):
-        polygons = transition_polygons(*pattern)
-        rings = {name: _ring(table, edges[name], mesh, chosen, pattern[0], polygons) for name, table in tables.items()}
+    replaced = np.union1d(plan.refine_faces, placed.transition_faces)
+    for pattern, chosen in face_patterns(mesh, placed, replaced):
+        polygons = face_polygons(*pattern)
+        ids = {name: _local_points(table, edges[name], mesh, chosen, pattern, polygons)
+               for name, table in tables.items()}
         for size in sorted({len(p) for p in polygons}):
-            picked = [p for p in polygons if len(p) == size]
+            picked = np.array([p for p in polygons if len(p) == size])
             faces.add(np.repeat(chosen, len(picked)),
-                      {name: ring[:, np.array(picked)].reshape(-1, size) for name, ring in rings.items()})
-    return _assemble(mesh, plan, placed, tables, faces)
+                      {name: local[:, picked].reshape(-1, size) for name, local in ids.items()})
+    return _assemble(mesh, replaced, tables, faces)
 
 
-def _refined_grid(table: _Table, edge: tuple, mesh: Mesh, faces: np.ndarray, n: int) -> np.ndarray:
-    """(Q n^2, 4) int64 table indices of the pieces of the quads ``faces`` (Q,) refined at level n."""
+def _local_points(table: _Table, edge: tuple, mesh: Mesh, faces: np.ndarray, pattern: tuple,
+                  polygons) -> np.ndarray:
+    """(T, L) int64 table indices of the local ids of :func:`~affinity.fix.tessellate.face_polygons` for the
+    faces ``faces`` (T,) of one pattern: the ring (corners, edge points), a refined quad's inner grid
+    points, then the centre when the cut needs one (:data:`CENTRE` = -1 picks the last column)."""
     start, points = edge
-    corners = mesh.face_start[faces, None] + np.arange(4)
-    ids = np.empty((len(faces), (n + 1) ** 2), dtype=np.int64)
-    ids[:, [0, n, (n + 1) ** 2 - 1, n * (n + 1)]] = table.index[corners]
-    for side, where in enumerate(grid.boundary_points(n)):
-        ids[:, where] = points[start[corners[:, side], None] + np.arange(n - 1)]
-    ids[:, grid.interior_points(n)] = table.blend_new(table.index[corners], grid.bilinear_weights(n)[
-        grid.interior_points(n)])
-    return ids[:, grid.sub_quads(n)].reshape(-1, 4)
-
-
-def _ring(table: _Table, edge: tuple, mesh: Mesh, faces: np.ndarray, counts: tuple, polygons) -> np.ndarray:
-    """(T, M [+ 1]) int64 table indices around the transition faces ``faces`` (T,) of one pattern:
-    corners and edge points in ring order, then the centre when the pattern's cut needs one."""
-    start, points = edge
+    level, edge_levels = pattern[0], pattern[1]
+    counts = [len(edge_parameters(bits)) + 1 for bits in edge_levels]
     corners = mesh.face_start[faces, None] + np.arange(len(counts))
-    ring = np.empty((len(faces), sum(counts)), dtype=np.int64)
-    for i, at in enumerate(ring_corners(counts)):
-        ring[:, at] = table.index[corners[:, i]]
-        ring[:, at + 1 : at + counts[i]] = points[start[corners[:, i], None] + np.arange(counts[i] - 1)]
+    columns = []
+    for i, count in enumerate(counts):
+        columns += [table.index[corners[:, i, None]], points[start[corners[:, i], None] + np.arange(count - 1)]]
+    if level:
+        inner = grid.bilinear_weights(level)[grid.interior_points(level)]
+        columns.append(table.blend_new(table.index[corners], inner))
     if any(CENTRE in p for p in polygons):
-        centre = table.blend_new(table.index[corners], np.full((1, len(counts)), 1 / len(counts)))
-        ring = np.concatenate([ring, centre], axis=1)  # CENTRE = -1 picks the last column
-    return ring
+        columns.append(table.blend_new(table.index[corners], np.full((1, len(counts)), 1 / len(counts))))
+    return np.concatenate(columns, axis=1)
 
 
-def _assemble(mesh: Mesh, plan: FixPlan, placed: Layout, tables: dict, faces: _Faces) -> Refined:
+def _assemble(mesh: Mesh, replaced: np.ndarray, tables: dict, faces: _Faces) -> Refined:
     """The fixed mesh: kept faces in file order, then the new faces by the face they replace
     (within each USD prim, so the prims' faces stay contiguous)."""
-    replaced = np.union1d(plan.refine_faces, placed.transition_faces)
     kept = np.setdiff1d(np.arange(mesh.n_faces), replaced)
     source_new, sizes_new, corners_new = faces.csr()
     source = np.concatenate([kept, source_new])

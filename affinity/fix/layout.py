@@ -1,18 +1,30 @@
-"""Where the refinement meets the rest of the mesh: which edges it splits and which faces it touches.
+"""Where the refinement meets the rest of the mesh: the points each edge gets and the faces it touches.
 
 Edges are identified by the positions of their ends, not by vertex indices, so two faces
 that meet on a seam (coincident vertices written twice, as OBJ files do where uv or
 colour change) still share the edge: splitting it on one side splits it on the other,
 and no crack opens in space where the file had none.
+
+A refined quad of level n puts points at k/n along each of its edges. An edge keeps the
+points of every refined quad on it: its *levels* (a bit set, bit n for level n) decide
+its points, the union of the k/n (:func:`edge_parameters`), the same for every face on
+the edge, so both sides meet point for point. Quads refined at different levels keep
+their own levels; only the cells of their grids along the shared edge take the other's
+points too (:func:`affinity.fix.tessellate.face_polygons`).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from fractions import Fraction
+from functools import cache
 
 import numpy as np
 
 from ..mesh import Mesh
+
+#: Levels are kept as bits of an int64.
+MAX_LEVEL = 62
 
 
 def welded_vertices(positions: np.ndarray) -> np.ndarray:
@@ -33,33 +45,6 @@ def next_corners(mesh: Mesh) -> np.ndarray:
     return following
 
 
-@dataclass(eq=False)
-class Layout:
-    """The edges a refinement splits, per corner of the mesh.
-
-    Attributes
-    ----------
-    welded : (V,) int64 id of each vertex's position (:func:`welded_vertices`)
-    following : (C,) int64 the next corner of every corner's face (:func:`next_corners`)
-    start, end : (C,) int64 welded ids of the ends of the edge from each corner to the next
-    segments : (C,) int64 segments of the edge from each corner to the next: the refined
-        quad's n on every edge of a refined quad or of a face sharing one with it, else 1
-    transition_faces : (T,) int64 faces not refined that share an edge with a refined quad
-    """
-
-    welded: np.ndarray
-    following: np.ndarray
-    start: np.ndarray
-    end: np.ndarray
-    segments: np.ndarray
-    transition_faces: np.ndarray
-
-    @property
-    def forward(self) -> np.ndarray:
-        """(C,) bool: the edge from each corner runs in its canonical direction (lower welded id first)."""
-        return self.start <= self.end
-
-
 def edge_keys(welded_start: np.ndarray, welded_end: np.ndarray, n_vertices: int) -> np.ndarray:
     """(E,) int64 one key per undirected edge between welded ids.
 
@@ -72,68 +57,85 @@ def edge_keys(welded_start: np.ndarray, welded_end: np.ndarray, n_vertices: int)
     return np.where(low == high, own, low * max(n_vertices, 1) + high)
 
 
-def layout(mesh: Mesh, refine_faces: np.ndarray, refine_n: np.ndarray) -> Layout:
-    """Split every edge of the quads ``refine_faces`` (R,) int64 into their ``refine_n`` (R,) segments.
+@cache
+def edge_parameters(levels: int) -> tuple[Fraction, ...]:
+    """The points of an edge whose refined quads have the level bits ``levels``: every k/n strictly
+    between 0 and 1 for each level n, once, ascending (symmetric: t and 1 - t both appear)."""
+    found = {Fraction(k, n) for n in range(2, MAX_LEVEL + 1) if levels >> n & 1 for k in range(1, n)}
+    return tuple(sorted(found))
 
-    Refined quads that share an edge must have the same n (:func:`equal_levels`).
+
+@dataclass(eq=False)
+class Layout:
+    """The points a refinement puts on each edge, per corner of the mesh.
+
+    Attributes
+    ----------
+    following : (C,) int64 the next corner of every corner's face (:func:`next_corners`)
+    start, end : (C,) int64 welded ids of the ends of the edge from each corner to the next
+    levels : (C,) int64 level bits of the edge from each corner to the next (0: no point on it)
+    level : (F,) int64 every face's refinement level, 0 for a face not refined
+    transition_faces : (T,) int64 faces not refined that share an edge with a refined quad
     """
+
+    following: np.ndarray
+    start: np.ndarray
+    end: np.ndarray
+    levels: np.ndarray
+    level: np.ndarray
+    transition_faces: np.ndarray
+
+    @property
+    def points(self) -> np.ndarray:
+        """(C,) int64: how many points the edge from each corner gets."""
+        bits, which = np.unique(self.levels, return_inverse=True)
+        counts = np.array([len(edge_parameters(b)) for b in bits.tolist()], dtype=np.int64)
+        return counts[which.reshape(-1)]
+
+    @property
+    def forward(self) -> np.ndarray:
+        """(C,) bool: the edge from each corner runs in its canonical direction (lower welded id first)."""
+        return self.start <= self.end
+
+
+def layout(mesh: Mesh, refine_faces: np.ndarray, refine_n: np.ndarray) -> Layout:
+    """Put the points of the quads ``refine_faces`` (R,) int64 refined at levels ``refine_n`` (R,) on their edges."""
+    if len(refine_n) and int(np.max(refine_n)) > MAX_LEVEL:
+        raise ValueError(f"refinement levels go up to {MAX_LEVEL}")
     welded = welded_vertices(mesh.positions)
     following = next_corners(mesh)
     start, end = welded[mesh.corner_vertex], welded[mesh.corner_vertex[following]]
     keys = edge_keys(start, end, len(welded))
     refined_corners = (mesh.face_start[refine_faces, None] + np.arange(4)).reshape(-1)
-    split_keys, first = np.unique(keys[refined_corners], return_index=True)
-    split_n = np.repeat(refine_n, 4)[first]
-    segments = np.ones(len(keys), dtype=np.int64)
+    split_keys, edge = np.unique(keys[refined_corners], return_inverse=True)
+    bits = np.zeros(len(split_keys), dtype=np.int64)
+    np.bitwise_or.at(bits, edge.reshape(-1), np.left_shift(1, np.repeat(refine_n, 4)).astype(np.int64))
+    levels = np.zeros(len(keys), dtype=np.int64)
     if len(split_keys):
         at = np.minimum(np.searchsorted(split_keys, keys), len(split_keys) - 1)
         hit = split_keys[at] == keys
-        segments[hit] = split_n[at[hit]]
+        levels[hit] = bits[at[hit]]
+    level = np.zeros(mesh.n_faces, dtype=np.int64)
+    level[refine_faces] = refine_n
     face_of = np.repeat(np.arange(mesh.n_faces), mesh.face_sizes)
     touched = np.zeros(mesh.n_faces, dtype=bool)
-    touched[face_of[segments > 1]] = True
+    touched[face_of[levels > 0]] = True
     touched[refine_faces] = False
-    return Layout(welded, following, start, end, segments, np.flatnonzero(touched))
+    return Layout(following, start, end, levels, level, np.flatnonzero(touched))
 
 
-def equal_levels(mesh: Mesh, faces: np.ndarray, n: np.ndarray) -> np.ndarray:
-    """Raise the levels ``n`` (R,) of quads ``faces`` (R,) so quads sharing an edge share a level.
-
-    Each connected group of refined quads takes its largest level (the shared edge's
-    points must be the same on both sides); a level only ever rises, so every quad still
-    meets the threshold it was refined for. Returns (R,) int64.
-    """
-    n = np.asarray(n, dtype=np.int64).copy()
-    if len(faces) < 2:
-        return n
-    welded = welded_vertices(mesh.positions)
-    corners = mesh.face_start[faces, None] + np.arange(4)
-    start = welded[mesh.corner_vertex[corners]]
-    end = welded[mesh.corner_vertex[corners[:, [1, 2, 3, 0]]]]
-    _, edge = np.unique(edge_keys(start, end, len(welded)).reshape(-1), return_inverse=True)
-    edge = edge.reshape(-1, 4)
-    while True:  # one pass per step across a group: groups of flagged quads are small
-        on_edge = np.zeros(edge.max() + 1, dtype=np.int64)
-        np.maximum.at(on_edge, edge.reshape(-1), np.repeat(n, 4))
-        raised = on_edge[edge].max(axis=1)
-        if (raised == n).all():
-            return n
-        n = raised
-
-
-def transition_patterns(mesh: Mesh, placed: Layout) -> list[tuple[tuple, np.ndarray]]:
-    """The transition faces grouped by their cut's pattern (:func:`affinity.fix.tessellate.transition_polygons`).
+def face_patterns(mesh: Mesh, placed: Layout, faces: np.ndarray) -> list[tuple[tuple, np.ndarray]]:
+    """The faces ``faces`` (n,) int64 grouped by the pattern of their cut
+    (the arguments of :func:`affinity.fix.tessellate.face_polygons`).
 
     Returns
     -------
-    list of (pattern, faces): ``pattern`` the arguments of ``transition_polygons``: the
-    segments of each edge, which corners may be a fan's apex (every corner, but only the
-    reflex one of a concave quad) and which edges are collapsed; ``faces`` (n,) int64 the
-    faces of that pattern in file order.
+    list of (pattern, faces): ``pattern`` = (level, edge level bits per edge, which corners may
+    be a fan's apex (every corner, but only the reflex one of a concave quad), which edges are
+    collapsed); ``faces`` (m,) int64 the faces of that pattern in file order.
     """
     from ..geometry import planar_quads
 
-    faces = placed.transition_faces
     if len(faces) == 0:
         return []
     sizes = mesh.face_sizes[faces]
@@ -141,7 +143,7 @@ def transition_patterns(mesh: Mesh, placed: Layout) -> list[tuple[tuple, np.ndar
     slot = np.arange(width)
     present = slot < sizes[:, None]
     corners = np.where(present, mesh.face_start[faces, None] + slot, 0)
-    counts = np.where(present, placed.segments[corners], 0)
+    bits = np.where(present, placed.levels[corners], -1)
     apexes = present.copy()
     quads = np.flatnonzero(sizes == 4)
     if len(quads):
@@ -149,12 +151,13 @@ def transition_patterns(mesh: Mesh, placed: Layout) -> list[tuple[tuple, np.ndar
         concave = reflex.any(axis=1)
         apexes[quads[concave], :4] = reflex[concave]
     collapsed = present & (placed.start[corners] == placed.end[corners])
-    keys = np.concatenate([counts, apexes, collapsed], axis=1)
+    keys = np.concatenate([placed.level[faces, None], bits, apexes, collapsed], axis=1)
     patterns, which = np.unique(keys, axis=0, return_inverse=True)
     which = which.reshape(-1)
     found = []
     for p, key in enumerate(patterns.tolist()):
-        size = int(np.count_nonzero(key[:width]))
-        flags = [tuple(bool(a) for a in key[at : at + size]) for at in (width, 2 * width)]
-        found.append(((tuple(key[:size]), *flags), faces[which == p]))
+        edges = key[1 : 1 + width]
+        size = sum(b >= 0 for b in edges)
+        flags = [tuple(bool(a) for a in key[at : at + size]) for at in (1 + width, 1 + 2 * width)]
+        found.append(((key[0], tuple(edges[:size]), *flags), faces[which == p]))
     return found

@@ -18,8 +18,8 @@ import numpy as np
 from ..mesh import Mesh, mesh_from_polygons
 from ..settings import Settings
 from . import grid
-from .layout import Layout, equal_levels, layout, transition_patterns
-from .tessellate import transition_polygons
+from .layout import Layout, edge_parameters, face_patterns, layout
+from .tessellate import face_polygons
 
 #: The scored rules a refinement removes.
 SCORED = ("Q101", "Q102", "Q103")
@@ -66,7 +66,8 @@ class FixPlan:
     transition_faces : (T,) int64 faces re-cut to meet the refined quads' new edge points
     faces_added : int faces in the fixed mesh minus faces in the input
     faces_added_bound : int sum of n^2 - 1 over refined quads plus 2 n per refined edge met by
-        a face that is not refined (issue 41)
+        a face that is not refined (issue 41), plus 2 per point that a neighbour refined at
+        another level adds to a refined quad's edge
     """
 
     refine_faces: np.ndarray
@@ -202,10 +203,10 @@ def plan_fix(mesh: Mesh, fix: FixSettings | None = None) -> FixPlan:
     reasons[(reasons == "") & (need > fix.max_refine)] = "over-cap"
     refine = reasons == ""
     refine_faces = candidates[refine]
-    refine_n = equal_levels(mesh, refine_faces, need[refine])
+    refine_n = need[refine]
     codes, before, after, units = _readings(mesh, refine_faces, refine_n, scored, fix)
     placed = layout(mesh, refine_faces, refine_n)
-    added, bound = _face_counts(mesh, placed, refine_n)
+    added, bound = _face_counts(mesh, placed, refine_faces)
     left = ~refine
     return FixPlan(refine_faces, refine_n, codes, before, after, units, candidates[left],
                    reasons[left].astype(str), placed.transition_faces, added, bound)
@@ -233,11 +234,15 @@ def _readings(mesh: Mesh, faces: np.ndarray, n: np.ndarray, scored: dict, fix: F
     return codes.astype(str), before, after, units.astype(str)
 
 
-def _face_counts(mesh: Mesh, placed: Layout, refine_n: np.ndarray) -> tuple[int, int]:
-    """Faces the refinement adds, and the issue's bound on them (:attr:`FixPlan.faces_added_bound`)."""
-    added = int(np.sum(refine_n * refine_n - 1))
-    bound = added
-    for pattern, faces in transition_patterns(mesh, placed):
-        added += (len(transition_polygons(*pattern)) - 1) * len(faces)
-        bound += 2 * sum(m for m in pattern[0] if m > 1) * len(faces)
+def _face_counts(mesh: Mesh, placed: Layout, refine_faces: np.ndarray) -> tuple[int, int]:
+    """Faces the refinement adds, and the bound on them (:attr:`FixPlan.faces_added_bound`)."""
+    added = bound = 0
+    for pattern, faces in face_patterns(mesh, placed, np.union1d(refine_faces, placed.transition_faces)):
+        level, edge_levels = pattern[0], pattern[1]
+        added += (len(face_polygons(*pattern)) - 1) * len(faces)
+        segments = [len(edge_parameters(bits)) + 1 for bits in edge_levels]
+        if level:  # n^2 - 1, and 2 per point another level adds to an edge
+            bound += (level * level - 1 + 2 * sum(m - level for m in segments)) * len(faces)
+        else:  # 2n per edge shared with a quad refined at level n
+            bound += 2 * sum(m for m in segments if m > 1) * len(faces)
     return added, bound

@@ -1,4 +1,11 @@
-"""Transition faces: a face beside refined quads, re-cut so it meets every new edge point.
+"""The cut of every face the fix replaces: the refined quad's grid, and the faces re-cut to meet its points.
+
+A refined quad of level n becomes the n x n cells of its grid (:mod:`affinity.fix.grid`);
+where an edge of it also carries another quad's points (a neighbour refined at another
+level), each cell along that edge is cut like a transition face over the points on its
+outer side, fanned from its inner corner (:func:`face_polygons`).
+
+Transition faces: a face beside refined quads, re-cut so it meets every new edge point.
 
 A face whose edges carry new points (an edge shared with a refined quad, split into n)
 is replaced by triangles (and quads) over its *ring*: its corners and, after each
@@ -24,7 +31,10 @@ stand, so it is built once per such *pattern* as local polygons over ring positi
 
 from __future__ import annotations
 
+from fractions import Fraction
 from functools import cache
+
+from .layout import edge_parameters
 
 #: Ring position of the centre vertex: one past the ring (``len(ring)``) in a pattern's polygons.
 CENTRE = -1
@@ -100,4 +110,56 @@ def _strip(counts: tuple[int, ...], corner: list[int], first: int) -> tuple[tupl
         else:
             polygons.append((along_a[i], along_b[j + 1], along_b[j]))
             j += 1
+    return tuple(polygons)
+
+
+@cache
+def face_polygons(level: int, edge_levels: tuple[int, ...], apex_allowed: tuple[bool, ...],
+                  collapsed: tuple[bool, ...]) -> tuple[tuple[int, ...], ...]:
+    """The cut of a face by its pattern (:func:`affinity.fix.layout.face_patterns`).
+
+    Local ids: 0 .. M - 1 the ring (corners, and after each its edge's points,
+    :func:`affinity.fix.layout.edge_parameters` of ``edge_levels``), then, for a refined
+    quad (``level`` n > 0), its grid's inner points M .. M + (n - 1)^2 - 1 in
+    :func:`affinity.fix.grid.interior_points` order; :data:`CENTRE` for a centre vertex.
+    """
+    params = [edge_parameters(bits) for bits in edge_levels]
+    counts = tuple(len(p) + 1 for p in params)
+    if level == 0:
+        return transition_polygons(counts, apex_allowed, collapsed)
+    n, corner, M = level, ring_corners(counts), sum(counts)
+
+    def on_edge(edge: int, t) -> int:
+        return corner[edge] + 1 + params[edge].index(t)
+
+    def grid_point(i: int, j: int) -> int:
+        if 0 < i < n and 0 < j < n:
+            return M + (j - 1) * (n - 1) + (i - 1)
+        if j == 0:
+            return corner[0] if i == 0 else corner[1] if i == n else on_edge(0, Fraction(i, n))
+        if j == n:
+            return corner[3] if i == 0 else corner[2] if i == n else on_edge(2, 1 - Fraction(i, n))
+        return corner[3 if i == 0 else 1] + 1 + params[3 if i == 0 else 1].index(
+            1 - Fraction(j, n) if i == 0 else Fraction(j, n))
+
+    def between(edge: int, a, b) -> list[int]:
+        """The ring ids of the points of ``edge`` strictly between parameters a < b, ascending."""
+        return [corner[edge] + 1 + k for k, t in enumerate(params[edge]) if a < t < b]
+
+    polygons = []
+    for j in range(n):
+        for i in range(n):
+            sides = [
+                between(0, Fraction(i, n), Fraction(i + 1, n)) if j == 0 else [],
+                between(1, Fraction(j, n), Fraction(j + 1, n)) if i == n - 1 else [],
+                between(2, 1 - Fraction(i + 1, n), 1 - Fraction(i, n)) if j == n - 1 else [],
+                between(3, 1 - Fraction(j + 1, n), 1 - Fraction(j, n)) if i == 0 else [],
+            ]
+            cell = [grid_point(i, j), grid_point(i + 1, j), grid_point(i + 1, j + 1), grid_point(i, j + 1)]
+            if not any(sides):
+                polygons.append(tuple(cell))
+                continue
+            ring = [point for k in range(4) for point in (cell[k], *sides[k])]
+            cut = transition_polygons(tuple(len(side) + 1 for side in sides), (True,) * 4, (False,) * 4)
+            polygons += [tuple(ring[r] for r in polygon) for polygon in cut]
     return tuple(polygons)
