@@ -219,7 +219,8 @@ def _subdivision_note(prims, time) -> str | None:
     if not count:
         return None
     named = " or ".join(sorted({scheme for scheme in schemes if scheme in SUBDIVIDED}))
-    return (f"{count} of {len(prims)} mesh prim{'s' * (len(prims) != 1)} subdivide (subdivisionScheme {named}, "
+    return (f"{count} of {len(prims)} mesh prim{'s' * (len(prims) != 1)} subdivide{'s' * (count == 1)} "
+            f"(subdivisionScheme {named}, "
             "authored or USD's default): the findings are for the cage, which is what Storm draws at its default "
             "complexity and what game engines draw")
 

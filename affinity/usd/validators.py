@@ -92,6 +92,7 @@ def _fixer(family: Family):
     from ..rules import RULES
 
     [code] = family.codes
+    error_name = RULES[code].name
 
     def sites(error) -> tuple:
         prims = [site for site in error.GetSites() if site.GetPrim()]
@@ -101,7 +102,7 @@ def _fixer(family: Family):
         from .fixing import refine_prims
 
         try:
-            return refine_prims(*sites(error), code, edit_target)
+            return error.GetName() == error_name and refine_prims(*sites(error), code, edit_target)
         except Exception:  # a failed fix, not an exception in the host
             return False
 
@@ -109,11 +110,12 @@ def _fixer(family: Family):
         from .fixing import can_refine
 
         try:  # ApplyFix saves the target's layer: one in memory cannot take the fix
-            return edit_target.IsValid() and not edit_target.GetLayer().anonymous and can_refine(*sites(error), code)
+            return (error.GetName() == error_name and edit_target.IsValid() and not edit_target.GetLayer().anonymous
+                    and can_refine(*sites(error), code))
         except Exception:
             return False
 
-    return UsdValidation.ValidationFixer(FIXER, FIXER_DOC, apply, can_apply, [KEYWORD], RULES[code].name)
+    return UsdValidation.ValidationFixer(FIXER, FIXER_DOC, apply, can_apply, [KEYWORD], error_name)
 
 
 def register() -> None:
