@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 from helpers.cli import run
 from helpers.sarif import assert_valid
-from helpers.usd_stages import BIG, SMALL, ST, referenced_stage
+from helpers.usd_stages import BIG, POINTS, SMALL, ST, referenced_stage
 
 pytest.importorskip("pxr", reason="needs the usd extra (usd-core)")
 
@@ -75,3 +75,23 @@ def test_different_stages_are_not_merged(tmp_path):
     findings = check_json(stage, tmp_path / "knight.usda")["findings"]
     assert sorted((Path(f["path"]).name, f["face"]) for f in findings) == \
         [("knight.usda", 0), ("knight.usda", 1), ("set.usda", 0), ("set.usda", 1)]
+
+
+def test_a_prim_that_authors_its_own_points_is_its_own_mesh(tmp_path):
+    """Prim B moves a point of the referenced mesh: its geometry is authored in set.usda, so it is reported
+    on its own (with its own value for the changed quad), and the other three stay one report."""
+    from pxr import Usd, UsdGeom
+
+    stage_path = referenced_stage(tmp_path)
+    stage = Usd.Stage.Open(str(stage_path))
+    moved = [(x, y + 0.5 * (i == 5), z) for i, (x, y, z) in enumerate(POINTS)]  # face 0's corner (-1, 1)
+    UsdGeom.Mesh(stage.GetPrimAtPath("/Set/B/Knight")).GetPointsAttr().Set(moved)
+    stage.GetRootLayer().Save()
+    findings = check_json(stage_path)["findings"]
+    by_prim = {}
+    for f in findings:
+        by_prim.setdefault(f["prim"], []).append(f)
+    assert sorted(by_prim) == ["/Set/A/Knight", "/Set/B/Knight"]
+    assert [f["prims"] for f in by_prim["/Set/A/Knight"]] == [[PRIMS[0], *PRIMS[2:]]] * 2
+    assert all("prims" not in f for f in by_prim["/Set/B/Knight"])
+    assert by_prim["/Set/B/Knight"][0]["value"] != by_prim["/Set/A/Knight"][0]["value"]
