@@ -113,12 +113,13 @@ USD_FIELDS = ("prim", "layer", "layer_prim", "prims", "prim_values")
 
 
 def finding_dict(f: Finding) -> dict:
-    """The finding as a dict with the keys of a JSON finding (the USD-only ones where they apply)."""
-    entry = dataclasses.asdict(f)
-    for key in USD_FIELDS:
-        if entry[key] is None:
-            del entry[key]
-    return entry
+    """The finding as a dict with the keys of a JSON finding (the USD-only ones where they apply).
+
+    Shallow: the lists (``prims``) are the finding's own, not copies (``dataclasses.asdict`` deep-copies
+    every value, which took 6 s for 8,827 findings naming 32 prims each).
+    """
+    return {field.name: value for field in dataclasses.fields(f)
+            if (value := getattr(f, field.name)) is not None or field.name not in USD_FIELDS}
 
 
 def writer(name: str):

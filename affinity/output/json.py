@@ -92,5 +92,6 @@ def document(run: CheckRun) -> dict:
 
 
 def write(run: CheckRun, out: TextIO) -> None:
-    json.dump(document(run), out, separators=(",", ":"))
-    out.write("\n")
+    # One string, one write: json.dump encodes in Python and writes every token on its own
+    # (900,000 writes, 6 s, for 8,827 findings naming 32 prims each); json.dumps uses the C encoder.
+    out.write(json.dumps(document(run), separators=(",", ":")) + "\n")
