@@ -95,3 +95,19 @@ def test_a_prim_that_authors_its_own_points_is_its_own_mesh(tmp_path):
     assert [f["prims"] for f in by_prim["/Set/A/Knight"]] == [[PRIMS[0], *PRIMS[2:]]] * 2
     assert all("prims" not in f for f in by_prim["/Set/B/Knight"])
     assert by_prim["/Set/B/Knight"][0]["value"] != by_prim["/Set/A/Knight"][0]["value"]
+
+
+@pytest.mark.parametrize("fmt", ["json", "sarif", "text"])
+def test_a_merge_of_shards_reports_shared_geometry_as_one_run(tmp_path, fmt):
+    """affinity merge reads layer, prims and each prim's values back from the shards' JSON."""
+    referenced_stage(tmp_path, override_st={"B": [*SMALL, *ST[4:]]})
+    (tmp_path / "other").mkdir()
+    referenced_stage(tmp_path / "other")
+    options = ["--no-cache", "--isolated", "set.usda", "other/set.usda"]
+    whole = run("check", *options, "--format", fmt, cwd=tmp_path)
+    for k in (1, 2):
+        result = run("check", *options, "--shard", f"{k}/2", "--format", "json", "-o", f"shard{k}.json", cwd=tmp_path)
+        assert result.returncode in (0, 1), result.stderr
+    merged = run("merge", "shard1.json", "shard2.json", "--format", fmt, cwd=tmp_path)
+    assert (merged.returncode, merged.stdout) == (whole.returncode, whole.stdout)
+    assert "prim_values" in whole.stdout or fmt == "text"
