@@ -111,3 +111,11 @@ def test_a_merge_of_shards_reports_shared_geometry_as_one_run(tmp_path, fmt):
     merged = run("merge", "shard1.json", "shard2.json", "--format", fmt, cwd=tmp_path)
     assert (merged.returncode, merged.stdout) == (whole.returncode, whole.stdout)
     assert "prim_values" in whole.stdout or fmt == "text"
+
+
+def test_the_result_cache_keeps_shared_geometry(tmp_path, monkeypatch):
+    monkeypatch.setenv("AFFINITY_CACHE_DIR", str(tmp_path / "cache"))
+    stage = referenced_stage(tmp_path, override_st={"B": [*SMALL, *ST[4:]]})
+    fresh = run("check", "--no-cache", "--isolated", "--format", "json", str(stage)).stdout
+    stored, cached = (run("check", "--isolated", "--format", "json", str(stage)).stdout for _ in range(2))
+    assert fresh == stored == cached and '"prim_values"' in cached
