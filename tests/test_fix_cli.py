@@ -35,7 +35,8 @@ def test_dry_run_json_lists_refined_and_left_faces_and_writes_nothing(tmp_path):
     result = run("fix", "--dry-run", "--format", "json", str(path))
     assert result.returncode == 1  # the trapezoid needs n = 23 > 8: left, needing a re-UV
     entry = json.loads(result.stdout)["files"][0]
-    assert entry["refine"] == [] and entry["left"] == [{"face": 0, "reason": "over-cap", "line": 9, "where": f"{path}:9:1"}]
+    assert entry["refine"] == []
+    assert entry["left"] == [{"face": 0, "reason": "over-cap", "line": 9, "where": f"{path}:9:1"}]
     result = run("fix", "--dry-run", "--format", "json", "--max-refine", "24", str(path))
     assert result.returncode == 0
     entry = json.loads(result.stdout)["files"][0]
@@ -193,3 +194,17 @@ def test_after_fix_check_finds_no_scored_finding_but_on_left_quads_and_the_rest_
     expected = {(f["code"], f["face"], round(f["value"], 9), f["level"]) for f in before
                 if f["code"] not in SCORED and f["face"] not in replaced and f["code"][:2] != "Q9"}
     assert unchanged == expected
+
+
+def test_a_neighbour_without_uv_is_re_cut_and_written_without_uv(tmp_path):
+    # the trapezoid, and a square below it sharing its bottom edge, written without texture coordinates
+    text = TRAPEZOID + "v -1 -1 0\nv 1 -1 0\nf 5 6 2 1\n"
+    path = write(tmp_path, "mixed.obj", text)
+    assert run("fix", "--max-refine", "24", str(path)).returncode == 0
+    fixed_text = (tmp_path / "mixed.fixed.obj").read_text()
+    fixed = load(tmp_path / "mixed.fixed.obj")
+    # 23 x 23 pieces with uv; the square fanned over the 23 segments of the shared edge, without uv
+    assert fixed.n_faces == 23 * 23 + 24
+    assert (fixed.corner_texcoord[fixed.face_start[-25]:] == -1).all()
+    assert all("/" not in line for line in fixed_text.splitlines()[-24:])
+    assert findings_of(tmp_path / "mixed.fixed.obj") == []

@@ -151,6 +151,8 @@ def face_patterns(mesh: Mesh, placed: Layout, faces: np.ndarray) -> list[tuple[t
         concave = reflex.any(axis=1)
         apexes[quads[concave], :4] = reflex[concave]
     collapsed = present & (placed.start[corners] == placed.end[corners])
+    refined = placed.level[faces] > 0
+    apexes[refined], collapsed[refined] = False, False  # a refined quad's cut needs neither
     keys = np.concatenate([placed.level[faces, None], bits, apexes, collapsed], axis=1)
     patterns, which = np.unique(keys, axis=0, return_inverse=True)
     which = which.reshape(-1)
