@@ -208,3 +208,14 @@ def test_a_neighbour_without_uv_is_re_cut_and_written_without_uv(tmp_path):
     assert (fixed.corner_texcoord[fixed.face_start[-25]:] == -1).all()
     assert all("/" not in line for line in fixed_text.splitlines()[-24:])
     assert findings_of(tmp_path / "mixed.fixed.obj") == []
+
+
+def test_usage_errors_are_one_line_and_exit_2(tmp_path):
+    path = write(tmp_path, "t.obj", TRAPEZOID)
+    for args, says in ((["-o", str(tmp_path / "t.ply"), str(path)], "its own format"),
+                       (["--max-refine", "99", str(path)], "not a level from 1 to 62"),
+                       (["--in-place", str(tmp_path / "s.usda")], "--in-place"),
+                       (["-o", str(tmp_path / "x.obj"), str(path), str(path)], "one output")):
+        result = run("fix", *args)
+        assert result.returncode == 2 and says in result.stderr and "Traceback" not in result.stderr, args
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.obj"]

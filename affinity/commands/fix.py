@@ -19,8 +19,10 @@ from . import EXIT_CLEAN, EXIT_ERROR, EXIT_FINDINGS
 
 
 def _level(text: str) -> int:
-    if not text.isdigit() or int(text) < 1:
-        raise argparse.ArgumentTypeError(f"not a positive number: {text!r}")
+    from ..fix.layout import MAX_LEVEL
+
+    if not text.isdigit() or not 1 <= int(text) <= MAX_LEVEL:
+        raise argparse.ArgumentTypeError(f"not a level from 1 to {MAX_LEVEL}: {text!r}")
     return int(text)
 
 
@@ -59,6 +61,14 @@ def add_parser(sub) -> None:
     p.set_defaults(run=run)
 
 
+def _format(path: str) -> str:
+    """The format family of a path by its extension: ``"usd"`` for every USD suffix, else the suffix."""
+    from ..fix.write import USD_SUFFIXES
+
+    extension = os.path.splitext(path)[1].lower()
+    return "usd" if extension in USD_SUFFIXES else extension.lstrip(".")
+
+
 def _output_path(path: str, args) -> str:
     from ..fix.write import default_output
 
@@ -77,6 +87,11 @@ def run(args) -> int:
         raise UsageError("-o and --in-place exclude each other")
     if args.output and os.path.exists(args.output) and os.path.samefile(args.output, args.paths[0]):
         raise UsageError(f"-o {args.output} is the input; use --in-place to replace it")
+    if args.output and _format(args.output) != _format(args.paths[0]):
+        raise UsageError(f"-o {args.output}: the fix of {args.paths[0]} is written in its own format "
+                         f"({_format(args.paths[0]) or 'none'})")
+    if args.in_place and any(_format(path) == "usd" for path in args.paths):
+        raise UsageError("--in-place: a USD stage's fix is a layer over it, written beside it (drop --in-place)")
     try:
         resolver = Resolver(_overrides(args), config=args.config, isolated=args.isolated)
     except ConfigError as err:

@@ -18,7 +18,7 @@ import numpy as np
 from ..mesh import Mesh, mesh_from_polygons
 from ..settings import Settings
 from . import grid
-from .layout import Layout, edge_parameters, face_patterns, layout
+from .layout import MAX_LEVEL, Layout, edge_parameters, face_patterns, layout
 from .tessellate import face_polygons
 
 #: The scored rules a refinement removes.
@@ -186,6 +186,8 @@ def plan_fix(mesh: Mesh, fix: FixSettings | None = None) -> FixPlan:
     fix = fix or FixSettings()
     if fix.level not in LEVEL_ORDER:
         raise ValueError(f"fix level must be one of {', '.join(LEVEL_ORDER)}; got {fix.level!r}")
+    if not 1 <= fix.max_refine <= MAX_LEVEL:
+        raise ValueError(f"max_refine must be from 1 to {MAX_LEVEL}; got {fix.max_refine}")
     scored, leaving = flagged_quads(mesh, fix)
     candidates = np.unique(np.concatenate([faces for faces, _ in scored.values()] or [np.zeros(0, np.int64)]))
     if fix.faces is not None:
