@@ -212,10 +212,23 @@ def test_a_neighbour_without_uv_is_re_cut_and_written_without_uv(tmp_path):
 
 def test_usage_errors_are_one_line_and_exit_2(tmp_path):
     path = write(tmp_path, "t.obj", TRAPEZOID)
+    other = write(tmp_path, "u.obj", TRAPEZOID)
+    stage = write(tmp_path, "s.usda", "#usda 1.0\n")
     for args, says in ((["-o", str(tmp_path / "t.ply"), str(path)], "its own format"),
                        (["--max-refine", "99", str(path)], "not a level from 1 to 62"),
-                       (["--in-place", str(tmp_path / "s.usda")], "--in-place"),
-                       (["-o", str(tmp_path / "x.obj"), str(path), str(path)], "one output")):
+                       (["--in-place", str(stage)], "--in-place"),
+                       (["-o", str(tmp_path / "x.obj"), str(path), str(other)], "one output"),
+                       ([str(tmp_path / "missing.obj")], "no such file")):
         result = run("fix", *args)
         assert result.returncode == 2 and says in result.stderr and "Traceback" not in result.stderr, args
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.obj"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.usda", "t.obj", "u.obj"]
+
+
+def test_a_directory_is_walked_and_earlier_fixes_in_it_are_not_inputs(tmp_path):
+    write(tmp_path, "t.obj", TRAPEZOID)
+    (tmp_path / "sub").mkdir()
+    write(tmp_path / "sub", "s.obj", SQUARE)
+    assert run("fix", "--max-refine", "24", str(tmp_path)).returncode == 0
+    assert (tmp_path / "t.fixed.obj").exists() and not (tmp_path / "sub" / "s.fixed.obj").exists()
+    again = run("fix", "--max-refine", "24", "--dry-run", str(tmp_path))
+    assert "t.fixed.obj" not in again.stdout and "t.obj: would refine 1 quads" in again.stdout

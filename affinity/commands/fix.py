@@ -37,7 +37,9 @@ def add_parser(sub) -> None:
                     "each becomes n x n quads on its own bilinear surface, and the faces beside it are re-cut "
                     "to meet the new edge points (no T-junction). Writes NAME.fixed.EXT beside each input.",
     )
-    p.add_argument("paths", nargs="+", metavar="PATH", help="mesh files")
+    p.add_argument("paths", nargs="+", metavar="PATH",
+                   help="mesh files or directories (searched as check searches them; NAME.fixed.EXT files "
+                        "found there are earlier fixes, not inputs)")
     p.add_argument("-o", "--output", metavar="OUT", help="the fixed file (one input only; default NAME.fixed.EXT)")
     p.add_argument("--in-place", action="store_true", help="replace each input with its fix (atomically)")
     p.add_argument("--dry-run", action="store_true",
@@ -77,10 +79,25 @@ def _output_path(path: str, args) -> str:
     return args.output or default_output(path)
 
 
+def _inputs(paths: list[str], resolver) -> list[str]:
+    """The mesh files of ``paths``: files as given, directories walked (earlier fixes found there left out)."""
+    from ..pipeline.files import collect_paths
+
+    found = collect_paths(paths, lambda folder: resolver.resolve(folder).settings,
+                          lambda message: sys.stderr.write(message + "\n"))
+    earlier = [path for path in found if path not in paths and os.path.splitext(path)[0].endswith(".fixed")]
+    return [path for path in found if path not in earlier]
+
+
 def run(args) -> int:
     from ..config import ConfigError, Resolver
     from .check import _overrides
 
+    try:
+        resolver = Resolver(_overrides(args), config=args.config, isolated=args.isolated)
+    except ConfigError as err:
+        raise UsageError(str(err)) from None
+    args.paths = _inputs(args.paths, resolver)
     if args.output and len(args.paths) > 1:
         raise UsageError("-o names one output: give one input, or none of -o for NAME.fixed.EXT beside each")
     if args.output and args.in_place:
@@ -92,10 +109,6 @@ def run(args) -> int:
                          f"({_format(args.paths[0]) or 'none'})")
     if args.in_place and any(_format(path) == "usd" for path in args.paths):
         raise UsageError("--in-place: a USD stage's fix is a layer over it, written beside it (drop --in-place)")
-    try:
-        resolver = Resolver(_overrides(args), config=args.config, isolated=args.isolated)
-    except ConfigError as err:
-        raise UsageError(str(err)) from None
     results = [_fix_one(path, resolver, args) for path in args.paths]
     if args.format == "json":
         import json
