@@ -232,3 +232,18 @@ def test_a_directory_is_walked_and_earlier_fixes_in_it_are_not_inputs(tmp_path):
     assert (tmp_path / "t.fixed.obj").exists() and not (tmp_path / "sub" / "s.fixed.obj").exists()
     again = run("fix", "--max-refine", "24", "--dry-run", str(tmp_path))
     assert "t.fixed.obj" not in again.stdout and "t.obj: would refine 1 quads" in again.stdout
+
+
+def test_a_silenced_face_is_not_fixed_and_nonplanar_quads_only_on_request(tmp_path):
+    silenced = write(tmp_path, "silenced.obj",
+                     TRAPEZOID.replace("f 1/1 2/2 3/3 4/4", "f 1/1 2/2 3/3 4/4  # affinity: ignore[Q101]"))
+    result = run("fix", "--max-refine", "24", "--format", "json", "--dry-run", str(silenced))
+    assert result.returncode == 0 and json.loads(result.stdout)["files"][0]["refine"] == []
+    # a square folded 60 degrees along its diagonal 0-2 (Q202), whose uv is not affine to it (Q101, 36 texels)
+    folded = write(tmp_path, "folded.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0.25 0.75 0.6124\n"
+                   "vt 0 0\nvt 1 0\nvt 1 1\nvt 0.1 0.9\nf 1/1 2/2 3/3 4/4\n")
+    left = json.loads(run("fix", "--dry-run", "--format", "json", "--max-refine", "16", str(folded)).stdout)
+    assert left["files"][0]["left"][0]["reason"] == "nonplanar"
+    refined = json.loads(run("fix", "--dry-run", "--format", "json", "--max-refine", "16", "--refine-nonplanar",
+                             str(folded)).stdout)
+    assert [r["face"] for r in refined["files"][0]["refine"]] == [0]

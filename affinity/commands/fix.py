@@ -50,6 +50,9 @@ def add_parser(sub) -> None:
     p.add_argument("--max-refine", type=_level, default=8, metavar="N",
                    help="refine a quad into at most N x N quads (default 8); one that needs more is left "
                         "and reported as needing a re-UV")
+    p.add_argument("--refine-nonplanar", action="store_true",
+                   help="refine the quads Q202 flags too: their pieces follow the quad's bilinear surface, "
+                        "not the folded split the input draws (default: left)")
     p.add_argument("--select", type=_selection, help="rule codes or prefixes whose findings are fixed, e.g. Q101")
     p.add_argument("--ignore", type=_codes, help="rule codes or prefixes not fixed")
     p.add_argument("--threshold", type=_threshold, action="append", default=[], metavar="[CODE=]VALUE",
@@ -129,6 +132,7 @@ def _fix_one(path: str, resolver, args) -> dict:
     try:
         settings = resolver.resolve(path).settings.for_file(path)
         mesh = load(path)
+        inline = _inline_ignores(path, mesh)
     except SkippedFile as skip:
         sys.stderr.write(f"{path}: skipped ({skip.reason})\n")
         return {"path": path, "skipped": skip.reason}
@@ -136,7 +140,8 @@ def _fix_one(path: str, resolver, args) -> dict:
         sys.stderr.write(f"{path}:{err.line}: Q901 unreadable: {err.reason}\n")
         return {"path": path, "error": err.reason, "line": err.line}
     try:
-        plan = plan_fix(mesh, FixSettings(lint=settings, level=args.fix_level, max_refine=args.max_refine))
+        plan = plan_fix(mesh, FixSettings(lint=settings, level=args.fix_level, max_refine=args.max_refine,
+                                          refine_nonplanar=args.refine_nonplanar, inline=inline))
         entry = plan_entry(path, mesh, plan)
         if not args.dry_run and not plan.empty:
             from ..fix.write import write_fixed
@@ -155,6 +160,14 @@ def _fix_one(path: str, resolver, args) -> dict:
     if args.format == "text":
         write_text(entry, args.dry_run, sys.stdout, args.quiet)
     return entry
+
+
+def _inline_ignores(path: str, mesh) -> list:
+    """The ``# affinity: ignore[...]`` comments of an OBJ file, as ``affinity check`` reads them."""
+    from ..loaders import read_source, reads_whole
+    from ..loaders.suppress import inline_ignores
+
+    return inline_ignores(read_source(path), mesh.face_line) if reads_whole(path) else []
 
 
 def summary(plan) -> str:

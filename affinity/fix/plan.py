@@ -41,12 +41,19 @@ class FixSettings:
     level : the lowest level of a Q101-Q103 finding that is fixed: ``"info"``, ``"warning"``, ``"error"``
     max_refine : the largest n (n x n pieces per quad); a quad that needs more is left ``over-cap``
     faces : (k,) int64 the only faces that may be refined (a Blender selection), None: any
+    refine_nonplanar : refine the quads Q202 flags too (their pieces follow the bilinear surface,
+        not the split the input draws), instead of leaving them
+    inline : ``(codes, faces)`` pairs of findings the file silences where they are
+        (:func:`affinity.loaders.suppress.inline_ignores`): such findings are not fixed, as
+        ``affinity check`` does not report them
     """
 
     lint: Settings = field(default_factory=Settings)
     level: str = "warning"
     max_refine: int = 8
     faces: np.ndarray | None = None
+    refine_nonplanar: bool = False
+    inline: list = field(default_factory=list)
 
 
 @dataclass(eq=False)
@@ -102,7 +109,7 @@ def flagged_quads(mesh: Mesh, fix: FixSettings) -> tuple[dict, dict]:
 
     enabled = [code for code in resolve_codes(fix.lint.select, fix.lint.ignore) if code in SCORED]
     settings = replace(fix.lint, select=[*enabled, *LEFT_BY_RULE], ignore=[])
-    hits = settle(lint_mesh(mesh, settings), settings, list(mesh.group_names))
+    hits = settle(lint_mesh(mesh, settings), settings, list(mesh.group_names), fix.inline)
     lowest = LEVEL_ORDER.index(fix.level)
     scored, leaving = {}, {}
     for h in hits:
@@ -194,7 +201,8 @@ def plan_fix(mesh: Mesh, fix: FixSettings | None = None) -> FixPlan:
         candidates = np.intersect1d(candidates, np.asarray(fix.faces, dtype=np.int64))
     reasons = np.full(len(candidates), "", dtype=object)
     for code, reason in reversed(LEFT_BY_RULE.items()):  # the first rule in the table wins
-        reasons[np.isin(candidates, leaving.get(code, []))] = reason
+        if not (reason == "nonplanar" and fix.refine_nonplanar):
+            reasons[np.isin(candidates, leaving.get(code, []))] = reason
     reasons[(reasons == "degenerate") & pole_quads(mesh, candidates)] = ""
     need = np.zeros(len(candidates), dtype=np.int64)
     for code, (faces, values) in scored.items():
