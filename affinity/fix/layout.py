@@ -109,11 +109,6 @@ class Layout:
         counts = np.array([len(edge_parameters(b)) for b in bits.tolist()], dtype=np.int64)
         return counts[which.reshape(-1)]
 
-    @property
-    def forward(self) -> np.ndarray:
-        """(C,) bool: the edge from each corner runs in its canonical direction (lower welded id first)."""
-        return self.start <= self.end
-
 
 def layout(mesh: Mesh, refine_faces: np.ndarray, refine_n: np.ndarray) -> Layout:
     """Put the points of the quads ``refine_faces`` (R,) int64 refined at levels ``refine_n`` (R,) on their edges."""

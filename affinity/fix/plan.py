@@ -6,7 +6,9 @@ the rule's flag threshold, measured by the rule itself on the pieces (the same c
 form ``affinity check`` uses, in texels, 1/255 steps or degrees). The search starts one
 below the guess of the 1/n^2 law, sqrt(value / threshold), and climbs to the cap. A
 quad that needs more than the cap is left (``over-cap``: its texture wants a re-UV);
-degenerate, bow-tie, nonplanar and uv-degenerate quads are left without a search.
+degenerate (pole quads excepted), bow-tie, nonplanar (unless ``refine_nonplanar``) and
+uv-degenerate quads are left without a search. Quads keep their own levels: where two of
+different levels meet, the edge carries both sets of points (:mod:`affinity.fix.layout`).
 """
 
 from __future__ import annotations
