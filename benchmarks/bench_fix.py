@@ -18,7 +18,6 @@ from __future__ import annotations
 import argparse
 import importlib.util
 import os
-import platform
 import statistics
 import sys
 import tempfile
@@ -26,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 from bench_report import timed_process
-from common import parse_with_output, write_table
+from common import parse_with_output, run_conditions, write_table
 
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "meshes"
 CAR = SHARED / "osd_catmark_car.obj"
@@ -77,8 +76,7 @@ def main(argv=None) -> None:
             for name, found in runs.items()]
     write_table([
         f"{quads:,} quads (the shared car, Catmull-Clark x{levels}, face-varying linear uv), "
-        f"{platform.processor() or platform.machine()}, {os.cpu_count()} CPUs, load {load:.2f} before, "
-        f"median of {rounds} round{'s' * (rounds > 1)}, each command in a fresh process:",
+        f"{run_conditions(load, rounds)}, each command in a fresh process:",
         "",
         "| command | wall (s) | x check | peak memory (MiB) |",
         "|---|---:|---:|---:|",

@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import platform
 import statistics
 import subprocess
 import sys
@@ -29,7 +28,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from common import parse_with_output, write_table
+from common import parse_with_output, run_conditions, write_table
 
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "meshes"
 CAR = SHARED / "osd_catmark_car.obj"
@@ -120,8 +119,7 @@ def main(argv=None) -> None:
                     "| mesh | wall (s) | peak memory (MiB) |", "|---|---:|---:|",
                     *(f"| {name} | {seconds:.2f} | {peak:.0f} |" for name, seconds, peak in shared)] if shared else []
     write_table([
-        f"{quads:,} quads ({source}, per-face unit uv), {platform.processor() or platform.machine()}, "
-        f"{os.cpu_count()} CPUs, load {load:.2f} before, median of {rounds} round{'s' * (rounds > 1)}:",
+        f"{quads:,} quads ({source}, per-face unit uv), {run_conditions(load, rounds)}:",
         "",
         "| `affinity report -q` | wall (s) | peak memory (MiB) | UV layout (s) | UV layout share |",
         "|---|---:|---:|---:|---:|",

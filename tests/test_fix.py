@@ -280,3 +280,43 @@ def test_neighbours_refined_at_different_levels_meet_point_for_point():
     n0, n1 = plan.refine_n.tolist()
     expected = np.unique(np.concatenate([np.arange(n0 + 1) / n0, np.arange(n1 + 1) / n1]))
     np.testing.assert_allclose(on_edge, expected, atol=1e-12)
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_random_grids_with_random_flagged_quads_stay_crack_free_and_clean(seed):
+    """A jittered grid (some cells cut into two triangles) whose quads carry, at random, a uv of their own
+    that is not an affine image of them: whatever levels the quads need, the fix leaves no T-junction and
+    no flagged quad but the listed ones, and adds exactly the faces it reports."""
+    rng = np.random.default_rng(seed)
+    nx, ny = rng.integers(3, 7, size=2)
+    X, Y = np.meshgrid(np.arange(nx + 1.0), np.arange(ny + 1.0))
+    X[1:-1, 1:-1] += rng.uniform(-0.2, 0.2, X[1:-1, 1:-1].shape)
+    Y[1:-1, 1:-1] += rng.uniform(-0.2, 0.2, Y[1:-1, 1:-1].shape)
+    positions = np.stack([X.ravel(), Y.ravel(), np.zeros(X.size)], axis=1)
+    cells = [[j * (nx + 1) + i, j * (nx + 1) + i + 1, (j + 1) * (nx + 1) + i + 1, (j + 1) * (nx + 1) + i]
+             for j in range(ny) for i in range(nx)]
+    quads = [c for c in cells if rng.random() > 0.15]
+    triangles = [t for c in cells if c not in quads for t in ([c[0], c[1], c[2]], [c[0], c[2], c[3]])]
+    sizes = [4] * len(quads) + [3] * len(triangles)
+    corner_vertex = np.array([v for face in quads + triangles for v in face])
+    texcoords = positions[:, :2] / max(nx, ny)
+    corner_texcoord = corner_vertex.copy()
+    own = np.flatnonzero(rng.random(len(quads)) < 0.4)
+    extra = []
+    for q in own.tolist():  # a uv trapezoid of the quad's own, pinched by a random amount
+        base = texcoords[quads[q]].copy()
+        base[2:, 0] += np.array([-1, 1]) * rng.uniform(0.002, 0.03)
+        corner_texcoord[4 * q : 4 * q + 4] = len(texcoords) + len(extra) + np.arange(4)
+        extra += base.tolist()
+    mesh = Mesh(path="random", positions=positions, face_start=np.concatenate([[0], np.cumsum(sizes)]),
+                corner_vertex=corner_vertex, face_line=np.zeros(len(sizes), dtype=np.int64),
+                texcoords=np.vstack([texcoords, extra]) if extra else texcoords, corner_texcoord=corner_texcoord)
+    mesh.validate()
+    plan = plan_fix(mesh, FixSettings(max_refine=int(rng.integers(4, 13))))
+    refined = refine_mesh(mesh, plan)
+    fixed = refined.mesh
+    fixed.validate()
+    assert fixed.n_faces - mesh.n_faces == plan.faces_added <= plan.faces_added_bound
+    edge_map_agrees(mesh, fixed)
+    remaining = [refined.source[f] for h in lint_mesh(fixed, Settings()) if h.code in SCORED for f in h.faces]
+    assert set(np.asarray(remaining, dtype=np.int64).tolist()) <= set(plan.left_faces.tolist())

@@ -35,7 +35,8 @@ def test_dry_run_json_lists_refined_and_left_faces_and_writes_nothing(tmp_path):
     result = run("fix", "--dry-run", "--format", "json", str(path))
     assert result.returncode == 1  # the trapezoid needs n = 23 > 8: left, needing a re-UV
     entry = json.loads(result.stdout)["files"][0]
-    assert entry["refine"] == [] and entry["left"] == [{"face": 0, "reason": "over-cap", "line": 9, "where": f"{path}:9:1"}]
+    assert entry["refine"] == []
+    assert entry["left"] == [{"face": 0, "reason": "over-cap", "line": 9, "where": f"{path}:9:1"}]
     result = run("fix", "--dry-run", "--format", "json", "--max-refine", "24", str(path))
     assert result.returncode == 0
     entry = json.loads(result.stdout)["files"][0]
@@ -193,3 +194,56 @@ def test_after_fix_check_finds_no_scored_finding_but_on_left_quads_and_the_rest_
     expected = {(f["code"], f["face"], round(f["value"], 9), f["level"]) for f in before
                 if f["code"] not in SCORED and f["face"] not in replaced and f["code"][:2] != "Q9"}
     assert unchanged == expected
+
+
+def test_a_neighbour_without_uv_is_re_cut_and_written_without_uv(tmp_path):
+    # the trapezoid, and a square below it sharing its bottom edge, written without texture coordinates
+    text = TRAPEZOID + "v -1 -1 0\nv 1 -1 0\nf 5 6 2 1\n"
+    path = write(tmp_path, "mixed.obj", text)
+    assert run("fix", "--max-refine", "24", str(path)).returncode == 0
+    fixed_text = (tmp_path / "mixed.fixed.obj").read_text()
+    fixed = load(tmp_path / "mixed.fixed.obj")
+    # 23 x 23 pieces with uv; the square fanned over the 23 segments of the shared edge, without uv
+    assert fixed.n_faces == 23 * 23 + 24
+    assert (fixed.corner_texcoord[fixed.face_start[-25]:] == -1).all()
+    assert all("/" not in line for line in fixed_text.splitlines()[-24:])
+    assert findings_of(tmp_path / "mixed.fixed.obj") == []
+
+
+def test_usage_errors_are_one_line_and_exit_2(tmp_path):
+    path = write(tmp_path, "t.obj", TRAPEZOID)
+    other = write(tmp_path, "u.obj", TRAPEZOID)
+    stage = write(tmp_path, "s.usda", "#usda 1.0\n")
+    for args, says in ((["-o", str(tmp_path / "t.ply"), str(path)], "its own format"),
+                       (["--max-refine", "99", str(path)], "not a level from 1 to 62"),
+                       (["--in-place", str(stage)], "--in-place"),
+                       (["-o", str(tmp_path / "x.obj"), str(path), str(other)], "one output"),
+                       ([str(tmp_path / "missing.obj")], "no such file")):
+        result = run("fix", *args)
+        assert result.returncode == 2 and says in result.stderr and "Traceback" not in result.stderr, args
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.usda", "t.obj", "u.obj"]
+
+
+def test_a_directory_is_walked_and_earlier_fixes_in_it_are_not_inputs(tmp_path):
+    write(tmp_path, "t.obj", TRAPEZOID)
+    (tmp_path / "sub").mkdir()
+    write(tmp_path / "sub", "s.obj", SQUARE)
+    assert run("fix", "--max-refine", "24", str(tmp_path)).returncode == 0
+    assert (tmp_path / "t.fixed.obj").exists() and not (tmp_path / "sub" / "s.fixed.obj").exists()
+    again = run("fix", "--max-refine", "24", "--dry-run", str(tmp_path))
+    assert "t.fixed.obj" not in again.stdout and "t.obj: would refine 1 quads" in again.stdout
+
+
+def test_a_silenced_face_is_not_fixed_and_nonplanar_quads_only_on_request(tmp_path):
+    silenced = write(tmp_path, "silenced.obj",
+                     TRAPEZOID.replace("f 1/1 2/2 3/3 4/4", "f 1/1 2/2 3/3 4/4  # affinity: ignore[Q101]"))
+    result = run("fix", "--max-refine", "24", "--format", "json", "--dry-run", str(silenced))
+    assert result.returncode == 0 and json.loads(result.stdout)["files"][0]["refine"] == []
+    # a square folded 60 degrees along its diagonal 0-2 (Q202), whose uv is not affine to it (Q101, 36 texels)
+    folded = write(tmp_path, "folded.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0.25 0.75 0.6124\n"
+                   "vt 0 0\nvt 1 0\nvt 1 1\nvt 0.1 0.9\nf 1/1 2/2 3/3 4/4\n")
+    left = json.loads(run("fix", "--dry-run", "--format", "json", "--max-refine", "16", str(folded)).stdout)
+    assert left["files"][0]["left"][0]["reason"] == "nonplanar"
+    refined = json.loads(run("fix", "--dry-run", "--format", "json", "--max-refine", "16", "--refine-nonplanar",
+                             str(folded)).stdout)
+    assert [r["face"] for r in refined["files"][0]["refine"]] == [0]

@@ -19,8 +19,10 @@ from . import EXIT_CLEAN, EXIT_ERROR, EXIT_FINDINGS
 
 
 def _level(text: str) -> int:
-    if not text.isdigit() or int(text) < 1:
-        raise argparse.ArgumentTypeError(f"not a positive number: {text!r}")
+    from ..fix.layout import MAX_LEVEL
+
+    if not text.isdigit() or not 1 <= int(text) <= MAX_LEVEL:
+        raise argparse.ArgumentTypeError(f"not a level from 1 to {MAX_LEVEL}: {text!r}")
     return int(text)
 
 
@@ -35,7 +37,9 @@ def add_parser(sub) -> None:
                     "each becomes n x n quads on its own bilinear surface, and the faces beside it are re-cut "
                     "to meet the new edge points (no T-junction). Writes NAME.fixed.EXT beside each input.",
     )
-    p.add_argument("paths", nargs="+", metavar="PATH", help="mesh files")
+    p.add_argument("paths", nargs="+", metavar="PATH",
+                   help="mesh files or directories (searched as check searches them; NAME.fixed.EXT files "
+                        "found there are earlier fixes, not inputs)")
     p.add_argument("-o", "--output", metavar="OUT", help="the fixed file (one input only; default NAME.fixed.EXT)")
     p.add_argument("--in-place", action="store_true", help="replace each input with its fix (atomically)")
     p.add_argument("--dry-run", action="store_true",
@@ -46,6 +50,9 @@ def add_parser(sub) -> None:
     p.add_argument("--max-refine", type=_level, default=8, metavar="N",
                    help="refine a quad into at most N x N quads (default 8); one that needs more is left "
                         "and reported as needing a re-UV")
+    p.add_argument("--refine-nonplanar", action="store_true",
+                   help="refine the quads Q202 flags too: their pieces follow the quad's bilinear surface, "
+                        "not the folded split the input draws (default: left)")
     p.add_argument("--select", type=_selection, help="rule codes or prefixes whose findings are fixed, e.g. Q101")
     p.add_argument("--ignore", type=_codes, help="rule codes or prefixes not fixed")
     p.add_argument("--threshold", type=_threshold, action="append", default=[], metavar="[CODE=]VALUE",
@@ -59,6 +66,14 @@ def add_parser(sub) -> None:
     p.set_defaults(run=run)
 
 
+def _format(path: str) -> str:
+    """The format family of a path by its extension: ``"usd"`` for every USD suffix, else the suffix."""
+    from ..fix.write import USD_SUFFIXES
+
+    extension = os.path.splitext(path)[1].lower()
+    return "usd" if extension in USD_SUFFIXES else extension.lstrip(".")
+
+
 def _output_path(path: str, args) -> str:
     from ..fix.write import default_output
 
@@ -67,20 +82,36 @@ def _output_path(path: str, args) -> str:
     return args.output or default_output(path)
 
 
+def _inputs(paths: list[str], resolver) -> list[str]:
+    """The mesh files of ``paths``: files as given, directories walked (earlier fixes found there left out)."""
+    from ..pipeline.files import collect_paths
+
+    found = collect_paths(paths, lambda folder: resolver.resolve(folder).settings,
+                          lambda message: sys.stderr.write(message + "\n"))
+    earlier = [path for path in found if path not in paths and os.path.splitext(path)[0].endswith(".fixed")]
+    return [path for path in found if path not in earlier]
+
+
 def run(args) -> int:
     from ..config import ConfigError, Resolver
     from .check import _overrides
 
+    try:
+        resolver = Resolver(_overrides(args), config=args.config, isolated=args.isolated)
+    except ConfigError as err:
+        raise UsageError(str(err)) from None
+    args.paths = _inputs(args.paths, resolver)
     if args.output and len(args.paths) > 1:
         raise UsageError("-o names one output: give one input, or none of -o for NAME.fixed.EXT beside each")
     if args.output and args.in_place:
         raise UsageError("-o and --in-place exclude each other")
     if args.output and os.path.exists(args.output) and os.path.samefile(args.output, args.paths[0]):
         raise UsageError(f"-o {args.output} is the input; use --in-place to replace it")
-    try:
-        resolver = Resolver(_overrides(args), config=args.config, isolated=args.isolated)
-    except ConfigError as err:
-        raise UsageError(str(err)) from None
+    if args.output and _format(args.output) != _format(args.paths[0]):
+        raise UsageError(f"-o {args.output}: the fix of {args.paths[0]} is written in its own format "
+                         f"({_format(args.paths[0]) or 'none'})")
+    if args.in_place and any(_format(path) == "usd" for path in args.paths):
+        raise UsageError("--in-place: a USD stage's fix is a layer over it, written beside it (drop --in-place)")
     results = [_fix_one(path, resolver, args) for path in args.paths]
     if args.format == "json":
         import json
@@ -101,6 +132,7 @@ def _fix_one(path: str, resolver, args) -> dict:
     try:
         settings = resolver.resolve(path).settings.for_file(path)
         mesh = load(path)
+        inline = _inline_ignores(path, mesh)
     except SkippedFile as skip:
         sys.stderr.write(f"{path}: skipped ({skip.reason})\n")
         return {"path": path, "skipped": skip.reason}
@@ -108,7 +140,8 @@ def _fix_one(path: str, resolver, args) -> dict:
         sys.stderr.write(f"{path}:{err.line}: Q901 unreadable: {err.reason}\n")
         return {"path": path, "error": err.reason, "line": err.line}
     try:
-        plan = plan_fix(mesh, FixSettings(lint=settings, level=args.fix_level, max_refine=args.max_refine))
+        plan = plan_fix(mesh, FixSettings(lint=settings, level=args.fix_level, max_refine=args.max_refine,
+                                          refine_nonplanar=args.refine_nonplanar, inline=inline))
         entry = plan_entry(path, mesh, plan)
         if not args.dry_run and not plan.empty:
             from ..fix.write import write_fixed
@@ -127,6 +160,14 @@ def _fix_one(path: str, resolver, args) -> dict:
     if args.format == "text":
         write_text(entry, args.dry_run, sys.stdout, args.quiet)
     return entry
+
+
+def _inline_ignores(path: str, mesh) -> list:
+    """The ``# affinity: ignore[...]`` comments of an OBJ file, as ``affinity check`` reads them."""
+    from ..loaders import read_source, reads_whole
+    from ..loaders.suppress import inline_ignores
+
+    return inline_ignores(read_source(path), mesh.face_line) if reads_whole(path) else []
 
 
 def summary(plan) -> str:

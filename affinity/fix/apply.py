@@ -24,7 +24,7 @@ import numpy as np
 
 from ..mesh import Mesh
 from . import grid
-from .layout import Layout, edge_parameters, face_patterns, layout
+from .layout import Layout, edge_parameters, face_patterns, layout, unique_rows
 from .plan import FixPlan
 from .tessellate import CENTRE, face_polygons
 
@@ -96,8 +96,9 @@ def _edge_points(table: _Table, placed: Layout) -> tuple[np.ndarray, np.ndarray]
     forward = (placed.start[split] < placed.end[split]) | ((placed.start[split] == placed.end[split]) & (a <= b))
     low, high = np.where(forward, a, b), np.where(forward, b, a)
     valued = (a >= 0) & (b >= 0)
-    keys, which = np.unique(np.stack([low, high, bits], axis=1)[valued], axis=0, return_inverse=True)
-    which = which.reshape(-1)
+    ends = np.stack([low, high, bits], axis=1)[valued]
+    first_row, which = unique_rows(ends)
+    keys = ends[first_row]
     first = np.zeros(len(keys), dtype=np.int64)
     for levels in np.unique(keys[:, 2]).tolist():  # one pass per set of levels on an edge
         rows = np.flatnonzero(keys[:, 2] == levels)

@@ -71,18 +71,6 @@ def blend(corner_values: np.ndarray, n: int) -> np.ndarray:
     return np.einsum("pk,qkd->qpd", bilinear_weights(n), corner_values)
 
 
-def boundary_points(n: int) -> np.ndarray:
-    """Grid indices of the points on each edge of the quad, corners excluded, in edge order.
-
-    Returns
-    -------
-    (4, n - 1) int64: edge e runs from corner e to corner e + 1 (0: t = 0 rising s;
-    1: s = 1 rising t; 2: t = 1 falling s; 3: s = 0 falling t).
-    """
-    k = np.arange(1, n)
-    return np.stack([k, k * (n + 1) + n, n * (n + 1) + n - k, (n - k) * (n + 1)])
-
-
 def interior_points(n: int) -> np.ndarray:
     """(n - 1)^2 int64 grid indices of the points strictly inside the quad."""
     j, i = np.divmod(np.arange((n - 1) ** 2), n - 1)

@@ -27,12 +27,29 @@ from ..mesh import Mesh
 MAX_LEVEL = 62
 
 
+def unique_rows(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The distinct rows of (n, k) ``rows``, by a sort on the columns (``np.unique(axis=0)`` sorts them as
+    raw bytes, several times slower on large arrays; equal numbers are equal here, -0.0 and 0.0 too).
+
+    Returns
+    -------
+    first : (U,) int64 a row of each distinct row, in the rows' sorted order
+    inverse : (n,) int64 the distinct row of every row
+    """
+    if len(rows) == 0:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    order = np.lexsort(rows.T[::-1])
+    ordered = rows[order]
+    new = np.ones(len(rows), dtype=bool)
+    new[1:] = (ordered[1:] != ordered[:-1]).any(axis=1)
+    inverse = np.empty(len(rows), dtype=np.int64)
+    inverse[order] = np.cumsum(new) - 1
+    return order[new], inverse
+
+
 def welded_vertices(positions: np.ndarray) -> np.ndarray:
     """(V,) int64: one id per distinct position (equal coordinates, equal id)."""
-    if len(positions) == 0:
-        return np.zeros(0, dtype=np.int64)
-    rows = np.ascontiguousarray(positions, dtype=np.float64) + 0.0  # -0.0 and 0.0 weld
-    return np.unique(rows.view(np.dtype((np.void, 24))).ravel(), return_inverse=True)[1].reshape(-1).astype(np.int64)
+    return unique_rows(np.asarray(positions, dtype=np.float64))[1]
 
 
 def next_corners(mesh: Mesh) -> np.ndarray:
@@ -92,11 +109,6 @@ class Layout:
         counts = np.array([len(edge_parameters(b)) for b in bits.tolist()], dtype=np.int64)
         return counts[which.reshape(-1)]
 
-    @property
-    def forward(self) -> np.ndarray:
-        """(C,) bool: the edge from each corner runs in its canonical direction (lower welded id first)."""
-        return self.start <= self.end
-
 
 def layout(mesh: Mesh, refine_faces: np.ndarray, refine_n: np.ndarray) -> Layout:
     """Put the points of the quads ``refine_faces`` (R,) int64 refined at levels ``refine_n`` (R,) on their edges."""
@@ -151,11 +163,12 @@ def face_patterns(mesh: Mesh, placed: Layout, faces: np.ndarray) -> list[tuple[t
         concave = reflex.any(axis=1)
         apexes[quads[concave], :4] = reflex[concave]
     collapsed = present & (placed.start[corners] == placed.end[corners])
+    refined = placed.level[faces] > 0
+    apexes[refined], collapsed[refined] = False, False  # a refined quad's cut needs neither
     keys = np.concatenate([placed.level[faces, None], bits, apexes, collapsed], axis=1)
-    patterns, which = np.unique(keys, axis=0, return_inverse=True)
-    which = which.reshape(-1)
+    first, which = unique_rows(keys)
     found = []
-    for p, key in enumerate(patterns.tolist()):
+    for p, key in enumerate(keys[first].tolist()):
         edges = key[1 : 1 + width]
         size = sum(b >= 0 for b in edges)
         flags = [tuple(bool(a) for a in key[at : at + size]) for at in (1 + width, 1 + 2 * width)]

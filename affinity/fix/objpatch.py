@@ -49,9 +49,10 @@ def state_lines(source: bytes, starts: np.ndarray, lines: np.ndarray) -> np.ndar
     return found
 
 
-def _numbers(rows: np.ndarray) -> list[str]:
-    """Each row of (k, D) float64 as space-separated shortest round-trip numbers."""
-    return [" ".join(map(repr, row)) for row in rows.tolist()]
+def _statements(keyword: str, rows: np.ndarray) -> str:
+    """``keyword x y ...`` lines of the rows of (k, D) float64, each number its shortest round-trip form."""
+    line = keyword + " %r" * rows.shape[1] + "\n"
+    return "".join(line % row for row in map(tuple, rows.tolist()))
 
 
 def _corner_words(fixed: Mesh, corners: np.ndarray) -> np.ndarray:
@@ -65,16 +66,29 @@ def _corner_words(fixed: Mesh, corners: np.ndarray) -> np.ndarray:
 
 
 def _face_lines(fixed: Mesh, faces: np.ndarray) -> np.ndarray:
-    """(k,) object: the ``f`` line of each face ``faces`` (k,) int64 of ``fixed``, line end included."""
+    """(k,) object: the ``f`` line of each face ``faces`` (k,) int64 of ``fixed``, line end included.
+
+    Faces whose corners all have the same indices (the usual case) are formatted a whole size
+    at a time with one format string; a face whose corners differ (some without uv or normal)
+    has its corners spelled one by one."""
     lines = np.empty(len(faces), dtype=object)
     sizes = fixed.face_sizes[faces]
+    tables = [index for index in (fixed.corner_texcoord, fixed.corner_normal)]
+    corner_form = "%d" + ("/%d" if tables[0] is not None else "/" if tables[1] is not None else "") + (
+        "/%d" if tables[1] is not None else "")
     for size in np.unique(sizes).tolist():  # one pass per face size
         rows = np.flatnonzero(sizes == size)
-        words = _corner_words(fixed, corner_slots(fixed.face_sizes, faces[rows])).reshape(-1, size)
-        line = "f " + words[:, 0]
-        for column in words.T[1:]:
-            line = line + " " + column
-        lines[rows] = line + "\n"
+        corners = corner_slots(fixed.face_sizes, faces[rows]).reshape(-1, size)
+        columns = [fixed.corner_vertex[corners]] + [index[corners] for index in tables if index is not None]
+        whole = np.ones(len(rows), dtype=bool)
+        for column in columns[1:]:
+            whole &= (column >= 0).all(axis=1)
+        numbers = np.stack(columns, axis=2).reshape(len(rows), -1)[whole] + 1
+        line = "f" + (" " + corner_form) * size + "\n"
+        lines[rows[whole]] = [line % row for row in map(tuple, numbers.tolist())]
+        for row in np.flatnonzero(~whole).tolist():
+            words = _corner_words(fixed, corners[row])
+            lines[rows[row]] = "f " + " ".join(words.tolist()) + "\n"
     return lines
 
 
@@ -91,11 +105,11 @@ def patched_obj(source: bytes, mesh: Mesh, refined: Refined, header: str) -> byt
     kept = b"".join(source[starts[a] : starts[b]] for a, b in zip(runs[::2].tolist(), runs[1::2].tolist()))
     out = ["" if not kept or kept.endswith(b"\n") else "\n", f"# {header}\n"]
     vertex_rows = fixed.positions if fixed.colors is None else np.hstack([fixed.positions, fixed.colors])
-    out += [f"v {row}\n" for row in _numbers(vertex_rows[len(mesh.positions):])]
+    out.append(_statements("v", vertex_rows[len(mesh.positions):]))
     if fixed.texcoords is not None and mesh.texcoords is not None:
-        out += [f"vt {row}\n" for row in _numbers(fixed.texcoords[len(mesh.texcoords):])]
+        out.append(_statements("vt", fixed.texcoords[len(mesh.texcoords):]))
     if fixed.normals is not None and mesh.normals is not None:
-        out += [f"vn {row}\n" for row in _numbers(fixed.normals[len(mesh.normals):])]
+        out.append(_statements("vn", fixed.normals[len(mesh.normals):]))
     new = np.flatnonzero(refined.added)
     lines = _face_lines(fixed, new)
     if len(new):

@@ -6,7 +6,9 @@ the rule's flag threshold, measured by the rule itself on the pieces (the same c
 form ``affinity check`` uses, in texels, 1/255 steps or degrees). The search starts one
 below the guess of the 1/n^2 law, sqrt(value / threshold), and climbs to the cap. A
 quad that needs more than the cap is left (``over-cap``: its texture wants a re-UV);
-degenerate, bow-tie, nonplanar and uv-degenerate quads are left without a search.
+degenerate (pole quads excepted), bow-tie, nonplanar (unless ``refine_nonplanar``) and
+uv-degenerate quads are left without a search. Quads keep their own levels: where two of
+different levels meet, the edge carries both sets of points (:mod:`affinity.fix.layout`).
 """
 
 from __future__ import annotations
@@ -18,7 +20,7 @@ import numpy as np
 from ..mesh import Mesh, mesh_from_polygons
 from ..settings import Settings
 from . import grid
-from .layout import Layout, edge_parameters, face_patterns, layout
+from .layout import MAX_LEVEL, Layout, edge_parameters, face_patterns, layout
 from .tessellate import face_polygons
 
 #: The scored rules a refinement removes.
@@ -41,12 +43,19 @@ class FixSettings:
     level : the lowest level of a Q101-Q103 finding that is fixed: ``"info"``, ``"warning"``, ``"error"``
     max_refine : the largest n (n x n pieces per quad); a quad that needs more is left ``over-cap``
     faces : (k,) int64 the only faces that may be refined (a Blender selection), None: any
+    refine_nonplanar : refine the quads Q202 flags too (their pieces follow the bilinear surface,
+        not the split the input draws), instead of leaving them
+    inline : ``(codes, faces)`` pairs of findings the file silences where they are
+        (:func:`affinity.loaders.suppress.inline_ignores`): such findings are not fixed, as
+        ``affinity check`` does not report them
     """
 
     lint: Settings = field(default_factory=Settings)
     level: str = "warning"
     max_refine: int = 8
     faces: np.ndarray | None = None
+    refine_nonplanar: bool = False
+    inline: list = field(default_factory=list)
 
 
 @dataclass(eq=False)
@@ -102,7 +111,7 @@ def flagged_quads(mesh: Mesh, fix: FixSettings) -> tuple[dict, dict]:
 
     enabled = [code for code in resolve_codes(fix.lint.select, fix.lint.ignore) if code in SCORED]
     settings = replace(fix.lint, select=[*enabled, *LEFT_BY_RULE], ignore=[])
-    hits = settle(lint_mesh(mesh, settings), settings, list(mesh.group_names))
+    hits = settle(lint_mesh(mesh, settings), settings, list(mesh.group_names), fix.inline)
     lowest = LEVEL_ORDER.index(fix.level)
     scored, leaving = {}, {}
     for h in hits:
@@ -186,13 +195,16 @@ def plan_fix(mesh: Mesh, fix: FixSettings | None = None) -> FixPlan:
     fix = fix or FixSettings()
     if fix.level not in LEVEL_ORDER:
         raise ValueError(f"fix level must be one of {', '.join(LEVEL_ORDER)}; got {fix.level!r}")
+    if not 1 <= fix.max_refine <= MAX_LEVEL:
+        raise ValueError(f"max_refine must be from 1 to {MAX_LEVEL}; got {fix.max_refine}")
     scored, leaving = flagged_quads(mesh, fix)
     candidates = np.unique(np.concatenate([faces for faces, _ in scored.values()] or [np.zeros(0, np.int64)]))
     if fix.faces is not None:
         candidates = np.intersect1d(candidates, np.asarray(fix.faces, dtype=np.int64))
     reasons = np.full(len(candidates), "", dtype=object)
     for code, reason in reversed(LEFT_BY_RULE.items()):  # the first rule in the table wins
-        reasons[np.isin(candidates, leaving.get(code, []))] = reason
+        if not (reason == "nonplanar" and fix.refine_nonplanar):
+            reasons[np.isin(candidates, leaving.get(code, []))] = reason
     reasons[(reasons == "degenerate") & pole_quads(mesh, candidates)] = ""
     need = np.zeros(len(candidates), dtype=np.int64)
     for code, (faces, values) in scored.items():

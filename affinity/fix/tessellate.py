@@ -31,7 +31,8 @@ stand, so it is built once per such *pattern* as local polygons over ring positi
 
 from __future__ import annotations
 
-from fractions import Fraction
+import bisect
+import math
 from functools import cache
 
 from .layout import edge_parameters
@@ -128,32 +129,34 @@ def face_polygons(level: int, edge_levels: tuple[int, ...], apex_allowed: tuple[
     if level == 0:
         return transition_polygons(counts, apex_allowed, collapsed)
     n, corner, M = level, ring_corners(counts), sum(counts)
-
-    def on_edge(edge: int, t) -> int:
-        return corner[edge] + 1 + params[edge].index(t)
+    # parameters as integers over one common denominator: exact, and fast to compare
+    scale = math.lcm(n, *(t.denominator for p in params for t in p))
+    numerators = [[int(t * scale) for t in p] for p in params]
+    index = [{t: corner[edge] + 1 + k for k, t in enumerate(p)} for edge, p in enumerate(numerators)]
+    step = scale // n
 
     def grid_point(i: int, j: int) -> int:
         if 0 < i < n and 0 < j < n:
             return M + (j - 1) * (n - 1) + (i - 1)
         if j == 0:
-            return corner[0] if i == 0 else corner[1] if i == n else on_edge(0, Fraction(i, n))
+            return corner[0] if i == 0 else corner[1] if i == n else index[0][i * step]
         if j == n:
-            return corner[3] if i == 0 else corner[2] if i == n else on_edge(2, 1 - Fraction(i, n))
-        return corner[3 if i == 0 else 1] + 1 + params[3 if i == 0 else 1].index(
-            1 - Fraction(j, n) if i == 0 else Fraction(j, n))
+            return corner[3] if i == 0 else corner[2] if i == n else index[2][scale - i * step]
+        return index[3][scale - j * step] if i == 0 else index[1][j * step]
 
-    def between(edge: int, a, b) -> list[int]:
-        """The ring ids of the points of ``edge`` strictly between parameters a < b, ascending."""
-        return [corner[edge] + 1 + k for k, t in enumerate(params[edge]) if a < t < b]
+    def between(edge: int, a: int, b: int) -> list[int]:
+        """The ring ids of the points of ``edge`` strictly between parameters a < b (numerators), ascending."""
+        p = numerators[edge]
+        return [corner[edge] + 1 + k for k in range(bisect.bisect_right(p, a), bisect.bisect_left(p, b))]
 
     polygons = []
     for j in range(n):
         for i in range(n):
             sides = [
-                between(0, Fraction(i, n), Fraction(i + 1, n)) if j == 0 else [],
-                between(1, Fraction(j, n), Fraction(j + 1, n)) if i == n - 1 else [],
-                between(2, 1 - Fraction(i + 1, n), 1 - Fraction(i, n)) if j == n - 1 else [],
-                between(3, 1 - Fraction(j + 1, n), 1 - Fraction(j, n)) if i == 0 else [],
+                between(0, i * step, (i + 1) * step) if j == 0 else [],
+                between(1, j * step, (j + 1) * step) if i == n - 1 else [],
+                between(2, scale - (i + 1) * step, scale - i * step) if j == n - 1 else [],
+                between(3, scale - (j + 1) * step, scale - j * step) if i == 0 else [],
             ]
             cell = [grid_point(i, j), grid_point(i + 1, j), grid_point(i + 1, j + 1), grid_point(i, j + 1)]
             if not any(sides):

@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..mesh import Mesh
+from .layout import unique_rows
 
 
 def _split_vertices(mesh: Mesh, per_vertex: list[str]) -> tuple[np.ndarray, np.ndarray]:
@@ -23,9 +24,8 @@ def _split_vertices(mesh: Mesh, per_vertex: list[str]) -> tuple[np.ndarray, np.n
     vertex_of : (C,) int64 the written vertex of every corner
     """
     columns = [mesh.corner_vertex] + [getattr(mesh, name) for name in per_vertex if getattr(mesh, name) is not None]
-    keys = np.stack(columns, axis=1)
-    _, first, vertex_of = np.unique(keys, axis=0, return_index=True, return_inverse=True)
-    return first, vertex_of.reshape(-1)
+    first, vertex_of = unique_rows(np.stack(columns, axis=1))
+    return first, vertex_of
 
 
 def _rows(columns: list[np.ndarray]) -> list[str]:
