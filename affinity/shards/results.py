@@ -13,7 +13,9 @@ same output as the run itself. Four things are rebuilt rather than read:
 - a message longer than the rule's summary is the summary and a detail;
 - a USD stage's faces count within their prim in JSON: the prims get
   consecutive face ranges in the order they appear (JSON lists a file's findings
-  in face order), which keeps the file order of every finding.
+  in face order), which keeps the file order of every finding;
+- a mesh several prims reference from one geometry layer: its findings' ``layer``,
+  ``layer_prim``, ``prims`` and ``prim_values`` become the report's ``shared`` entry.
 """
 
 from __future__ import annotations
@@ -124,12 +126,26 @@ def _report(entry: dict, findings: list[dict]) -> FileReport:
         path,
         counts={key: value for key, value in entry.items() if key not in _ENTRY_KEYS},
         hits=hits,
+        shared=_shared(findings),
         group_names=group_names,
         prim_face_start=prim_face_start,
         up_axis=entry.get("up_axis"),
         meters_per_unit=entry.get("meters_per_unit"),
         notes=list(entry.get("notes", [])),
     )
+
+
+def _shared(findings: list[dict]) -> list[dict]:
+    """The :attr:`FileReport.shared` entries the findings on shared geometry name (in the order of their prims)."""
+    shared: dict[str, dict] = {}
+    for f in findings:
+        if "prims" not in f:
+            continue
+        entry = shared.setdefault(f["prim"], {"prim": f["prim"], "layer": f["layer"], "layer_prim": f["layer_prim"],
+                                              "prims": f["prims"], "values": {}})
+        if "prim_values" in f:
+            entry["values"].setdefault(f["code"], []).append([f["face"], f["prim_values"]])
+    return list(shared.values())
 
 
 def _prim_face_start(faces: np.ndarray, groups: np.ndarray, n_groups: int) -> np.ndarray:
