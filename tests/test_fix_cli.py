@@ -247,3 +247,11 @@ def test_a_silenced_face_is_not_fixed_and_nonplanar_quads_only_on_request(tmp_pa
     refined = json.loads(run("fix", "--dry-run", "--format", "json", "--max-refine", "16", "--refine-nonplanar",
                              str(folded)).stdout)
     assert [r["face"] for r in refined["files"][0]["refine"]] == [0]
+
+
+def test_windows_line_ends_are_kept_and_used_for_the_new_lines(tmp_path):
+    path = write(tmp_path, "t.obj", TRAPEZOID.replace("\n", "\r\n").encode())
+    assert run("fix", "--max-refine", "24", str(path)).returncode == 0
+    output = (tmp_path / "t.fixed.obj").read_bytes()
+    assert output.startswith(TRAPEZOID.replace("\n", "\r\n").rsplit("f ", 1)[0].encode())
+    assert output.count(b"\n") == output.count(b"\r\n") and load(tmp_path / "t.fixed.obj").n_faces == 529
