@@ -11,12 +11,16 @@ from __future__ import annotations
 import importlib
 import os
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..findings import FileReport, RuleHits
 from ..rules import LEVELS, RULES, with_unit
 from ..settings import Settings
+
+if TYPE_CHECKING:
+    from ..shards.selection import ShardRecord
 
 FORMATS = ("text", "json", "sarif", "github", "junit")
 #: SARIF results / GitHub annotations per run without ``--max-findings``: code scanning takes at most 25,000.
@@ -33,6 +37,8 @@ class CheckRun:
     ``max_findings`` caps the findings the structured formats keep per file and
     rule (the worst; ``--max-findings``); without it SARIF and GitHub output keep
     at most ``run_cap`` per run (:meth:`capped`). ``statistics`` asks for per-rule counts.
+    ``shard`` (:class:`affinity.shards.selection.ShardRecord`) is set when the run
+    checked one shard of a larger one (``--shard K/N``).
     """
 
     reports: list[FileReport]
@@ -41,6 +47,7 @@ class CheckRun:
     max_findings: int | None = None
     statistics: bool = False
     run_cap: int = RUN_CAP
+    shard: ShardRecord | None = None
 
     def tally(self) -> dict[str, int]:
         """Counts for a summary: ``files``, ``checked``, ``unreadable``, ``skipped``, ``findings``, ``baselined``."""

@@ -14,7 +14,8 @@ Document layout::
       "summary": {"files", "checked", "unreadable", "skipped", "findings",
                   "baselined", "by_rule": {"Q101": n, ...}, "by_level": {"warning": n, ...}},
       with --max-findings N: "truncated": [{"path", "code", "kept", "total"}],
-      with --statistics: "statistics": [{"code", "name", "level", "count"}]
+      with --statistics: "statistics": [{"code", "name", "level", "count"}],
+      with --shard K/N: "shard": {"index", "of", "run_files", "run_digest", "positions", "baseline", "version"}
     }
 
 Written compact (no indentation): machine formats are read by machines.
@@ -34,6 +35,8 @@ is 0. ``settings`` are the resolved settings for the working directory (a file
 governed by another configuration file was checked with that file's settings;
 ``affinity check --show-settings PATH`` prints them). With ``--baseline``, ``findings`` holds
 only the new findings and ``summary.baselined`` counts those the baseline hid.
+``shard`` ties a shard's result to its run (:class:`affinity.shards.selection.ShardRecord`);
+``affinity merge`` reads these documents back.
 """
 
 from __future__ import annotations
@@ -85,6 +88,8 @@ def document(run: CheckRun) -> dict:
         doc["truncated"] = truncation(run, run.max_findings)
     if run.statistics:
         doc["statistics"] = statistics(run.reports)
+    if run.shard is not None:
+        doc["shard"] = dataclasses.asdict(run.shard)
     return doc
 
 

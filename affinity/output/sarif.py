@@ -27,6 +27,10 @@ file keeps the worst N results per rule instead, and the run's
 the total; ``--statistics`` adds ``properties.statistics`` (per-rule
 counts). The log is written compact.
 
+A shard's log (``--shard K/N``) names its shard in ``automationDetails.id``
+(``quad-affinity/shard-K-of-N/``, the category code scanning keys uploads by), so
+the shards' uploads do not replace each other; a merged log has none.
+
 Unreadable (Q901) and skipped files are not results: they are tool execution
 notifications of the run's invocation, and an unreadable file makes
 ``executionSuccessful`` false.
@@ -62,6 +66,12 @@ def _descriptor(rule) -> dict:
         "defaultConfiguration": {"level": sarif_level(rule.level)},
         "properties": {"unit": rule.unit, "defaultThreshold": rule.default_threshold},
     }
+
+
+def shard_category(shard) -> str:
+    """The code scanning category of shard K of N: ``quad-affinity/shard-K-of-N/`` (a trailing ``/``
+    makes the whole id the category, with no run id)."""
+    return f"quad-affinity/shard-{shard.index}-of-{shard.of}/"
 
 
 def sarif_level(level: str) -> str:
@@ -194,6 +204,7 @@ def document(run: CheckRun) -> dict:
             "originalUriBaseIds": {SRCROOT: {"uri": _folder_uri(Path.cwd())}},
             "columnKind": "unicodeCodePoints",
             "results": results,
+            **({} if run.shard is None else {"automationDetails": {"id": shard_category(run.shard)}}),
             **({"properties": properties} if properties else {}),
         }],
     }
