@@ -247,3 +247,32 @@ def test_a_silenced_face_is_not_fixed_and_nonplanar_quads_only_on_request(tmp_pa
     refined = json.loads(run("fix", "--dry-run", "--format", "json", "--max-refine", "16", "--refine-nonplanar",
                              str(folded)).stdout)
     assert [r["face"] for r in refined["files"][0]["refine"]] == [0]
+
+
+def test_windows_line_ends_are_kept_and_used_for_the_new_lines(tmp_path):
+    path = write(tmp_path, "t.obj", TRAPEZOID.replace("\n", "\r\n").encode())
+    assert run("fix", "--max-refine", "24", str(path)).returncode == 0
+    output = (tmp_path / "t.fixed.obj").read_bytes()
+    assert output.startswith(TRAPEZOID.replace("\n", "\r\n").rsplit("f ", 1)[0].encode())
+    assert output.count(b"\n") == output.count(b"\r\n") and load(tmp_path / "t.fixed.obj").n_faces == 529
+
+
+def test_dry_run_reports_the_faces_a_grid_with_one_flagged_quad_gains(tmp_path):
+    """A 5 x 5 grid whose middle quad carries a uv trapezoid of its own: --dry-run's faces_added is what
+    the fix adds, and at most n^2 - 1 plus 2n for each of the four edges it shares with an unrefined quad."""
+    lines = [f"v {x} {y} 0" for y in range(6) for x in range(6)] + [f"vt {x / 5} {y / 5}" for y in range(6)
+                                                                     for x in range(6)]
+    lines += ["vt 0.40 0.40", "vt 0.60 0.40", "vt 0.57 0.6", "vt 0.43 0.6"]
+    for j in range(5):
+        for i in range(5):
+            v = [j * 6 + i + 1, j * 6 + i + 2, (j + 1) * 6 + i + 2, (j + 1) * 6 + i + 1]
+            t = [37, 38, 39, 40] if (i, j) == (2, 2) else v
+            lines.append("f " + " ".join(f"{a}/{b}" for a, b in zip(v, t)))
+    path = write(tmp_path, "grid.obj", "\n".join(lines) + "\n")
+    entry = json.loads(run("fix", "--dry-run", "--format", "json", str(path)).stdout)["files"][0]
+    assert [r["face"] for r in entry["refine"]] == [12] and entry["left"] == []
+    n = entry["refine"][0]["n"]
+    assert entry["transitions"] == [7, 11, 13, 17]
+    assert entry["faces_added"] <= n * n - 1 + 4 * 2 * n == entry["faces_added_bound"]
+    assert run("fix", str(path)).returncode == 0
+    assert load(tmp_path / "grid.fixed.obj").n_faces == 25 + entry["faces_added"]

@@ -79,3 +79,33 @@ def test_override_layer_composes_to_the_fixed_mesh_and_leaves_the_input_alone(tm
                                    getattr(expected, name)[getattr(expected, index)], atol=1e-5)
     check = run("check", "--isolated", str(out))
     assert check.returncode == 0, check.stdout
+
+
+def test_dry_run_numbers_usd_faces_as_the_check_does(tmp_path):
+    import json
+
+    path = tmp_path / "stage.usda"
+    # a clean square first, then the trapezoid: its face counts from 0 within its prim, as in the check's JSON
+    path.write_text("""#usda 1.0
+def Mesh "First"
+{
+    point3f[] points = [(5, 0, 0), (6, 0, 0), (6, 1, 0), (5, 1, 0)]
+    int[] faceVertexCounts = [4]
+    int[] faceVertexIndices = [0, 1, 2, 3]
+}
+
+def Mesh "Panel"
+{
+    point3f[] points = [(-1, 0, 0), (1, 0, 0), (0.5, 1, 0), (-0.5, 1, 0)]
+    int[] faceVertexCounts = [4]
+    int[] faceVertexIndices = [0, 1, 2, 3]
+    texCoord2f[] primvars:st = [(0, 0), (1, 0), (1, 1), (0, 1)] (
+        interpolation = "vertex"
+    )
+}
+""")
+    checked = json.loads(run("check", "--format", "json", "--isolated", str(path)).stdout)["findings"]
+    planned = json.loads(run("fix", "--dry-run", "--format", "json", "--max-refine", "24", str(path)).stdout)
+    refine = planned["files"][0]["refine"]
+    assert [(r["prim"], r["face"]) for r in refine] == [(f["prim"], f["face"]) for f in checked] == [("/Panel", 0)]
+    assert refine[0]["where"] == f"{path}:/Panel:face 0"

@@ -179,26 +179,37 @@ def summary(plan) -> str:
 
 def where(path: str, mesh, face: int) -> str:
     """How a text line names a face: ``path:line:1`` (design.md), ``path:/prim/path:face N`` in a USD stage."""
-    if mesh.prim_face_start is None:
+    numbered = as_in_check(mesh, face)
+    if "prim" not in numbered:
         return f"{path}:{int(mesh.face_line[face])}:1"
+    return f"{path}:{numbered['prim']}:face {numbered['face']}"
+
+
+def as_in_check(mesh, face: int) -> dict:
+    """A face as ``affinity check --format json`` numbers it: ``face`` in file order, or in a USD stage
+    ``face`` within its mesh prim and ``prim`` the prim's path."""
+    if mesh.prim_face_start is None:
+        return {"face": face}
     group = int(mesh.face_group[face])
-    return f"{path}:{mesh.group_names[group]}:face {face - int(mesh.prim_face_start[group])}"
+    return {"face": face - int(mesh.prim_face_start[group]), "prim": mesh.group_names[group]}
 
 
 def plan_entry(path: str, mesh, plan) -> dict:
-    """The JSON entry of a file's plan (design.md: ``refine``, ``left``; the rest is for people)."""
+    """The JSON entry of a file's plan (design.md: ``refine``, ``left``; the rest is for people). Faces are
+    numbered as in the check's JSON (:func:`as_in_check`)."""
     lines = mesh.face_line
     return {
         "path": path,
         "faces": mesh.n_faces,
-        "refine": [{"face": f, "n": n, "line": int(lines[f]), "where": where(path, mesh, f), "code": code,
-                    "before": before, "after": after, "unit": unit}
+        "refine": [{**as_in_check(mesh, f), "n": n, "line": int(lines[f]), "where": where(path, mesh, f),
+                    "code": code, "before": before, "after": after, "unit": unit}
                    for f, n, code, before, after, unit in zip(plan.refine_faces.tolist(), plan.refine_n.tolist(),
                                                               plan.codes.tolist(), plan.before.tolist(),
                                                               plan.after.tolist(), plan.units.tolist())],
-        "left": [{"face": f, "reason": reason, "line": int(lines[f]), "where": where(path, mesh, f)}
+        "left": [{**as_in_check(mesh, f), "reason": reason, "line": int(lines[f]), "where": where(path, mesh, f)}
                  for f, reason in zip(plan.left_faces.tolist(), plan.left_reasons.tolist())],
-        "transitions": plan.transition_faces.tolist(),
+        "transitions": [as_in_check(mesh, f) if mesh.prim_face_start is not None else f
+                        for f in plan.transition_faces.tolist()],
         "faces_added": plan.faces_added,
         "faces_added_bound": plan.faces_added_bound,
     }

@@ -7,6 +7,7 @@ beside them) are dropped; the new ``v``/``vt``/``vn`` rows and faces are appende
 the end, so no index of an existing line moves (negative, relative indices included).
 Before each run of new faces the ``usemtl``, ``g``, ``o`` and ``s`` statements in force
 at the face they replace are restated, so they keep its material, group and smoothing.
+The new lines end as the file's first line does (``\n`` or ``\r\n``).
 """
 
 from __future__ import annotations
@@ -120,4 +121,7 @@ def patched_obj(source: bytes, mesh: Mesh, refined: Refined, header: str) -> byt
             lines[row] = "".join(source[starts[line - 1] : starts[line]].decode("latin-1").rstrip("\r\n") + "\n"
                                  for line in stated) + lines[row]
     out += lines.tolist()
-    return kept + "".join(out).encode("latin-1")
+    appended = "".join(out)
+    if source[: starts[1]].endswith(b"\r\n"):  # a file with Windows line ends gets them on its new lines too
+        appended = appended.replace("\n", "\r\n")
+    return kept + appended.encode("latin-1")
