@@ -27,7 +27,11 @@ def degenerate(quads) -> tuple:
 
     What it does:
         Flags quads with a repeated corner, a collapsed edge or an area at or below
-        the threshold relative to their size.
+        the threshold relative to their size. A quad whose whole area is at or below
+        the threshold gets no Q101-Q103, whether or not this rule is selected (one
+        finding per defect; the message says so); a quad with one repeated corner
+        (a pole quad) is a triangle with area and keeps them: their value is exact
+        there.
 
     Why it matters:
         One of the two triangles of the split covers no pixels, so the half of the
@@ -173,7 +177,8 @@ def bowtie(quads) -> tuple:
 
     What it does:
         Flags quads whose edges cross (a bow-tie) in their own plane; the value
-        reported is the folded fraction of the quad.
+        reported is the folded fraction of the quad. A bow-tie gets no Q101-Q103,
+        whether or not this rule is selected (one finding per defect).
 
     Why it matters:
         A self-crossing quad has no consistent orientation; one half renders
