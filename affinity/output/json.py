@@ -12,12 +12,15 @@ Document layout::
                     "threshold", "unit", "level", "group", "message", Q101-Q103 only: "measure",
                     USD only: "prim"}],
       "summary": {"files", "checked", "unreadable", "skipped", "findings",
-                  "baselined", "by_rule": {"Q101": n, ...}, "by_level": {"warning": n, ...}},
+                  "baselined", "by_rule": {"Q101": n, ...}, "by_level": {"warning": n, ...},
+                  with --level: "not_shown": {"info": n, ...}},
       with --max-findings N: "truncated": [{"path", "code", "kept", "total"}],
       with --statistics: "statistics": [{"code", "name", "level", "count"}]
     }
 
-Written compact (no indentation): machine formats are read by machines.
+Written compact (no indentation): machine formats are read by machines. The
+findings are written as they are formatted, file by file, so a big run costs
+time and memory in proportion to its findings, with small constants.
 ``level`` is the finding's level (``[levels]`` in the configuration
 overrides the rule's); ``unit`` the unit of ``value`` and ``threshold``.
 With ``--max-findings N`` each file keeps the worst N findings per rule and
@@ -40,10 +43,11 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
 from typing import TextIO
 
 from ..findings import FileReport
-from . import CheckRun, Finding, level_counts, rule_counts, statistics, truncation
+from . import CheckRun, Columns, level_counts, rule_counts, statistics, truncation
 
 SCHEMA = "quad-affinity-check"
 VERSION = 1
@@ -60,34 +64,55 @@ def _file_entry(report: FileReport) -> dict:
     return entry
 
 
-def _finding_entry(f: Finding, settings) -> dict:
-    entry = dataclasses.asdict(f)
-    if f.prim is None:
-        del entry["prim"]
-    measure = settings.measure_of(f.code)
-    if measure is not None:
-        entry["measure"] = measure
-    return entry
+def _finding_rows(settings):
+    """The JSON text of each finding of a :class:`Columns`, written from per-rule pieces encoded once (the
+    keys of :class:`Finding`, in its order, then ``measure``)."""
+
+    def rows(c: Columns) -> list[str]:
+        encode = json.dumps
+        head = f'{{"path":{encode(c.path)},"line":'
+        rule = f',"code":{encode(c.code)},"name":{encode(c.name)},"face":'
+        unit = f',"threshold":{encode(c.threshold)},"unit":{encode(c.unit)},"level":"'
+        measure = settings.measure_of(c.code)
+        tail = "}" if measure is None else f',"measure":{encode(measure)}}}'
+        values = map(float.__repr__, c.value) if math.isfinite(sum(c.value)) else map(encode, c.value)
+        groups, messages = _encoded(c.group), _encoded(c.message)
+        prims = [""] * len(c) if c.prim[0] is None else [f',"prim":{encode(p)}' for p in c.prim]
+        return [f'{head}{line},"column":{column}{rule}{face},"value":{value}{unit}{level}","group":{group},'
+                f'"message":{message}{prim}{tail}'
+                for line, column, face, value, level, group, message, prim in zip(
+                    c.line, c.column, c.face, values, c.level, groups, messages, prims)]
+
+    return rows
 
 
-def document(run: CheckRun) -> dict:
-    """The whole JSON document as Python objects."""
-    findings = [_finding_entry(f, run.settings) for r in run.reports for f in run.kept(r)]
-    doc = {
-        "schema": SCHEMA,
-        "version": VERSION,
-        "settings": dataclasses.asdict(run.settings),
-        "files": [_file_entry(r) for r in run.reports],
-        "findings": findings,
-        "summary": {**run.tally(), "by_rule": rule_counts(run.reports), "by_level": level_counts(run.reports)},
-    }
-    if run.max_findings is not None:
-        doc["truncated"] = truncation(run, run.max_findings)
-    if run.statistics:
-        doc["statistics"] = statistics(run.reports)
-    return doc
+def _encoded(texts: list[str]) -> list[str]:
+    """JSON strings of ``texts``, each distinct text encoded once (a rule's findings share a few)."""
+    known = {text: json.dumps(text) for text in set(texts)}
+    return [known[text] for text in texts]
+
+
+def _summary(run: CheckRun) -> dict:
+    summary = {**run.tally(), "by_rule": rule_counts(run.reports), "by_level": level_counts(run.reports)}
+    if run.hidden is not None:
+        summary["not_shown"] = run.hidden
+    return summary
 
 
 def write(run: CheckRun, out: TextIO) -> None:
-    json.dump(document(run), out, separators=(",", ":"))
-    out.write("\n")
+    """The document, its findings streamed file by file (in source order within a file)."""
+    compact = {"separators": (",", ":")}
+    head = {"schema": SCHEMA, "version": VERSION, "settings": dataclasses.asdict(run.settings),
+            "files": [_file_entry(r) for r in run.reports]}
+    out.write(json.dumps(head, **compact)[:-1] + ',"findings":[')
+    rows, separator = _finding_rows(run.settings), ""
+    for report in run.reports:
+        for block in run.kept(report).formatted(rows):
+            out.write(separator + ",".join(block))
+            separator = ","
+    tail = {"summary": _summary(run)}
+    if run.max_findings is not None:
+        tail["truncated"] = truncation(run, run.max_findings)
+    if run.statistics:
+        tail["statistics"] = statistics(run.reports)
+    out.write("]," + json.dumps(tail, **compact)[1:] + "\n")

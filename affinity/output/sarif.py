@@ -19,9 +19,11 @@ changes, which makes it a new finding.
 
 Each result's ``level`` is the finding's (SARIF's ``note`` for ``info``).
 Without ``--max-findings`` the run keeps at most 5,000 results (code scanning
-accepts 25,000), the worst (errors first, then by how far beyond the threshold;
-:meth:`affinity.output.CheckRun.capped`), in file order, and says so in a tool
-execution notification and one line on stderr. With ``--max-findings N`` each
+accepts 25,000): every file's findings at the failing level (``--fail-on``)
+before anyone's below it, a fair share per file where a level does not fit,
+each file's worst first (:func:`affinity.output.cap.cap_findings`), in file
+order; a tool execution notification and one line on stderr say per level
+what was left out. With ``--max-findings N`` each
 file keeps the worst N results per rule instead, and the run's
 ``properties.truncated`` lists, per file and rule cut, how many were kept of
 the total; ``--statistics`` adds ``properties.statistics`` (per-rule
@@ -41,10 +43,13 @@ from pathlib import Path
 from typing import TextIO
 from urllib.parse import quote
 
+import numpy as np
+
 from .. import __version__
 from ..findings import FileReport
 from ..rules import RULES, UNREADABLE, rule_page
-from . import CheckRun, Finding, face_label, located, statistics, truncation, value_token, working_relative
+from . import CheckRun, Finding, Selection, face_label, located, statistics, truncation, value_token, working_relative
+from .cap import cap_findings
 
 SARIF_VERSION = "2.1.0"
 SARIF_SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
@@ -90,15 +95,15 @@ def fingerprint(code: str, uri: str, group: str, value: float, ordinal: int) -> 
     return hashlib.sha256(text.encode("utf-8")).hexdigest()[:32]
 
 
-def _numbered(run: CheckRun, report: FileReport) -> list[tuple[Finding, int]]:
-    """The file's findings, each with its ordinal among those of the same rule, group and value."""
+def _ordinals(selection: Selection) -> list[int]:
+    """Each finding's ordinal among the file's findings of the same rule, group and value, in file order."""
     seen: dict[tuple, int] = {}
-    numbered = []
-    for f in run.kept(report):
-        identity = (f.code, f.group, value_token(f.value))
-        seen[identity] = seen.get(identity, -1) + 1
-        numbered.append((f, seen[identity]))
-    return numbered
+    ordinals = []
+    for block in selection.formatted(lambda c: [(c.code, g, value_token(v)) for g, v in zip(c.group, c.value)]):
+        for identity in block:
+            seen[identity] = seen.get(identity, -1) + 1
+            ordinals.append(seen[identity])
+    return ordinals
 
 
 def _result(f: Finding, ordinal: int, location: dict, rule_index: int) -> dict:
@@ -120,14 +125,23 @@ def _result(f: Finding, ordinal: int, location: dict, rule_index: int) -> dict:
 
 
 def _results(run: CheckRun) -> tuple[list[dict], str | None]:
-    """The run's results (capped, :meth:`CheckRun.capped`) and the truncation notice (None: nothing cut)."""
-    rows = [(f, ordinal, report.path) for report in run.reports for f, ordinal in _numbered(run, report)]
-    kept = run.capped([f for f, _, _ in rows])
+    """The run's results (capped, :func:`affinity.output.cap.cap_findings`, unless ``--max-findings``), and the
+    truncation notice (None: nothing cut)."""
+    selections = [run.kept(report) for report in run.reports]
+    kept, notice = [np.arange(len(s)) for s in selections], None
+    if run.max_findings is None:
+        capped = cap_findings([(s.level_ranks(), s.badness()) for s in selections], run.fail_on, run.run_cap)
+        kept, notice = capped.kept, capped.note("SARIF results")
     rule_index = {code: i for i, code in enumerate(RULES)}  # registered rules, as the driver lists them
-    locations = {report.path: artifact_location(report.path) for report in run.reports}
-    results = [_result(f, ordinal, locations[path], rule_index[f.code])
-               for f, ordinal, path in (rows[i] for i in kept)]
-    return results, run.cap_notice(len(kept), len(rows), "SARIF results")
+    results = []
+    for selection, rows in zip(selections, kept):
+        if len(rows) == 0:
+            continue
+        location = artifact_location(selection.report.path)
+        ordinals = np.asarray(_ordinals(selection))[rows].tolist()
+        results += [_result(f, ordinal, location, rule_index[f.code])
+                    for f, ordinal in zip(selection.subset(rows).findings(), ordinals)]
+    return results, notice
 
 
 def _logical_location(f: Finding) -> dict | None:

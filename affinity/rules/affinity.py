@@ -59,7 +59,7 @@ def uv_disaffinity(quads) -> tuple:
         f 1/1 2/2 3/3 4/4
 
     Prints:
-        example.obj:10:1: Q101 uv-disaffine: texture coordinates are not an affine image of the positions: no texture found, texels of an assumed 1024x1024 texture (give the size with --texture-size or the texture-size setting) (175.7 vs 0.5 texels) [face 0]
+        example.obj:10:1: Q101 error uv-disaffine: texture coordinates are not an affine image of the positions: no texture found, texels of an assumed 1024x1024 texture (give the size with --texture-size or the texture-size setting) (175.7 vs 0.5 texels) [face 0]
 
     How to fix:
         Re-UV the quad as a parallelogram matching its shape (Blender: UV > Follow
@@ -93,7 +93,7 @@ def color_disaffinity(quads) -> tuple:
         f 1 2 3 4
 
     Prints:
-        example.obj:6:1: Q102 color-disaffine: vertex colours are not an affine image of the positions (110.4 vs 2/255) [face 0]
+        example.obj:6:1: Q102 error color-disaffine: vertex colours are not an affine image of the positions (110.4 vs 2/255) [face 0]
 
     How to fix:
         Repaint the corner colours so opposite corners average to the same colour,
@@ -127,7 +127,7 @@ def normal_disaffinity(quads) -> tuple:
         f 1//1 2//2 3//3 4//4
 
     Prints:
-        example.obj:10:1: Q103 normal-disaffine: normals are not an affine image of the positions (9.847 vs 2 degrees) [face 0]
+        example.obj:10:1: Q103 error normal-disaffine: normals are not an affine image of the positions (9.847 vs 2 degrees) [face 0]
 
     How to fix:
         Subdivide the quad or even out its corners (Blender: Mesh > Clean Up, or

@@ -46,7 +46,7 @@ def degenerate(quads) -> tuple:
         f 1 2 3 3
 
     Prints:
-        example.obj:5:1: Q201 degenerate-quad: zero area, collapsed edge or repeated corner (0 vs 1e-09 relative area) [face 0]
+        example.obj:5:1: Q201 warning degenerate-quad: zero area, collapsed edge or repeated corner (0 vs 1e-09 relative area) [face 0]
 
     How to fix:
         Merge the collapsed corners (Blender: Mesh > Clean Up > Merge by Distance)
@@ -121,7 +121,7 @@ def nonplanar(quads) -> tuple:
         f 1 2 3 4
 
     Prints:
-        example.obj:6:1: Q202 nonplanar-quad: the split folds: the two triangles meet at an angle along the diagonal (60 vs 45 degrees) [face 0]
+        example.obj:6:1: Q202 warning nonplanar-quad: the split folds: the two triangles meet at an angle along the diagonal (60 vs 45 degrees) [face 0]
 
     How to fix:
         Flatten the quad (Blender: Mesh > Clean Up > Make Planar Faces), subdivide
@@ -153,7 +153,7 @@ def concave(quads) -> tuple:
         f 1 2 3 4
 
     Prints:
-        example.obj:6:1: Q203 concave-quad: one corner is reflex (233.1 vs 180 degrees) [face 0]
+        example.obj:6:1: Q203 info concave-quad: one corner is reflex (233.1 vs 180 degrees) [face 0]
 
     How to fix:
         Move the reflex corner outward, or split the quad into two triangles along
@@ -193,7 +193,7 @@ def bowtie(quads) -> tuple:
         f 1 2 3 4
 
     Prints:
-        example.obj:6:1: Q204 bowtie-quad: the quad crosses itself (0.5 folded fraction) [face 0]
+        example.obj:6:1: Q204 error bowtie-quad: the quad crosses itself (0.5 folded fraction) [face 0]
 
     How to fix:
         Reorder the corners (flip the crossing edge) or delete and refill the face

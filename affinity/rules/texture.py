@@ -33,7 +33,7 @@ def uv_degenerate(quads) -> tuple:
         f 1/1 2/2 3/2 4/1
 
     Prints:
-        example.obj:8:1: Q301 uv-degenerate: zero area in texture space: the texture smears over it, so Q101 is not measured on it (0 vs 1e-09 relative area) [face 0]
+        example.obj:8:1: Q301 warning uv-degenerate: zero area in texture space: the texture smears over it, so Q101 is not measured on it (0 vs 1e-09 relative area) [face 0]
 
     References:
         Bloomenthal 2022, §2 (the barycentric test divides by the uv triangles' areas).
@@ -74,7 +74,7 @@ def uv_flipped(quads) -> tuple:
         f 1/1 2/2 3/3 4/4
 
     Prints:
-        example.obj:10:1: Q302 uv-flipped: texture orientation reversed against the surface (-1 relative area) [face 0]
+        example.obj:10:1: Q302 info uv-flipped: texture orientation reversed against the surface (-1 relative area) [face 0]
 
     References:
         Mikkelsen 2008, Simulation of wrinkled surfaces revisited (tangent frames at mirrored UVs).
