@@ -103,7 +103,7 @@ def test_junit_is_valid_xml_with_failures_errors_and_skips():
     assert ET.fromstring(render(junit, warning_gate)).get("failures") == "3"
     props = {p.get("name"): p.get("value") for p in flagged[2].find("properties")}
     assert props["face"] == "2" and float(props["value"]) == 256.0 and float(props["threshold"]) == 0.5
-    assert props["line"] == "12" and props["group"] == "body"
+    assert flagged[2].get("line") == "12" and props["group"] == "body" and props["level"] == "warning"
     (clean,) = suites["clean.obj"].findall("testcase")
     assert list(clean) == []  # a passing testcase
     assert suites["broken.obj"].find("testcase/error").get("type") == "Q901"
@@ -171,3 +171,16 @@ def test_unreadable_file_in_structured_formats_exits_2(meshes):
     assert result.returncode == 2
     assert result.stdout.startswith("::error file=broken.obj,line=4,title=Q901 unreadable::")
     assert result.stderr.startswith("broken.obj:4: Q901 unreadable:")
+
+
+def test_junit_of_a_mesh_with_warnings_only_has_no_failures(shared_meshes):
+    """The vase's 288 findings are warnings (under 2 texels): exit 0, and JUnit agrees; --fail-on warning fails both."""
+    vase = str(shared_meshes / "gen_vase_revolution.obj")
+    result = run("check", "--format", "junit", vase)
+    assert result.returncode == 0, result.stderr
+    root = ET.fromstring(result.stdout)
+    assert (root.get("tests"), root.get("failures")) == ("288", "0")
+    assert all(case.find("system-out").text.split(": ", 2)[1].startswith("Q101 warning ")
+               for case in root.iter("testcase"))
+    gated = run("check", "--format", "junit", "--fail-on", "warning", vase)
+    assert gated.returncode == 1 and ET.fromstring(gated.stdout).get("failures") == "288"

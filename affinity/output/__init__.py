@@ -369,12 +369,14 @@ def text_lines(c: Columns, described: list[str] | None = None) -> list[str]:
     """The ruff-style lines ``path:line:col: CODE level name: message (value vs threshold unit) [face F]``
     (design.md); ``path:prim:face N: CODE level ...`` in USD; no ``[face]`` for file-level findings.
     ``described`` are the findings' :func:`descriptions` when the caller has them."""
-    path, code, name = c.path, c.code, c.name
+    path, code, name, described = c.path, c.code, c.name, described or descriptions(c)
+    if c.prim[0] is None and min(c.face, default=0) >= 0:  # faces of a mesh file: one shape for every line
+        return [f"{path}:{line}:{column}: {code} {level} {name}: {text} [face {face}]"
+                for line, column, face, level, text in zip(c.line, c.column, c.face, c.level, described)]
     return [
         (f"{path}:{prim}:face {face}: " if prim is not None else f"{path}:{line}:{column}: ")
         + f"{code} {level} {name}: {text}" + (f" [face {face}]" if prim is None and face >= 0 else "")
-        for line, column, face, level, prim, text in zip(c.line, c.column, c.face, c.level, c.prim,
-                                                         described or descriptions(c))
+        for line, column, face, level, prim, text in zip(c.line, c.column, c.face, c.level, c.prim, described)
     ]
 
 

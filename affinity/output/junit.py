@@ -1,9 +1,10 @@
 """JUnit XML, for CI systems that show test reports (GitLab, Jenkins, Azure).
 
-One ``<testsuite>`` per file, one ``<testcase>`` per finding (properties face,
-value, threshold, unit, level, line, column, code, name, group, and prim in
-USD). A finding at or above ``--fail-on`` is a ``<failure>`` (type = rule code,
-message = the description, body = the text line); one below it is reported
+One ``<testsuite>`` per file, one ``<testcase>`` per finding (named after the
+rule and the face, with the file and line as attributes; properties face, value,
+threshold, unit, level, group, and prim in USD). A finding at or above
+``--fail-on`` is a ``<failure>`` (type = rule code, message = the
+description, body = the text line); one below it is reported
 without failing, its text line in the testcase's ``<system-out>``, so the
 report's failures are what fails the run. A clean file gets one passing
 testcase, an unreadable file one testcase with an ``<error>`` (type Q901), a
@@ -60,10 +61,8 @@ def _finding_cases(fail_on: str):
         rule = f"{xml_attribute(c.code)} {xml_attribute(c.name)}"
         shared = (f'"/><property name="threshold" value="{c.threshold}"/><property name="unit" '
                   f'value="{xml_attribute(c.unit)}"/><property name="level" value="')
-        named = f'"/><property name="code" value="{xml_attribute(c.code)}"/><property name="name" value="' \
-                f'{xml_attribute(c.name)}"/><property name="group" value="'
-        known: dict[str, str] = {}
-        groups = [known.get(g) or known.setdefault(g, xml_attribute(g)) for g in c.group]
+        escaped = {g: xml_attribute(g) for g in set(c.group)}
+        groups = [escaped[g] for g in c.group]
         prims = ([""] * len(c) if c.prim[0] is None
                  else [f'<property name="prim" value="{xml_attribute(p)}"/>' for p in c.prim])
         described = descriptions(c)
@@ -78,10 +77,10 @@ def _finding_cases(fail_on: str):
         return [
             f'<testcase classname="{path}" name="{rule}{label}" file="{path}" line="{line}">'
             f'<properties><property name="face" value="{face}"/><property name="value" value="{value!r}'
-            f'{shared}{level}"/><property name="line" value="{line}"/><property name="column" value="{column}'
-            f'{named}{group}"/>{prim_property}</properties>{verdict}</testcase>\n'
-            for line, column, face, value, level, group, label, prim_property, verdict in zip(
-                c.line, c.column, c.face, c.value, c.level, groups, labels, prims, verdicts)
+            f'{shared}{level}"/><property name="group" value="{group}"/>{prim_property}</properties>{verdict}'
+            "</testcase>\n"
+            for line, face, value, level, group, label, prim_property, verdict in zip(
+                c.line, c.face, c.value, c.level, groups, labels, prims, verdicts)
         ]
 
     return cases

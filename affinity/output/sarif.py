@@ -48,7 +48,7 @@ import numpy as np
 from .. import __version__
 from ..findings import FileReport
 from ..rules import RULES, UNREADABLE, rule_page
-from . import CheckRun, Finding, Selection, face_label, located, statistics, truncation, value_token, working_relative
+from . import CheckRun, Columns, Selection, descriptions, statistics, truncation, value_token, working_relative
 from .cap import cap_findings
 
 SARIF_VERSION = "2.1.0"
@@ -95,33 +95,47 @@ def fingerprint(code: str, uri: str, group: str, value: float, ordinal: int) -> 
     return hashlib.sha256(text.encode("utf-8")).hexdigest()[:32]
 
 
-def _ordinals(selection: Selection) -> list[int]:
-    """Each finding's ordinal among the file's findings of the same rule, group and value, in file order."""
-    seen: dict[tuple, int] = {}
-    ordinals = []
-    for block in selection.formatted(lambda c: [(c.code, g, value_token(v)) for g, v in zip(c.group, c.value)]):
-        for identity in block:
-            seen[identity] = seen.get(identity, -1) + 1
-            ordinals.append(seen[identity])
+def _ordinals(selection: Selection) -> np.ndarray:
+    """(n,) int64: each finding's ordinal among the file's findings of the same rule, group and value token,
+    in file order (the selection's order)."""
+    tokens = [token for hits, take in selection.parts for token in map(value_token, hits.values[take].tolist())]
+    token = np.unique(np.array(tokens, dtype=str), return_inverse=True)[1].reshape(-1)[selection.order]
+    code = np.concatenate([np.full(len(take), i) for i, (_, take) in enumerate(selection.parts)])[selection.order]
+    group = np.concatenate([hits.groups[take] for hits, take in selection.parts])[selection.order]
+    position = np.arange(len(selection))
+    by_identity = np.lexsort((position, token, group, code))  # file order within each identity
+    keys = np.stack([code, group, token])[:, by_identity]
+    starts = np.flatnonzero(np.concatenate([[True], (keys[:, 1:] != keys[:, :-1]).any(axis=0)]))
+    run_start = np.repeat(starts, np.diff(np.append(starts, len(selection))))
+    ordinals = np.empty(len(selection), dtype=np.int64)
+    ordinals[by_identity] = position - run_start
     return ordinals
 
 
-def _result(f: Finding, ordinal: int, location: dict, rule_index: int) -> dict:
-    result_location: dict = {"physicalLocation": _physical(location, f.line, f.column)}
-    logical = _logical_location(f)
-    if logical:
-        result_location["logicalLocations"] = [logical]
-    return {
-        "ruleId": f.code,
-        "ruleIndex": rule_index,
-        "level": sarif_level(f.level),
-        "message": {"text": located(f)},
-        "locations": [result_location],
-        "partialFingerprints": {FINGERPRINT: fingerprint(f.code, location["uri"], f.group, f.value, ordinal)},
-        "properties": {"name": f.name, "face": f.face, "value": f.value,
-                       "threshold": f.threshold, "unit": f.unit, "level": f.level, "group": f.group,
-                       **({} if f.prim is None else {"prim": f.prim})},
-    }
+def _result_rows(location: dict, rule_index: dict[str, int]):
+    """The SARIF results of a :class:`Columns`, without their fingerprints."""
+
+    def rows(c: Columns) -> list[dict]:
+        results = []
+        for line, column, face, value, level, group, prim, text in zip(
+                c.line, c.column, c.face, c.value, c.level, c.group, c.prim, descriptions(c)):
+            result_location: dict = {"physicalLocation": _physical(location, line, column)}
+            logical, label = _logical_location(prim, group, face)
+            if logical:
+                result_location["logicalLocations"] = [logical]
+            results.append({
+                "ruleId": c.code,
+                "ruleIndex": rule_index[c.code],
+                "level": sarif_level(level),
+                "message": {"text": f"{text}, {label}" if label else text},
+                "locations": [result_location],
+                "properties": {"name": c.name, "face": face, "value": value, "threshold": c.threshold,
+                               "unit": c.unit, "level": level, "group": group,
+                               **({} if prim is None else {"prim": prim})},
+            })
+        return results
+
+    return rows
 
 
 def _results(run: CheckRun) -> tuple[list[dict], str | None]:
@@ -138,20 +152,26 @@ def _results(run: CheckRun) -> tuple[list[dict], str | None]:
         if len(rows) == 0:
             continue
         location = artifact_location(selection.report.path)
-        ordinals = np.asarray(_ordinals(selection))[rows].tolist()
-        results += [_result(f, ordinal, location, rule_index[f.code])
-                    for f, ordinal in zip(selection.subset(rows).findings(), ordinals)]
+        ordinals = iter(_ordinals(selection)[rows].tolist())
+        for block in selection.subset(rows).formatted(_result_rows(location, rule_index)):
+            for result in block:
+                properties = result["properties"]
+                result["partialFingerprints"] = {FINGERPRINT: fingerprint(
+                    result["ruleId"], location["uri"], properties["group"], properties["value"], next(ordinals))}
+            results += block
     return results, notice
 
 
-def _logical_location(f: Finding) -> dict | None:
-    """The USD mesh prim, or the face (qualified by its group); None for file-level findings."""
-    if f.prim is not None:
-        return {"name": f.prim.rsplit("/", 1)[-1], "fullyQualifiedName": f.prim, "kind": "object"}
-    if not face_label(f):
-        return None
-    qualified = "/".join(filter(None, [f.group, face_label(f)]))
-    return {"name": face_label(f), "fullyQualifiedName": qualified, "kind": "element"}
+def _logical_location(prim: str | None, group: str, face: int) -> tuple[dict | None, str]:
+    """The USD mesh prim, or the face (qualified by its group), and how the message names the face; (None, "")
+    for file-level findings."""
+    if face < 0:
+        return None, ""
+    if prim is not None:
+        return ({"name": prim.rsplit("/", 1)[-1], "fullyQualifiedName": prim, "kind": "object"},
+                f"{prim} face {face}")
+    label = f"face {face}"
+    return {"name": label, "fullyQualifiedName": "/".join(filter(None, [group, label])), "kind": "element"}, label
 
 
 def _notifications(reports: list[FileReport], truncated: str | None) -> list[dict]:
@@ -214,5 +234,5 @@ def document(run: CheckRun) -> dict:
 
 
 def write(run: CheckRun, out: TextIO) -> None:
-    json.dump(document(run), out, separators=(",", ":"))
+    out.write(json.dumps(document(run), separators=(",", ":")))
     out.write("\n")
