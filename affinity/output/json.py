@@ -76,20 +76,19 @@ def _finding_rows(settings):
         measure = settings.measure_of(c.code)
         tail = "}" if measure is None else f',"measure":{encode(measure)}}}'
         values = map(float.__repr__, c.value) if math.isfinite(sum(c.value)) else map(encode, c.value)
-        groups, messages = _encoded(c.group), _encoded(c.message)
-        prims = [""] * len(c) if c.prim[0] is None else [f',"prim":{encode(p)}' for p in c.prim]
-        return [f'{head}{line},"column":{column}{rule}{face},"value":{value}{unit}{level}","group":{group},'
-                f'"message":{message}{prim}{tail}'
-                for line, column, face, value, level, group, message, prim in zip(
-                    c.line, c.column, c.face, values, c.level, groups, messages, prims)]
+        # What follows the value depends on a few texts only (level, group, message, prim): each written once.
+        texts = list(zip(c.level, c.group, c.message, c.prim))
+        ends = {key: unit + _after_level(*key) + tail for key in set(texts)}
+        return [f'{head}{line},"column":{column}{rule}{face},"value":{value}{ends[key]}'
+                for line, column, face, value, key in zip(c.line, c.column, c.face, values, texts)]
 
     return rows
 
 
-def _encoded(texts: list[str]) -> list[str]:
-    """JSON strings of ``texts``, each distinct text encoded once (a rule's findings share a few)."""
-    known = {text: json.dumps(text) for text in set(texts)}
-    return [known[text] for text in texts]
+def _after_level(level: str, group: str, message: str, prim: str | None) -> str:
+    """A finding's JSON from its level's value to its message (and prim)."""
+    return f'{level}","group":{json.dumps(group)},"message":{json.dumps(message)}' + (
+        "" if prim is None else f',"prim":{json.dumps(prim)}')
 
 
 def _summary(run: CheckRun) -> dict:

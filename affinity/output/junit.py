@@ -61,10 +61,11 @@ def _finding_cases(fail_on: str):
         rule = f"{xml_attribute(c.code)} {xml_attribute(c.name)}"
         shared = (f'"/><property name="threshold" value="{c.threshold}"/><property name="unit" '
                   f'value="{xml_attribute(c.unit)}"/><property name="level" value="')
-        escaped = {g: xml_attribute(g) for g in set(c.group)}
-        groups = [escaped[g] for g in c.group]
-        prims = ([""] * len(c) if c.prim[0] is None
-                 else [f'<property name="prim" value="{xml_attribute(p)}"/>' for p in c.prim])
+        # What follows the value depends on a few texts only (level, group, prim): each written once.
+        texts = list(zip(c.level, c.group, c.prim))
+        ends = {(level, group, prim): f'{shared}{level}"/><property name="group" value="{xml_attribute(group)}"/>'
+                + ("" if prim is None else f'<property name="prim" value="{xml_attribute(prim)}"/>')
+                + "</properties>" for level, group, prim in set(texts)}
         described = descriptions(c)
         lines = text_lines(c, described)
         if _needs_escaping(c):  # numbers never do: only the path, messages, groups and prims can
@@ -75,12 +76,10 @@ def _finding_cases(fail_on: str):
         labels = ["" if face < 0 else f" face {face}" if prim is None else f" {xml_attribute(prim)} face {face}"
                   for face, prim in zip(c.face, c.prim)]
         return [
-            f'<testcase classname="{path}" name="{rule}{label}" file="{path}" line="{line}">'
-            f'<properties><property name="face" value="{face}"/><property name="value" value="{value!r}'
-            f'{shared}{level}"/><property name="group" value="{group}"/>{prim_property}</properties>{verdict}'
+            f'<testcase classname="{path}" name="{rule}{label}" file="{path}" line="{line}"><properties>'
+            f'<property name="face" value="{face}"/><property name="value" value="{value!r}{ends[key]}{verdict}'
             "</testcase>\n"
-            for line, face, value, level, group, label, prim_property, verdict in zip(
-                c.line, c.face, c.value, c.level, groups, labels, prims, verdicts)
+            for line, face, value, key, label, verdict in zip(c.line, c.face, c.value, texts, labels, verdicts)
         ]
 
     return cases
