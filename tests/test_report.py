@@ -231,7 +231,7 @@ def test_sections_a_mesh_lacks_are_left_out_and_the_others_remain(tmp_path):
     assert "one timed render per method is noise" in study.text()
     files = section(doc, "summary").find_all("table", "files")[0].find_all("tr")[1:]
     statuses = [row.find_all("span", "status")[0].text() for row in files]
-    assert statuses == ["findings", "clean"]
+    assert statuses == ["fails", "passes"]
 
 
 def test_file_and_group_named_like_markup_render_as_text(tmp_path):
@@ -256,7 +256,7 @@ def test_unreadable_mesh_is_a_failed_row_and_the_others_still_report(tmp_path):
     assert "bad.obj:2: Q901 unreadable" in result.stderr
     doc = parse(tmp_path / "out.html")
     (row,) = [r for r in section(doc, "summary").find_all("table", "files")[0].find_all("tr") if "bad.obj" in r.text()]
-    assert "failed" in row.text() and "line 2" in row.text()
+    assert "unreadable" in row.text() and "line 2" in row.text()
     bad = mesh_article(doc, "bad.obj")
     assert bad.find_all("section") == [] and "Q901 unreadable" in bad.text()
     assert left_out(section(mesh_article(doc, "good.obj"), "renders")) is None
