@@ -418,16 +418,19 @@ def _layout_notes(layout) -> list[str]:
 
 
 def uv_layout_section(result: MeshResult) -> Section:
-    """Every face in texture space, flagged faces in the flag colour, the worst places labelled."""
+    """Every face in texture space, the faces the uv rules flag in the flag colour, their worst places labelled."""
     from .uvlayout import LABELLED, LAYOUT_SIZE, layout_image, layout_svg
 
     title = "UV layout"
     if result.mesh.texcoords is None:
         return leave_out("uv-layout", title, "the mesh has no texture coordinates")
+    # Only the texture-space rules' faces: a colour or normal finding is not fixed in the UV editor.
+    uv_rules = {code for code, rule in RULES.items() if rule.attribute == "texcoords"}
     flagged = np.zeros(result.mesh.n_faces, dtype=bool)
     for hits in result.file.hits:
-        flagged[hits.faces[hits.faces >= 0]] = True
-    labelled = list(dict.fromkeys((place.worst, place.code) for place in result.places))
+        if hits.code in uv_rules:
+            flagged[hits.faces[hits.faces >= 0]] = True
+    labelled = list(dict.fromkeys((place.worst, place.code) for place in result.places if place.code in uv_rules))
     layout = layout_image(result.mesh, flagged, LAYOUT_SIZE)
     if layout is None:
         return leave_out("uv-layout", title, "no face has texture coordinates at every corner")

@@ -62,10 +62,12 @@ def uv_disaffinity(quads) -> tuple:
         example.obj:10:1: Q101 error uv-disaffine: texture coordinates are not an affine image of the positions: no texture found, texels of an assumed 1024x1024 texture (give the size with --texture-size or the texture-size setting) (175.7 vs 0.5 texels) [face 0]
 
     How to fix:
-        Re-UV the quad as a parallelogram matching its shape (Blender: UV > Follow
-        Active Quads, or straighten the island), subdivide it so each piece is
-        closer to a parallelogram, or triangulate before baking so every tool uses
-        the same diagonal.
+        Refine the quad (affinity fix, or subdivide it): each smaller piece is
+        closer to a parallelogram and its crease shrinks with it. Or re-UV it as
+        a parallelogram matching its shape (Blender: UV > Follow Active Quads, or
+        straighten the island); the texture then has to be re-baked. Triangulating
+        does not remove the crease: it only makes every tool draw the same one,
+        along the diagonal you chose.
     """
     rows, uv = quads.uv
     diagonal = quads.settings.diagonal
@@ -96,8 +98,11 @@ def color_disaffinity(quads) -> tuple:
         example.obj:6:1: Q102 error color-disaffine: vertex colours are not an affine image of the positions (110.4 vs 2/255) [face 0]
 
     How to fix:
-        Repaint the corner colours so opposite corners average to the same colour,
-        subdivide the quad, or triangulate before baking so the diagonal is explicit.
+        Refine the quad (affinity fix, or subdivide it) so each piece carries a
+        smaller change of colour, or repaint its corner colours so they vary
+        evenly across it: the two diagonals then average to the same colour
+        (c0 + c2 = c1 + c3). Triangulating does not remove the seam: it only
+        makes every tool draw the same one.
     """
     rows, colors = quads.complete("colors")
     return rows, color_steps(quads.split_error(rows, colors).T)
@@ -130,9 +135,11 @@ def normal_disaffinity(quads) -> tuple:
         example.obj:10:1: Q103 error normal-disaffine: normals are not an affine image of the positions (9.847 vs 2 degrees) [face 0]
 
     How to fix:
-        Subdivide the quad or even out its corners (Blender: Mesh > Clean Up, or
-        relax the loop), or triangulate before baking normals so the split diagonal
-        is fixed.
+        Refine the quad (affinity fix, or subdivide it) so each piece spans a
+        smaller turn of the normals, or smooth its corner normals so they turn
+        evenly across it (Blender: Mesh > Normals > Smooth Vectors, or relax the
+        loop). Triangulating before baking normals does not remove the bend: it
+        only makes every tool shade the same one.
     """
     rows, unit = quads.complete("normals")  # unit length already (see affinity.lint.CornerTables.gather)
     m = quads.split_error(rows, unit)

@@ -50,7 +50,9 @@ def degenerate(quads) -> tuple:
 
     How to fix:
         Merge the collapsed corners (Blender: Mesh > Clean Up > Merge by Distance)
-        so the face becomes the triangle it really is.
+        so the face becomes the triangle it really is; a face with no area at all
+        is dissolved (Blender: Mesh > Clean Up > Degenerate Dissolve), and its
+        neighbours' attributes are then measured as usual.
     """
     return slice(None), degeneracy(quads.planar)
 

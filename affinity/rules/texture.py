@@ -39,7 +39,9 @@ def uv_degenerate(quads) -> tuple:
         Bloomenthal 2022, §2 (the barycentric test divides by the uv triangles' areas).
 
     How to fix:
-        Unwrap the face again so it gets its own area in UV space.
+        Unwrap the face again so it gets its own area in UV space (Blender: select
+        it, UV > Unwrap); the texture no longer smears over it, and Q101 then
+        measures its affinity.
     """
     return quads.uv[0], np.abs(relative_signed_area(quads.uv_planar))
 
