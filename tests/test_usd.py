@@ -363,7 +363,7 @@ def test_github_and_junit_name_the_prim():
     assert colour.endswith(", /World/Panel face 0")
     junit = check("--format", "junit", str(SCENE)).stdout
     assert 'name="Q102 color-disaffine /World/Panel face 0"' in junit
-    assert '<property name="prim" value="/World/Panel"/>' in junit
+    assert "/World/Panel:face 0: Q102 error color-disaffine:" in junit  # the text line names the prim
 
 
 def test_directories_and_the_hook_include_usd_files(tmp_path):

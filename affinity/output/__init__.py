@@ -395,6 +395,10 @@ def working_relative(path: str) -> str | None:
     return None if rel.startswith("..") else rel.replace(os.sep, "/")
 
 
+#: The format of :func:`value_token`, for formatting many values at once.
+VALUE_TOKEN = "{:.6g}"
+
+
 def value_token(value: float) -> str:
     """A measured value rounded to 6 significant digits: equal for the same quad on every run.
 
@@ -402,5 +406,5 @@ def value_token(value: float) -> str:
     this token (with rule, file and group) identifies a finding across face
     reordering and edits elsewhere in the file (baseline, SARIF fingerprints).
     """
-    return f"{value:.6g}"
+    return VALUE_TOKEN.format(value)
 

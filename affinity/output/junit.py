@@ -1,10 +1,10 @@
 """JUnit XML, for CI systems that show test reports (GitLab, Jenkins, Azure).
 
-One ``<testsuite>`` per file, one ``<testcase>`` per finding (named after the
-rule and the face, with the file and line as attributes; properties face, value,
-threshold, unit, level, group, and prim in USD). A finding at or above
-``--fail-on`` is a ``<failure>`` (type = rule code, message = the
-description, body = the text line); one below it is reported
+One ``<testsuite>`` per file, one ``<testcase>`` per finding, named after the
+rule and the face (and the prim in USD), with the file and line as attributes;
+its text line (level, value, threshold and unit included) is its body. A
+finding at or above ``--fail-on`` is a ``<failure>`` (type = rule code,
+message = the description, body = the text line); one below it is reported
 without failing, its text line in the testcase's ``<system-out>``, so the
 report's failures are what fails the run. A clean file gets one passing
 testcase, an unreadable file one testcase with an ``<error>`` (type Q901), a
@@ -59,28 +59,17 @@ def _finding_cases(fail_on: str):
     def cases(c: Columns) -> list[str]:
         path = xml_attribute(c.path)
         rule = f"{xml_attribute(c.code)} {xml_attribute(c.name)}"
-        shared = (f'"/><property name="threshold" value="{c.threshold}"/><property name="unit" '
-                  f'value="{xml_attribute(c.unit)}"/><property name="level" value="')
-        # What follows the value depends on a few texts only (level, group, prim): each written once.
-        texts = list(zip(c.level, c.group, c.prim))
-        ends = {(level, group, prim): f'{shared}{level}"/><property name="group" value="{xml_attribute(group)}"/>'
-                + ("" if prim is None else f'<property name="prim" value="{xml_attribute(prim)}"/>')
-                + "</properties>" for level, group, prim in set(texts)}
         described = descriptions(c)
         lines = text_lines(c, described)
         if _needs_escaping(c):  # numbers never do: only the path, messages, groups and prims can
             described, lines = list(map(xml_attribute, described)), list(map(xml_text, lines))
         failure = f'<failure type="{xml_attribute(c.code)}" message="'
-        verdicts = [f'{failure}{d}">{t}</failure>' if level in failing else f"<system-out>{t}</system-out>"
-                    for level, d, t in zip(c.level, described, lines)]
-        labels = ["" if face < 0 else f" face {face}" if prim is None else f" {xml_attribute(prim)} face {face}"
-                  for face, prim in zip(c.face, c.prim)]
-        return [
-            f'<testcase classname="{path}" name="{rule}{label}" file="{path}" line="{line}"><properties>'
-            f'<property name="face" value="{face}"/><property name="value" value="{value!r}{ends[key]}{verdict}'
-            "</testcase>\n"
-            for line, face, value, key, label, verdict in zip(c.line, c.face, c.value, texts, labels, verdicts)
-        ]
+        names = [rule if face < 0 else f"{rule} face {face}" if prim is None
+                 else f"{rule} {xml_attribute(prim)} face {face}" for face, prim in zip(c.face, c.prim)]
+        return [f'<testcase classname="{path}" name="{name}" file="{path}" line="{line}">'
+                + (f'{failure}{d}">{t}</failure></testcase>\n' if level in failing
+                   else f"<system-out>{t}</system-out></testcase>\n")
+                for name, line, level, d, t in zip(names, c.line, c.level, described, lines)]
 
     return cases
 

@@ -48,7 +48,17 @@ import numpy as np
 from .. import __version__
 from ..findings import FileReport
 from ..rules import RULES, UNREADABLE, rule_page
-from . import CheckRun, Columns, Selection, descriptions, statistics, truncation, value_token, working_relative
+from . import (
+    VALUE_TOKEN,
+    CheckRun,
+    Columns,
+    Selection,
+    descriptions,
+    statistics,
+    truncation,
+    value_token,
+    working_relative,
+)
 from .cap import cap_findings
 
 SARIF_VERSION = "2.1.0"
@@ -98,7 +108,7 @@ def fingerprint(code: str, uri: str, group: str, value: float, ordinal: int) -> 
 def _ordinals(selection: Selection) -> np.ndarray:
     """(n,) int64: each finding's ordinal among the file's findings of the same rule, group and value token,
     in file order (the selection's order)."""
-    tokens = [token for hits, take in selection.parts for token in map(value_token, hits.values[take].tolist())]
+    tokens = [token for hits, take in selection.parts for token in map(VALUE_TOKEN.format, hits.values[take].tolist())]
     token = np.unique(np.array(tokens, dtype=str), return_inverse=True)[1].reshape(-1)[selection.order]
     code = np.concatenate([np.full(len(take), i) for i, (_, take) in enumerate(selection.parts)])[selection.order]
     group = np.concatenate([hits.groups[take] for hits, take in selection.parts])[selection.order]
