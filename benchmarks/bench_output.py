@@ -60,32 +60,41 @@ def main(argv=None) -> None:
             summary = text_output.read().splitlines()[-1]  # "Found 88503 findings: 82194 error, ... (1 file checked)."
         load = os.getloadavg()
         times: dict[str, list[float]] = {fmt: [] for fmt in FORMATS}
+        cpu: dict[str, list[float]] = {fmt: [] for fmt in FORMATS}
         memory: dict[str, float] = dict.fromkeys(FORMATS, 0.0)
         for _ in range(rounds):
             for fmt in FORMATS:
-                wall, _, peak, _, code = run(command(fmt), pycache)
+                wall, seconds, peak, _, code = run(command(fmt), pycache)
                 if code not in (0, 1):
                     sys.exit(f"{' '.join(command(fmt))} exited {code}")
                 times[fmt].append(wall)
+                cpu[fmt].append(seconds)
                 memory[fmt] = max(memory[fmt], peak)
+        after = os.getloadavg()
         sizes = {fmt: os.path.getsize(os.path.join(folder, f"out.{fmt}")) for fmt in FORMATS}
-    text = statistics.median(times["text"])
+    median = {fmt: statistics.median(times[fmt]) for fmt in FORMATS}
+    best = {fmt: min(times[fmt]) for fmt in FORMATS}
+    median_cpu = {fmt: statistics.median(cpu[fmt]) for fmt in FORMATS}
     found = re.match(r"Found (\d+) findings: (.+) \(", summary)
     by_level = re.sub(r"\d+", lambda n: f"{int(n[0]):,}", found[2])
     rows = [
-        f"| {fmt} | {statistics.median(times[fmt]):.2f} | {min(times[fmt]):.2f} | "
-        f"{statistics.median(times[fmt]) / text:.2f} | {memory[fmt]:.0f} | {sizes[fmt] / 1e6:.1f} |"
+        f"| {fmt} | {median[fmt]:.2f} | {best[fmt]:.2f} | {median_cpu[fmt]:.2f} | "
+        f"**{median[fmt] / median['text']:.2f}** | {best[fmt] / best['text']:.2f} | "
+        f"{median_cpu[fmt] / median_cpu['text']:.2f} | {memory[fmt]:.0f} | "
+        f"{sizes[fmt] / 1e6:.1f} |"
         for fmt in FORMATS
     ]
-    worst = max(statistics.median(times[fmt]) / text for fmt in FORMATS[1:])
+    worst = max(median[fmt] / median["text"] for fmt in FORMATS[1:])
     write_table([
         f"{quads:,} quads ({source}, per-face unit uv): {int(found[1]):,} findings ({by_level}); "
-        f"{platform.processor() or platform.machine()}, {os.cpu_count()} CPUs, load average before "
-        f"{load[0]:.2f}, affinity at {revision()}; {rounds} round{'s' * (rounds > 1)}, whole "
-        "`affinity check --no-cache --format F -o FILE` processes taking turns.",
+        f"{platform.processor() or platform.machine()}, {os.cpu_count()} CPUs, affinity at {revision()}; "
+        f"{rounds} round{'s' * (rounds > 1)}, whole `affinity check --no-cache --format F -o FILE` processes taking "
+        f"turns. Load average before {load[0]:.2f}, after {after[0]:.2f} (a shared machine: compare the formats of "
+        "one run; CPU time is the steadier measure).",
         "",
-        "| format | median s | best s | median / text | peak MiB | output MB |",
-        "|---|---:|---:|---:|---:|---:|",
+        "| format | median s | best s | median CPU s | median / text | best / text | CPU / text | peak MiB "
+        "| output MB |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|",
         *rows,
         "",
         f"Slowest machine format / text (medians): {worst:.2f} (goal: at most {TIME_GOAL}); largest peak memory "

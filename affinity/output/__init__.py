@@ -240,7 +240,7 @@ class Selection:
             index = self.order[begin : begin + block]
             part = np.searchsorted(starts, index, side="right") - 1
             out = np.empty(len(index), dtype=object)
-            for p in np.unique(part).tolist():
+            for p in np.flatnonzero(np.bincount(part, minlength=len(self.parts))).tolist():
                 where = np.flatnonzero(part == p)
                 hits, take = self.parts[p]
                 rows = format_rows(columns(self.report, hits, take[index[where] - starts[p]]))
