@@ -64,6 +64,12 @@ def _finding_cases(fail_on: str):
         if _needs_escaping(c):  # numbers never do: only the path, messages, groups and prims can
             described, lines = list(map(xml_attribute, described)), list(map(xml_text, lines))
         failure = f'<failure type="{xml_attribute(c.code)}" message="'
+        if c.prim[0] is None and min(c.face, default=0) >= 0:  # faces of a mesh file: one shape for every case
+            case = f'<testcase classname="{path}" name="{rule} face '
+            return [f'{case}{face}" file="{path}" line="{line}">{failure}{d}">{t}</failure></testcase>\n'
+                    if level in failing else
+                    f'{case}{face}" file="{path}" line="{line}"><system-out>{t}</system-out></testcase>\n'
+                    for face, line, level, d, t in zip(c.face, c.line, c.level, described, lines)]
         names = [rule if face < 0 else f"{rule} face {face}" if prim is None
                  else f"{rule} {xml_attribute(prim)} face {face}" for face, prim in zip(c.face, c.prim)]
         return [f'<testcase classname="{path}" name="{name}" file="{path}" line="{line}">'

@@ -108,8 +108,9 @@ def fingerprint(code: str, uri: str, group: str, value: float, ordinal: int) -> 
 def _ordinals(selection: Selection) -> np.ndarray:
     """(n,) int64: each finding's ordinal among the file's findings of the same rule, group and value token,
     in file order (the selection's order)."""
-    tokens = [token for hits, take in selection.parts for token in map(VALUE_TOKEN.format, hits.values[take].tolist())]
-    token = np.unique(np.array(tokens, dtype=str), return_inverse=True)[1].reshape(-1)[selection.order]
+    ids: dict[str, int] = {}  # value token -> a number, equal for equal tokens
+    token = np.array([ids.setdefault(t, len(ids)) for hits, take in selection.parts
+                      for t in map(VALUE_TOKEN.format, hits.values[take].tolist())], dtype=np.int64)[selection.order]
     code = np.concatenate([np.full(len(take), i) for i, (_, take) in enumerate(selection.parts)])[selection.order]
     group = np.concatenate([hits.groups[take] for hits, take in selection.parts])[selection.order]
     position = np.arange(len(selection))
