@@ -232,9 +232,10 @@ class Selection:
         """The findings at ``positions`` (k,) of the order, in that order."""
         return Selection(self.report, self.parts, self.order[positions], self.omitted)
 
-    def formatted(self, format_rows, block: int = 16384) -> Iterator[list]:
+    def formatted(self, format_rows, block: int = 16384, along: np.ndarray | None = None) -> Iterator[list]:
         """``format_rows(columns) -> list`` (one entry a finding, :class:`Columns`) over the findings, yielded
-        in order, ``block`` at a time (a format's rows of a big file are never all held at once)."""
+        in order, ``block`` at a time (a format's rows of a big file are never all held at once). With
+        ``along`` (n,), values in the selection's order, ``format_rows(columns, values)`` gets those of its rows."""
         starts = np.cumsum([0] + [len(take) for _, take in self.parts])
         for begin in range(0, len(self.order), block):
             index = self.order[begin : begin + block]
@@ -243,7 +244,8 @@ class Selection:
             for p in np.flatnonzero(np.bincount(part, minlength=len(self.parts))).tolist():
                 where = np.flatnonzero(part == p)
                 hits, take = self.parts[p]
-                rows = format_rows(columns(self.report, hits, take[index[where] - starts[p]]))
+                found = columns(self.report, hits, take[index[where] - starts[p]])
+                rows = format_rows(found) if along is None else format_rows(found, along[begin + where])
                 out[where] = np.fromiter(rows, dtype=object, count=len(where))
             yield out.tolist()
 

@@ -4,7 +4,8 @@ One ``<testsuite>`` per file, one ``<testcase>`` per finding, named after the
 rule and the face (and the prim in USD), with the file and line as attributes;
 its text line (level, value, threshold and unit included) is its body. A
 finding at or above ``--fail-on`` is a ``<failure>`` (type = rule code,
-message = the description, body = the text line); one below it is reported
+message = the rule's code, name and summary, body = the text line with the
+measurement); one below it is reported
 without failing, its text line in the testcase's ``<system-out>``, so the
 report's failures are what fails the run. A clean file gets one passing
 testcase, an unreadable file one testcase with an ``<error>`` (type Q901), a
@@ -22,8 +23,8 @@ import re
 from typing import TextIO
 
 from ..findings import FileReport
-from ..rules import LEVELS, UNREADABLE
-from . import CheckRun, Columns, Selection, descriptions, statistics, text_lines
+from ..rules import LEVELS, RULES, UNREADABLE
+from . import CheckRun, Columns, Selection, statistics, text_lines
 
 # Characters XML 1.0 cannot carry at all (control characters, lone surrogates from undecodable file names).
 _NOT_XML = re.compile("[^\t\n\r\x20-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
@@ -59,23 +60,22 @@ def _finding_cases(fail_on: str):
     def cases(c: Columns) -> list[str]:
         path = xml_attribute(c.path)
         rule = f"{xml_attribute(c.code)} {xml_attribute(c.name)}"
-        described = descriptions(c)
-        lines = text_lines(c, described)
+        lines = text_lines(c)
         if _needs_escaping(c):  # numbers never do: only the path, messages, groups and prims can
-            described, lines = list(map(xml_attribute, described)), list(map(xml_text, lines))
-        failure = f'<failure type="{xml_attribute(c.code)}" message="'
+            lines = list(map(xml_text, lines))
+        failure = f'<failure type="{xml_attribute(c.code)}" message="{rule}: {xml_attribute(RULES[c.code].summary)}">'
         if c.prim[0] is None and min(c.face, default=0) >= 0:  # faces of a mesh file: one shape for every case
             case = f'<testcase classname="{path}" name="{rule} face '
-            return [f'{case}{face}" file="{path}" line="{line}">{failure}{d}">{t}</failure></testcase>\n'
+            return [f'{case}{face}" file="{path}" line="{line}">{failure}{t}</failure></testcase>\n'
                     if level in failing else
                     f'{case}{face}" file="{path}" line="{line}"><system-out>{t}</system-out></testcase>\n'
-                    for face, line, level, d, t in zip(c.face, c.line, c.level, described, lines)]
+                    for face, line, level, t in zip(c.face, c.line, c.level, lines)]
         names = [rule if face < 0 else f"{rule} face {face}" if prim is None
                  else f"{rule} {xml_attribute(prim)} face {face}" for face, prim in zip(c.face, c.prim)]
         return [f'<testcase classname="{path}" name="{name}" file="{path}" line="{line}">'
-                + (f'{failure}{d}">{t}</failure></testcase>\n' if level in failing
+                + (f"{failure}{t}</failure></testcase>\n" if level in failing
                    else f"<system-out>{t}</system-out></testcase>\n")
-                for name, line, level, d, t in zip(names, c.line, c.level, described, lines)]
+                for name, line, level, t in zip(names, c.line, c.level, lines)]
 
     return cases
 

@@ -123,35 +123,39 @@ def _ordinals(selection: Selection) -> np.ndarray:
     return ordinals
 
 
-def _result_rows(location: dict, rule_index: dict[str, int]):
-    """The SARIF results of a :class:`Columns`, without their fingerprints."""
+PRIM = ',"prim":'
 
-    def rows(c: Columns) -> list[dict]:
+
+def _result_rows(location: dict, rule_index: dict[str, int]):
+    """The SARIF results of a :class:`Columns` as JSON text, each with its fingerprint (from its ``ordinals``,
+    :func:`_ordinals`); the pieces every result of a rule shares are encoded once."""
+    encode, compact = json.dumps, (",", ":")
+
+    def rows(c: Columns, ordinals: np.ndarray) -> list[str]:
+        head = f'{{"ruleId":{encode(c.code)},"ruleIndex":{rule_index[c.code]},"level":"'
+        shared = f',"threshold":{encode(c.threshold)},"unit":{encode(c.unit)},"level":"'
         results = []
-        for line, column, face, value, level, group, prim, text in zip(
-                c.line, c.column, c.face, c.value, c.level, c.group, c.prim, descriptions(c)):
-            result_location: dict = {"physicalLocation": _physical(location, line, column)}
+        for line, column, face, value, level, group, prim, text, ordinal in zip(
+                c.line, c.column, c.face, c.value, c.level, c.group, c.prim, descriptions(c), ordinals.tolist()):
+            located: dict = {"physicalLocation": _physical(location, line, column)}
             logical, label = _logical_location(prim, group, face)
             if logical:
-                result_location["logicalLocations"] = [logical]
-            results.append({
-                "ruleId": c.code,
-                "ruleIndex": rule_index[c.code],
-                "level": sarif_level(level),
-                "message": {"text": f"{text}, {label}" if label else text},
-                "locations": [result_location],
-                "properties": {"name": c.name, "face": face, "value": value, "threshold": c.threshold,
-                               "unit": c.unit, "level": level, "group": group,
-                               **({} if prim is None else {"prim": prim})},
-            })
+                located["logicalLocations"] = [logical]
+            identity = fingerprint(c.code, location["uri"], group, value, ordinal)
+            results.append(
+                f'{head}{sarif_level(level)}","message":{{"text":{encode(f"{text}, {label}" if label else text)}}},'
+                f'"locations":[{encode(located, separators=compact)}],'
+                f'"partialFingerprints":{{"{FINGERPRINT}":"{identity}"}},'
+                f'"properties":{{"name":{encode(c.name)},"face":{face},"value":{encode(value)}{shared}{level}",'
+                f'"group":{encode(group)}{"" if prim is None else PRIM + encode(prim)}}}}}')
         return results
 
     return rows
 
 
-def _results(run: CheckRun) -> tuple[list[dict], str | None]:
-    """The run's results (capped, :func:`affinity.output.cap.cap_findings`, unless ``--max-findings``), and the
-    truncation notice (None: nothing cut)."""
+def _results(run: CheckRun) -> tuple[list[str], str | None]:
+    """The run's results as JSON text (capped, :func:`affinity.output.cap.cap_findings`, unless
+    ``--max-findings``), and the truncation notice (None: nothing cut)."""
     selections = [run.kept(report) for report in run.reports]
     kept, notice = [np.arange(len(s)) for s in selections], None
     if run.max_findings is None:
@@ -163,12 +167,8 @@ def _results(run: CheckRun) -> tuple[list[dict], str | None]:
         if len(rows) == 0:
             continue
         location = artifact_location(selection.report.path)
-        ordinals = iter(_ordinals(selection)[rows].tolist())
-        for block in selection.subset(rows).formatted(_result_rows(location, rule_index)):
-            for result in block:
-                properties = result["properties"]
-                result["partialFingerprints"] = {FINGERPRINT: fingerprint(
-                    result["ruleId"], location["uri"], properties["group"], properties["value"], next(ordinals))}
+        for block in selection.subset(rows).formatted(_result_rows(location, rule_index),
+                                                      along=_ordinals(selection)[rows]):
             results += block
     return results, notice
 
@@ -209,8 +209,8 @@ def _folder_uri(folder: Path) -> str:
     return uri if uri.endswith("/") else uri + "/"
 
 
-def document(run: CheckRun) -> dict:
-    """The SARIF log as Python objects."""
+def document(run: CheckRun) -> tuple[dict, list[str]]:
+    """The SARIF log as Python objects, its results standing in as ``[RESULTS]``, and the results as JSON text."""
     properties: dict = {}
     if run.max_findings is not None:
         properties["truncated"] = truncation(run, run.max_findings)
@@ -238,12 +238,17 @@ def document(run: CheckRun) -> dict:
             }],
             "originalUriBaseIds": {SRCROOT: {"uri": _folder_uri(Path.cwd())}},
             "columnKind": "unicodeCodePoints",
-            "results": results,
+            "results": [RESULTS],
             **({"properties": properties} if properties else {}),
         }],
-    }
+    }, results
+
+
+#: Where the results go in the log's text (a string no other value of the log can be).
+RESULTS = "\0results\0"
 
 
 def write(run: CheckRun, out: TextIO) -> None:
-    out.write(json.dumps(document(run), separators=(",", ":")))
-    out.write("\n")
+    log, results = document(run)
+    head, tail = json.dumps(log, separators=(",", ":")).split(json.dumps(RESULTS), 1)
+    out.write(head + ",".join(results) + tail + "\n")
