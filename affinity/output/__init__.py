@@ -240,14 +240,19 @@ class Selection:
         for begin in range(0, len(self.order), block):
             index = self.order[begin : begin + block]
             part = np.searchsorted(starts, index, side="right") - 1
-            out = np.empty(len(index), dtype=object)
-            for p in np.flatnonzero(np.bincount(part, minlength=len(self.parts))).tolist():
+            present = np.flatnonzero(np.bincount(part, minlength=len(self.parts))).tolist()
+            out = None if len(present) == 1 else np.empty(len(index), dtype=object)
+            for p in present:
                 where = np.flatnonzero(part == p)
                 hits, take = self.parts[p]
                 found = columns(self.report, hits, take[index[where] - starts[p]])
                 rows = format_rows(found) if along is None else format_rows(found, along[begin + where])
-                out[where] = np.fromiter(rows, dtype=object, count=len(where))
-            yield out.tolist()
+                if out is None:  # one rule in the block: its rows are the block, in order
+                    yield rows
+                else:
+                    out[where] = np.fromiter(rows, dtype=object, count=len(where))
+            if out is not None:
+                yield out.tolist()
 
     def findings(self) -> list[Finding]:
         return [f for rows in self.formatted(Columns.findings) for f in rows]

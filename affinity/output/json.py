@@ -75,19 +75,18 @@ def _finding_rows(settings):
         unit = f',"threshold":{encode(c.threshold)},"unit":{encode(c.unit)},"level":"'
         measure = settings.measure_of(c.code)
         tail = "}" if measure is None else f',"measure":{encode(measure)}}}'
-        values = map(float.__repr__, c.value) if math.isfinite(sum(c.value)) else map(encode, c.value)
         # What follows the value depends on a few texts only (level, group, message, prim): each written once,
         # looked up by the level alone where the others are the same for every finding (the usual case).
         shared = len(set(c.group)) == len(set(c.message)) == len(set(c.prim)) == 1
         texts = c.level if shared else list(zip(c.level, c.group, c.message, c.prim))
         ends = {key: unit + _after_level(*((key, c.group[0], c.message[0], c.prim[0]) if shared else key)) + tail
                 for key in set(texts)}
-        if set(c.column) == {1}:  # every face on a source line
+        if set(c.column) == {1} and math.isfinite(sum(c.value)):  # faces on source lines, finite values
             rule = ',"column":1' + rule
-            return [f"{head}{line}{rule}{face},\"value\":{value}{ends[key]}"
-                    for line, face, value, key in zip(c.line, c.face, values, texts)]
+            return [f"{head}{line}{rule}{face},\"value\":{value!r}{ends[key]}"
+                    for line, face, value, key in zip(c.line, c.face, c.value, texts)]
         return [f'{head}{line},"column":{column}{rule}{face},"value":{value}{ends[key]}'
-                for line, column, face, value, key in zip(c.line, c.column, c.face, values, texts)]
+                for line, column, face, value, key in zip(c.line, c.column, c.face, map(encode, c.value), texts)]
 
     return rows
 
