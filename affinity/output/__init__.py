@@ -341,6 +341,15 @@ def format_value(value: float) -> str:
     return f"{value:.4g}"
 
 
+def _measured(c: Columns) -> tuple[str, str]:
+    """What follows a value in a description: its unit (``" texels"``, ``"/255"``) where there is no threshold,
+    else ``" vs 0.5 texels"``."""
+    unit = with_unit("", c.unit)  # what follows the number: " texels", "/255"
+    if c.threshold is None:
+        return unit, ""
+    return "", f" vs {format_value(c.threshold)}{unit}"
+
+
 def descriptions(c: Columns) -> list[str]:
     """Each message with its measurement and unit: ``... (3.2 vs 0.5 texels)``, ``... (0.5 folded fraction)``.
 
@@ -348,10 +357,7 @@ def descriptions(c: Columns) -> list[str]:
     """
     if not c.unit:
         return list(c.message)
-    unit = with_unit("", c.unit)  # what follows the number: " texels", "/255"
-    against = "" if c.threshold is None else f" vs {format_value(c.threshold)}{unit}"
-    if c.threshold is not None:
-        unit = ""
+    unit, against = _measured(c)
     return [f"{m} ({v:.4g}{unit}{against})" for m, v in zip(c.message, c.value)]
 
 
@@ -372,14 +378,15 @@ def located(f: Finding) -> str:
     return ", ".join(filter(None, [describe(f), face_label(f)]))
 
 
-def text_lines(c: Columns, described: list[str] | None = None) -> list[str]:
+def text_lines(c: Columns) -> list[str]:
     """The ruff-style lines ``path:line:col: CODE level name: message (value vs threshold unit) [face F]``
-    (design.md); ``path:prim:face N: CODE level ...`` in USD; no ``[face]`` for file-level findings.
-    ``described`` are the findings' :func:`descriptions` when the caller has them."""
-    path, code, name, described = c.path, c.code, c.name, described or descriptions(c)
-    if c.prim[0] is None and min(c.face, default=0) >= 0:  # faces of a mesh file: one shape for every line
-        return [f"{path}:{line}:{column}: {code} {level} {name}: {text} [face {face}]"
-                for line, column, face, level, text in zip(c.line, c.column, c.face, c.level, described)]
+    (design.md); ``path:prim:face N: CODE level ...`` in USD; no ``[face]`` for file-level findings."""
+    path, code, name = c.path, c.code, c.name
+    if c.unit and c.prim[0] is None and min(c.face, default=0) >= 0:  # measured faces of a mesh file
+        unit, against = _measured(c)
+        return [f"{path}:{line}:{column}: {code} {level} {name}: {m} ({v:.4g}{unit}{against}) [face {face}]"
+                for line, column, face, level, m, v in zip(c.line, c.column, c.face, c.level, c.message, c.value)]
+    described = descriptions(c)
     return [
         (f"{path}:{prim}:face {face}: " if prim is not None else f"{path}:{line}:{column}: ")
         + f"{code} {level} {name}: {text}" + (f" [face {face}]" if prim is None and face >= 0 else "")
