@@ -18,7 +18,6 @@ The table goes to ``<out>/bench_output.md`` (default ``reports/bench/``) and int
 
 from __future__ import annotations
 
-import argparse
 import os
 import platform
 import re
@@ -27,7 +26,8 @@ import sys
 import tempfile
 
 from bench_check import revision, run
-from common import parse_with_output, write_table
+from bench_report import car_options
+from common import write_table
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 FORMATS = ("text", "json", "sarif", "github", "junit")
@@ -36,10 +36,7 @@ TIME_GOAL, MEMORY_GOAL = 1.5, 300
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--rounds", type=int, default=5)
-    args = parse_with_output(parser, "6,300 quads, 1 round", "folder of bench_output.md", argv)
-    levels, rounds = (1, 1) if args.small else (3, args.rounds)
+    args, levels, rounds = car_options(__doc__, 5, "bench_output.md", argv)
     with tempfile.TemporaryDirectory() as folder:
         mesh = os.path.join(folder, "car.obj")
         pycache = os.path.join(folder, "pycache")
