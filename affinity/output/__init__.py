@@ -2,8 +2,13 @@
 
 ``text`` (ruff-style lines), ``json`` (the documented schema), ``sarif`` (SARIF
 2.1.0 for code scanning), ``github`` (workflow annotations) and ``junit`` (XML
-for CI test reports). This package holds what they share: the flat
-:class:`Finding` rows and how a finding is described.
+for CI test reports); :mod:`.cap` keeps a run's SARIF results and GitHub
+annotations within the run cap. This package holds what they share: which
+findings of a file are written and in which order (:func:`select`, a
+:class:`Selection`), the findings as :class:`Columns` (a block of one rule's
+findings, so a format writes many rows at a time: time and memory grow with the
+findings, with small constants) or as :class:`Finding` rows, and how a finding
+is described (:func:`descriptions`, :func:`text_lines`).
 """
 
 from __future__ import annotations
@@ -60,13 +65,10 @@ class CheckRun:
             "baselined": sum((self.baselined or {}).values()),
         }
 
-    def kept(self, report: FileReport, order: str = "file") -> Selection:
-        """The findings of ``report`` a structured format writes: all, or the worst ``max_findings`` per rule."""
-        return select(report, self.max_findings, order)
-
-    def fails(self, level: str) -> bool:
-        """Whether findings at ``level`` fail the run (``level`` at or above ``fail_on``)."""
-        return LEVELS.index(level) <= LEVELS.index(self.fail_on)
+    def kept(self, report: FileReport) -> Selection:
+        """The findings of ``report`` a structured format writes, in file order: all, or the worst
+        ``max_findings`` per rule."""
+        return select(report, self.max_findings)
 
 
 def at_or_above(reports: list[FileReport], level: str) -> tuple[list[FileReport], dict[str, int]]:
@@ -373,11 +375,6 @@ def face_label(f: Finding) -> str:
     return f"face {f.face}" if f.prim is None else f"{f.prim} face {f.face}"
 
 
-def located(f: Finding) -> str:
-    """:func:`describe` naming the face, for formats without a text line: ``..., face 12``."""
-    return ", ".join(filter(None, [describe(f), face_label(f)]))
-
-
 def text_lines(c: Columns) -> list[str]:
     """The ruff-style lines ``path:line:col: CODE level name: message (value vs threshold unit) [face F]``
     (design.md); ``path:prim:face N: CODE level ...`` in USD; no ``[face]`` for file-level findings."""
@@ -392,11 +389,6 @@ def text_lines(c: Columns) -> list[str]:
         + f"{code} {level} {name}: {text}" + (f" [face {face}]" if prim is None and face >= 0 else "")
         for line, column, face, level, prim, text in zip(c.line, c.column, c.face, c.level, c.prim, described)
     ]
-
-
-def text_line(f: Finding) -> str:
-    """:func:`text_lines` of one finding."""
-    return text_lines(Columns.of(f))[0]
 
 
 def working_relative(path: str) -> str | None:
