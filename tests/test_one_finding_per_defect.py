@@ -12,10 +12,10 @@ import json
 import numpy as np
 import pytest
 from helpers.cli import run, write
-from test_lint import quads_mesh
 
 from affinity.lint import lint_mesh
 from affinity.loaders import load
+from affinity.mesh import mesh_from_polygons
 from affinity.settings import Settings
 
 SQUARE = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
@@ -34,6 +34,13 @@ SOUND_UV = {
 }
 
 
+def separate_quads(quads, texcoords, **attributes):
+    """One quad per (4, 3) corner list, each with its own four vertices; attributes per vertex."""
+    flat = {name: np.asarray(values, float).reshape(len(quads) * 4, -1) for name, values in attributes.items()}
+    return mesh_from_polygons("test.obj", np.reshape(quads, (-1, 3)), np.arange(4 * len(quads)).reshape(-1, 4),
+                              texcoords=np.reshape(texcoords, (-1, 2)), **flat)
+
+
 def by_code(hits) -> dict[str, set[int]]:
     return {h.code: set(h.faces.tolist()) for h in hits}
 
@@ -42,7 +49,7 @@ def by_code(hits) -> dict[str, set[int]]:
 def collapsed_uv_mesh():
     """Trapezoids (a crease on any non-affine uv) carrying the collapsed uv, then the sound ones."""
     uvs = [*COLLAPSED_UV.values(), *SOUND_UV.values()]
-    return quads_mesh(*[TRAPEZOID] * len(uvs), texcoords=uvs)
+    return separate_quads([TRAPEZOID] * len(uvs), uvs)
 
 
 @pytest.mark.parametrize("select", [None, ["Q101"], ["Q1", "Q3"], ["Q101", "Q302"]])
@@ -69,7 +76,7 @@ def test_quads_without_area_and_bowties_get_no_q101_to_q103_but_a_pole_keeps_the
     rng = np.random.default_rng(7)
     colors = rng.uniform(size=(12, 3))
     normals = rng.normal(size=(12, 3)) * 0.3 + [0, 0, 1]
-    mesh = quads_mesh(flat, bowtie, pole, texcoords=[UNIT_UV] * 3, colors=colors, normals=normals)
+    mesh = separate_quads([flat, bowtie, pole], [UNIT_UV] * 3, colors=colors, normals=normals)
     for select in (None, ["Q1"]):
         found = by_code(lint_mesh(mesh, Settings(select=select)))
         for code in ("Q101", "Q102", "Q103"):
