@@ -54,12 +54,24 @@ class RuleHits:
 
     def levels(self) -> np.ndarray:
         """(n,) str: the level of each finding (``error`` above ``error_above``, else ``level``)."""
-        from .rules import RULES
+        from .rules import LEVELS
 
-        level = self.level or RULES[self.code].level
-        if self.error_above is None:
-            return np.full(len(self), level)
-        return np.where(self.values > self.error_above, "error", level)
+        return np.asarray(LEVELS)[self.level_ranks()]
+
+    def level_ranks(self) -> np.ndarray:
+        """(n,) int8: each finding's level as its index in ``LEVELS`` (0 ``error``, 1 ``warning``, 2 ``info``)."""
+        from .rules import LEVELS, RULES
+
+        rank = np.full(len(self), LEVELS.index(self.level or RULES[self.code].level), dtype=np.int8)
+        if self.error_above is not None:
+            rank[self.values > self.error_above] = 0
+        return rank
+
+    def at_or_above(self, level: str) -> RuleHits:
+        """The findings at ``level`` or worse (``error`` > ``warning`` > ``info``)."""
+        from .rules import LEVELS
+
+        return self.subset(self.level_ranks() <= LEVELS.index(level))
 
     def subset(self, rows: np.ndarray) -> RuleHits:
         """The findings at ``rows`` (an index array or a boolean mask), level and unit kept."""

@@ -370,6 +370,20 @@ def relative_signed_area(quads: PlanarQuads) -> np.ndarray:
     return _relative((quads.areas[:, 0] + quads.areas[:, 2]) / 2, quads.size)
 
 
+def zero_area(quads: PlanarQuads, threshold: float) -> np.ndarray:
+    """Quads collapsed to a segment or a point: the whole area (T_0 + T_2) / 2 within rounding of zero
+    or at most ``threshold`` times the squared longest edge.
+
+    A quad with one repeated corner (a pole quad) is a triangle with area: not zero.
+
+    Returns
+    -------
+    (Q,) bool
+    """
+    doubled = quads.areas[:, 0] + quads.areas[:, 2]
+    return (np.abs(doubled) <= quads.rounding) | (np.abs(_relative(doubled / 2, quads.size)) <= threshold)
+
+
 def nonplanarity(corners: np.ndarray) -> np.ndarray:
     """Warp: distance between the two diagonals relative to their mean length.
 

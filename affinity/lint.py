@@ -245,33 +245,111 @@ def lint_mesh(mesh: Mesh, settings: Settings) -> list[RuleHits]:
     quad_rules = [rule for rule in enabled if rule.scope == "quad"]
     thresholds = {rule.code: settings.threshold(rule.code) if rule.has_threshold else None for rule in quad_rules}
 
-    def flag(batch: QuadBatch) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-        """Rule code -> (faces, values) of the batch's flagged quads."""
+    def flag(batch: QuadBatch) -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]:
+        """Rule code -> (faces, values, breaks) of the batch's flagged quads, one finding per defect
+        (:class:`Unmeasurable`); ``breaks`` (n,) bool marks the causes that took other findings' place."""
         found = {}
+        causes = Unmeasurable(batch)
         for rule in quad_rules:
             rows, values = rule.check(batch)
-            faces = batch.faces[rows]
+            rows = np.arange(len(batch))[rows]
             threshold = thresholds[rule.code]
             if threshold is not None:
                 flagged = rule.flagged(values, threshold)
-                faces, values = faces[flagged], values[flagged]
-            found[rule.code] = faces, values
+                rows, values = rows[flagged], values[flagged]
+            if rule.scored:
+                measured = ~causes.masked(rule)[rows]
+                rows, values = rows[measured], values[measured]
+            found[rule.code] = batch.faces[rows], values, causes.breaks(rule.code)[rows]
         return found
 
     attributes = sorted({rule.attribute for rule in quad_rules if rule.attribute})
     batches = _map_quad_batches(mesh, settings, flag, attributes) if quad_rules else []
+    scored = [rule for rule in quad_rules if rule.scored and getattr(mesh, rule.attribute) is not None]
     for rule in quad_rules:
         faces = np.concatenate([found[rule.code][0] for found in batches] or [np.zeros(0, dtype=np.int64)])
         if len(faces):
             values = np.concatenate([found[rule.code][1] for found in batches])
             threshold = thresholds[rule.code]
+            breaks = np.concatenate([found[rule.code][2] for found in batches])
             hits.append(
                 RuleHits(rule.code, faces, mesh.face_line[faces], values,
                          0.0 if threshold is None else float(threshold), mesh.face_group[faces],
-                         details=_texel_details(mesh, settings, rule, faces))
+                         details=_texel_details(mesh, settings, rule, faces)
+                         or _cause_details(rule.code, breaks, [r.code for r in scored if r.attribute in
+                                                               CAUSE_MASKS.get(rule.code, ())]))
             )
     order = {code: i for i, code in enumerate(RULES)}
     return sorted(hits, key=lambda h: order[h.code])
+
+
+#: Cause rule -> the attributes whose scored rules (Q101-Q103) it takes over (:class:`Unmeasurable`).
+CAUSE_MASKS = {"Q201": ("texcoords", "colors", "normals"), "Q204": ("texcoords", "colors", "normals"),
+               "Q301": ("texcoords",)}
+
+
+class Unmeasurable:
+    """The quads of a batch the scored rules (Q101-Q103) do not measure: one finding per defect (design.md).
+
+    A quad whose uv collapses to a line or a point (Q301's test, at Q301's threshold) gets no Q101: its
+    value would be computed from collapsed values. A quad without area (its whole area at or below
+    Q201's threshold; one repeated corner, a pole quad, is a triangle with area and keeps its findings)
+    or a bow-tie (Q204's test) gets no Q101-Q103. The tests run whatever rules are selected, so the
+    suppression does not depend on the cause being reported.
+
+    Attributes
+    ----------
+    collapsed_uv, no_area, bowtie : (Q,) bool
+    """
+
+    def __init__(self, batch: QuadBatch):
+        self.batch = batch
+
+    @cached_property
+    def no_area(self) -> np.ndarray:
+        from .geometry import zero_area
+
+        return zero_area(self.batch.planar, self.batch.settings.threshold("Q201"))
+
+    @cached_property
+    def bowtie(self) -> np.ndarray:
+        from .geometry import is_bowtie
+
+        return is_bowtie(self.batch.planar)
+
+    @cached_property
+    def collapsed_uv(self) -> np.ndarray:
+        from .rules.texture import uv_degenerate
+
+        collapsed = np.zeros(len(self.batch), dtype=bool)
+        if self.batch.tables.tables.get("texcoords") is not None:
+            rows, area = uv_degenerate(self.batch)
+            collapsed[rows] = RULES["Q301"].flagged(area, self.batch.settings.threshold("Q301"))
+        return collapsed
+
+    def masked(self, rule) -> np.ndarray:
+        """(Q,) bool: the quads the scored ``rule`` leaves alone."""
+        masked = self.no_area | self.bowtie
+        return masked | self.collapsed_uv if rule.attribute in CAUSE_MASKS["Q301"] else masked
+
+    def breaks(self, code: str) -> np.ndarray:
+        """(Q,) bool: the quads where a finding of rule ``code`` takes the scored rules' place."""
+        cause = {"Q201": "no_area", "Q204": "bowtie", "Q301": "collapsed_uv"}.get(code)
+        return np.zeros(len(self.batch), dtype=bool) if cause is None else getattr(self, cause)
+
+
+#: What a cause's finding says where it takes the scored rules' place (:class:`Unmeasurable`).
+CAUSES = {"Q201": "it has no area", "Q204": "it has no consistent orientation", "Q301": "the texture smears over it"}
+
+
+def _cause_details(code: str, breaks: np.ndarray, taken: list[str]) -> list | None:
+    """One detail per finding of rule ``code``: where ``breaks`` (n,) bool, the cause and the scored
+    rules ``taken`` over (those selected whose attribute the mesh has, that the cause masks), else None;
+    None altogether where nothing was taken over."""
+    if code not in CAUSES or not taken or not breaks.any():
+        return None
+    detail = f"{CAUSES[code]}, so {', '.join(taken)} {'is' if len(taken) == 1 else 'are'} not measured on it"
+    return np.where(breaks, detail, None).tolist()
 
 
 def _texel_details(mesh: Mesh, settings: Settings, rule, faces: np.ndarray) -> list | None:

@@ -97,11 +97,17 @@ def timed_process(command: list[str], ok: tuple[int, ...] = (0,)) -> tuple[float
     return wall, usage.ru_maxrss / 1024, out
 
 
+def car_options(doc: str, rounds: int, table: str, argv=None) -> tuple[argparse.Namespace, int, int]:
+    """A benchmark on the subdivided car: its options (``--rounds``, default ``rounds``; ``--small``, 6,300
+    quads and one round; ``--out``, the folder of ``table``), the car's subdivision levels and the rounds."""
+    parser = argparse.ArgumentParser(description=doc.split("\n\n")[0])
+    parser.add_argument("--rounds", type=int, default=rounds)
+    args = parse_with_output(parser, "6,300 quads, 1 round", f"folder of {table}", argv)
+    return args, *((1, 1) if args.small else (3, args.rounds))
+
+
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--rounds", type=int, default=3)
-    args = parse_with_output(parser, "6,300 quads, 1 round", "folder of bench_report.md", argv)
-    levels, rounds = (1, 1) if args.small else (3, args.rounds)
+    args, levels, rounds = car_options(__doc__, 3, "bench_report.md", argv)
     with tempfile.TemporaryDirectory() as folder:
         mesh = os.path.join(folder, "car.obj")
         source, quads = write_car(mesh, levels)

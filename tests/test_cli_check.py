@@ -10,7 +10,7 @@ import pytest
 from helpers.cli import SQUARE, TRAPEZOID, run, write
 
 TEXT_LINE = re.compile(
-    r"^(?P<path>.+):(?P<line>\d+):(?P<col>\d+): (?P<code>Q\d{3}) (?P<name>[a-z-]+): .+ "
+    r"^(?P<path>.+):(?P<line>\d+):(?P<col>\d+): (?P<code>Q\d{3}) (?P<level>error|warning|info) (?P<name>[a-z-]+): .+ "
     r"\((?P<value>\S+) vs (?P<threshold>\S+) (?P<unit>[a-z ]+)\) \[face (?P<face>\d+)\]$"
 )
 
@@ -33,7 +33,8 @@ def test_trapezoid_is_flagged_with_ruff_style_line(tmp_path):
     assert len(lines) == 1, result.stdout
     match = TEXT_LINE.match(lines[0])
     assert match, lines[0]
-    assert (match["line"], match["col"], match["code"], match["name"]) == ("10", "1", "Q101", "uv-disaffine")
+    assert (match["line"], match["col"], match["code"], match["level"], match["name"]) == (
+        "10", "1", "Q101", "error", "uv-disaffine")
     assert (match["value"], match["threshold"], match["unit"], match["face"]) == ("175.7", "0.5", "texels", "0")
 
 

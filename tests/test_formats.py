@@ -30,14 +30,15 @@ def render(module, run_: CheckRun) -> str:
 
 
 def test_text_lines_and_summary():
+    """Each line carries its level after the code; the error comes first, then the warnings, the worst first."""
     out = io.StringIO()
     text.write(sample_run(), out)
     assert out.getvalue().splitlines() == [
-        "a, b:c.obj:10:1: Q101 uv-disaffine: texture coordinates are not an affine image of the positions "
-        "(3.5 vs 0.5 texels) [face 0]",
-        "a, b:c.obj:11:1: Q204 bowtie-quad: the quad crosses itself (0.3 folded fraction) [face 1]",
-        "a, b:c.obj:12:1: Q101 uv-disaffine: texture coordinates are not an affine image of the positions "
+        "a, b:c.obj:11:1: Q204 error bowtie-quad: the quad crosses itself (0.3 folded fraction) [face 1]",
+        "a, b:c.obj:12:1: Q101 warning uv-disaffine: texture coordinates are not an affine image of the positions "
         "(256 vs 0.5 texels) [face 2]",
+        "a, b:c.obj:10:1: Q101 warning uv-disaffine: texture coordinates are not an affine image of the positions "
+        "(3.5 vs 0.5 texels) [face 0]",
         "Found 3 findings: 1 error, 2 warning (2 files checked, 1 unreadable, 1 skipped).",
     ]
 
@@ -85,17 +86,22 @@ def test_file_level_finding_names_no_face():
 
 
 def test_junit_is_valid_xml_with_failures_errors_and_skips():
+    """Only the findings at or above --fail-on (default error) fail; the warnings are reported in system-out."""
     root = ET.fromstring(render(junit, sample_run()))
     assert root.tag == "testsuites"
     assert {k: root.get(k) for k in ("tests", "failures", "errors", "skipped")} == {
-        "tests": "6", "failures": "3", "errors": "1", "skipped": "1"}
+        "tests": "6", "failures": "1", "errors": "1", "skipped": "1"}
     suites = {s.get("name"): s for s in root.findall("testsuite")}
     assert list(suites) == ["a, b:c.obj", "clean.obj", "broken.obj", "big.obj"]
+    assert suites["a, b:c.obj"].get("failures") == "1"
     flagged = suites["a, b:c.obj"].findall("testcase")
-    assert [c.find("failure").get("type") for c in flagged] == ["Q101", "Q204", "Q101"]
-    props = {p.get("name"): p.get("value") for p in flagged[2].find("properties")}
-    assert props["face"] == "2" and float(props["value"]) == 256.0 and float(props["threshold"]) == 0.5
-    assert props["line"] == "12" and props["group"] == "body"
+    assert [c.find("failure").get("type") if c.find("failure") is not None else None for c in flagged] == [
+        None, "Q204", None]
+    assert flagged[2].find("system-out").text.startswith("a, b:c.obj:12:1: Q101 warning uv-disaffine:")
+    warning_gate = sample_run()
+    warning_gate.fail_on = "warning"
+    assert ET.fromstring(render(junit, warning_gate)).get("failures") == "3"
+    assert flagged[2].get("name") == "Q101 uv-disaffine face 2" and flagged[2].get("line") == "12"
     (clean,) = suites["clean.obj"].findall("testcase")
     assert list(clean) == []  # a passing testcase
     assert suites["broken.obj"].find("testcase/error").get("type") == "Q901"
@@ -142,7 +148,7 @@ def test_junit_format_end_to_end(meshes):
     root = ET.fromstring(result.stdout)
     assert (root.get("tests"), root.get("failures"), root.get("errors")) == ("2", "1", "0")
     failure = root.find("testsuite[@name='bad.obj']/testcase/failure")
-    assert failure.get("type") == "Q101" and failure.text.startswith("bad.obj:10:1: Q101 uv-disaffine:")
+    assert failure.get("type") == "Q101" and failure.text.startswith("bad.obj:10:1: Q101 error uv-disaffine:")
     assert root.find("testsuite[@name='good.obj']/testcase/failure") is None
 
 
@@ -163,3 +169,16 @@ def test_unreadable_file_in_structured_formats_exits_2(meshes):
     assert result.returncode == 2
     assert result.stdout.startswith("::error file=broken.obj,line=4,title=Q901 unreadable::")
     assert result.stderr.startswith("broken.obj:4: Q901 unreadable:")
+
+
+def test_junit_of_a_mesh_with_warnings_only_has_no_failures(shared_meshes):
+    """The vase's 288 findings are warnings (under 2 texels): exit 0, and JUnit agrees; --fail-on warning fails both."""
+    vase = str(shared_meshes / "gen_vase_revolution.obj")
+    result = run("check", "--format", "junit", vase)
+    assert result.returncode == 0, result.stderr
+    root = ET.fromstring(result.stdout)
+    assert (root.get("tests"), root.get("failures")) == ("288", "0")
+    assert all(case.find("system-out").text.split(": ", 2)[1].startswith("Q101 warning ")
+               for case in root.iter("testcase"))
+    gated = run("check", "--format", "junit", "--fail-on", "warning", vase)
+    assert gated.returncode == 1 and ET.fromstring(gated.stdout).get("failures") == "288"

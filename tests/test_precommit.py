@@ -75,5 +75,5 @@ def test_bad_mesh_fails_the_hook_and_good_mesh_passes(tmp_path):
 
     bad = run_hook("models/good.obj", "models/BAD.OBJ")
     assert bad.returncode == 1, bad.stdout + bad.stderr
-    assert "models/BAD.OBJ:9:1: Q101 uv-disaffine" in bad.stdout
+    assert "models/BAD.OBJ:9:1: Q101 error uv-disaffine" in bad.stdout
     assert "Found 1 finding: 1 error (2 files checked)" in bad.stdout

@@ -101,7 +101,7 @@ def test_an_mtllib_named_with_a_hash_is_found_and_a_comment_still_ends_the_name(
     # A word starting with '#' starts a comment, as the loader reads every statement.
     mesh.write_text("mtllib lib #1.mtl\n" + TRAPEZOID_OBJ)
     code, out, _ = run_cli(["check", "--no-cache", "--select", "Q902", str(mesh)], capsys)
-    assert "a.obj:1:1: Q902 missing-resource:" in out and out.rstrip().count("mtllib lib not found") == 1
+    assert "a.obj:1:1: Q902 info missing-resource:" in out and out.rstrip().count("mtllib lib not found") == 1
 
 
 class OpenCounter:
@@ -304,7 +304,7 @@ def test_every_output_format_writes_one_mesh(tmp_path, capsys):
         elif name == "github":
             assert out.startswith("::") and "line=9" in out
         else:
-            assert "trapezoid.obj:9:1: Q101 uv-disaffine:" in out
+            assert "trapezoid.obj:9:1: Q101 error uv-disaffine:" in out
 
 
 def test_a_usd_stage_lists_its_layers_as_resources_and_the_cache_hashes_them(tmp_path):

@@ -98,17 +98,19 @@ def test_a_place_has_the_level_of_its_worst_finding(tmp_path):
     assert all(p.level == ("error" if p.value > 2.0 else "warning") for p in places)
 
 
-def test_places_take_turns_between_rules_worst_first():
+def test_places_go_errors_first_then_take_turns_between_rules_worst_first():
     from affinity.report.places import Place, choose_places
 
-    def place(code, beyond, face):
-        return Place(code, np.array([face]), np.array([beyond]), face, beyond, beyond,
-                     "error" if code == "Q204" else "warning")
+    def place(code, beyond, face, level="warning"):
+        return Place(code, np.array([face]), np.array([beyond]), face, beyond, beyond, level)
 
-    by_rule = {"Q101": [place("Q101", 9.0, 1), place("Q101", 5.0, 2), place("Q101", 4.0, 3)],
-               "Q202": [place("Q202", 2.0, 4)], "Q204": [place("Q204", 1.5, 5)]}  # Q204 is an error
-    chosen = choose_places(by_rule, 4)
-    assert [(p.code, p.worst) for p in chosen] == [("Q204", 5), ("Q101", 1), ("Q202", 4), ("Q101", 2)]
+    by_rule = {"Q101": [place("Q101", 9.0, 1, "error"), place("Q101", 5.0, 2, "error"), place("Q101", 4.0, 3)],
+               "Q202": [place("Q202", 2.0, 4)], "Q204": [place("Q204", 1.5, 5, "error")],
+               "Q302": [place("Q302", 1.0, 6, "info")]}
+    chosen = choose_places(by_rule, 6)
+    assert [(p.code, p.worst) for p in chosen] == [("Q101", 1), ("Q204", 5), ("Q101", 2), ("Q101", 3),
+                                                   ("Q202", 4), ("Q302", 6)]
+    assert [p.level for p in choose_places(by_rule, 3)] == ["error"] * 3
     assert choose_places(by_rule, 0) == []
 
 

@@ -59,3 +59,14 @@ def test_readme_rule_table_is_the_generated_one():
     assert match, "README.md lacks the <!-- rules:start --> / <!-- rules:end --> markers"
     assert match[1] == rules_table(), "regenerate the table with `affinity rules --markdown`"
     assert run("rules", "--markdown").stdout == rules_table()
+
+
+def test_the_affinity_fixes_say_what_removes_the_crease_and_speak_of_their_attribute():
+    """Design.md: refining or re-UVing removes a crease; triangulating only makes every tool draw the same one."""
+    uv = RULES["Q101"].fix
+    assert "Refine the quad" in uv and "affinity fix" in uv and "re-UV it as a parallelogram" in uv
+    assert "Triangulating does not remove the crease" in uv
+    for code, attribute in (("Q102", "colour"), ("Q103", "normal")):
+        fix = RULES[code].fix
+        assert attribute in fix and "Refine the quad" in fix and "does not remove" in fix
+        assert "uv" not in fix.lower() and "unwrap" not in fix.lower()

@@ -117,9 +117,11 @@ def test_a_known_texture_needs_no_note(tmp_path):
 
 # The run cap of SARIF and GitHub output.
 
-def test_default_sarif_keeps_the_worst_5000_of_a_run_over_several_files(tmp_path):
+def test_default_sarif_keeps_5000_of_a_run_over_several_files_a_fair_share_each(tmp_path):
+    """6,600 errors in three files: each file keeps its worst third of the 5,000 (1,667, 1,667, 1,666)."""
     rng = np.random.default_rng(3)
-    widths = [rng.uniform(0.2, 1.98, 2200) for _ in range(3)]  # 6,600 flagged quads in three files
+    widths = [rng.uniform(0.2, 0.6, 2200) for _ in range(3)]  # 6,600 flagged quads in three files, all errors
+    assert min(texels(w) for ws in widths for w in ws) > 2.0
     paths = [str(write(tmp_path, f"part{i}.obj", trapezoids(w))) for i, w in enumerate(widths)]
     result = run("check", "--format", "sarif", *paths, cwd=tmp_path)
     assert result.returncode == 1
@@ -128,15 +130,36 @@ def test_default_sarif_keeps_the_worst_5000_of_a_run_over_several_files(tmp_path
     (sarif_run,) = log["runs"]
     results = sarif_run["results"]
     assert len(results) == 5000
-    expected = np.sort([texels(w) for ws in widths for w in ws])[::-1][:5000]
-    kept = np.sort([r["properties"]["value"] for r in results])[::-1]
-    np.testing.assert_allclose(kept, expected, rtol=1e-6)
-    assert len({r["locations"][0]["physicalLocation"]["artifactLocation"]["uri"] for r in results}) == 3
+    for i, (ws, share) in enumerate(zip(widths, [1667, 1667, 1666])):
+        kept = [r["properties"]["value"] for r in results
+                if r["locations"][0]["physicalLocation"]["artifactLocation"]["uri"] == f"part{i}.obj"]
+        expected = np.sort([texels(w) for w in ws])[::-1][:share]
+        np.testing.assert_allclose(np.sort(kept)[::-1], expected, rtol=1e-6)
     (note,) = sarif_run["invocations"][0]["toolExecutionNotifications"]
-    assert "truncated" in note["message"]["text"] and "6,600" in note["message"]["text"]
+    assert "truncated" in note["message"]["text"] and "left out: 1,600 of 6,600 error" in note["message"]["text"]
     assert "truncated" in result.stderr and len(result.stderr.strip().splitlines()) == 1
     capped = json.loads(run("check", "--format", "sarif", "--max-findings", "2000", *paths, cwd=tmp_path).stdout)
     assert len(capped["runs"][0]["results"]) == 6000, "--max-findings replaces the run cap (per file and rule)"
+
+
+def test_sarif_keeps_every_error_of_a_small_file_beside_a_big_one(tmp_path):
+    """The issue's folder: a big file with thousands of errors and warnings must not crowd out a small one's
+    errors, and no warning is kept while an error is dropped."""
+    rng = np.random.default_rng(5)
+    big = np.concatenate([rng.uniform(0.2, 0.6, 5500), rng.uniform(1.986, 1.994, 1500)])  # errors, then warnings
+    small = np.concatenate([rng.uniform(0.5, 0.9, 7), rng.uniform(1.986, 1.994, 30)])
+    small_values, big_values = (np.array([texels(w) for w in ws]) for ws in (small, big))
+    assert (small_values > 2.0).sum() == 7 and (big_values <= 2.0).sum() == 1500
+    write(tmp_path, "car.obj", trapezoids(big))
+    write(tmp_path, "cow.obj", trapezoids(small))
+    result = run("check", "--format", "sarif", ".", cwd=tmp_path)
+    results = json.loads(result.stdout)["runs"][0]["results"]
+    by_file = {}
+    for r in results:
+        by_file.setdefault(r["locations"][0]["physicalLocation"]["artifactLocation"]["uri"], []).append(r["level"])
+    assert by_file["cow.obj"].count("error") == 7, "all of the small file's errors"
+    assert len(results) == 5000 and {level for levels in by_file.values() for level in levels} == {"error"}
+    assert "left out: 507 of 5,507 error, 1,530 of 1,530 warning" in result.stderr
 
 
 def test_sarif_under_the_cap_says_nothing_of_truncation(tmp_path):

@@ -165,6 +165,9 @@ def add_gate_arguments(p) -> None:
     p.add_argument("--fail-on", choices=LEVELS, default="error",
                    help="the lowest level whose findings make exit 1 (default: error, a plainly visible "
                         "crease; warning also fails on the milder ones)")
+    p.add_argument("--level", choices=LEVELS,
+                   help="show only the findings at this level or above: error prints what fails the default gate "
+                        "(default: every level; the exit code still counts every finding)")
     p.add_argument("--exit-zero", action="store_true",
                    help="exit 0 even with findings (unreadable input and --fail-on-skip still exit 2)")
     p.add_argument("--fail-on-skip", action="store_true",
@@ -364,19 +367,26 @@ def run(args) -> int:
         return EXIT_ERROR if _failed(reports, args.fail_on_skip) else EXIT_CLEAN
 
     check_run = CheckRun(reports, resolver.resolve(os.curdir).settings,
-                         max_findings=args.max_findings, statistics=args.statistics, shard=shard)
+                         max_findings=args.max_findings, statistics=args.statistics, shard=shard,
+                         fail_on=args.fail_on)
     if args.baseline:
         check_run.reports, check_run.baselined = baseline.apply(reports, known)
     return publish(check_run, args)
 
 
 def publish(check_run, args) -> int:
-    """Write ``check_run`` as ``args`` asks (``--format``, ``-o``, ``--verbose``, ``--statistics``, ``-q``)
-    and return the run's exit code (``--fail-on``, ``--exit-zero``, ``--fail-on-skip``; design.md)."""
+    """Write ``check_run`` as ``args`` asks (``--format``, ``-o``, ``--level``, ``--verbose``, ``--statistics``,
+    ``-q``) and return the run's exit code (``--fail-on``, ``--exit-zero``, ``--fail-on-skip``; design.md): the
+    gate counts every finding, whatever ``--level`` shows."""
+    gated = check_run.reports
+    if args.level is not None:
+        from ..output import at_or_above
+
+        check_run.reports, check_run.hidden = at_or_above(check_run.reports, args.level)
     _write_output_file(args.output_file, lambda out: _write_output(check_run, args, out))
     if _failed(check_run.reports, args.fail_on_skip):
         return EXIT_ERROR
-    return EXIT_CLEAN if args.exit_zero or not _fails(check_run.reports, args.fail_on) else EXIT_FINDINGS
+    return EXIT_CLEAN if args.exit_zero or not _fails(gated, args.fail_on) else EXIT_FINDINGS
 
 
 def _failed(reports, fail_on_skip: bool) -> bool:
@@ -388,8 +398,7 @@ def _fails(reports, fail_on: str) -> bool:
     """Whether any finding is at level ``fail_on`` or above (error > warning > info)."""
     from ..rules import LEVELS
 
-    worse = set(LEVELS[: LEVELS.index(fail_on) + 1])
-    return any(not worse.isdisjoint(h.levels().tolist()) for r in reports for h in r.hits)
+    return any(len(h) and h.level_ranks().min() <= LEVELS.index(fail_on) for r in reports for h in r.hits)
 
 
 def _write_output_file(path: str | None, write) -> None:

@@ -42,5 +42,6 @@ def run(args) -> int:
         sys.stderr.writelines(f"affinity merge: error: {problem}\n" for problem in err.problems)
         return EXIT_ERROR
     report_problems(merged.reports, args.quiet, args.fail_on_skip)
-    check_run = CheckRun(merged.reports, merged.settings, baselined=merged.baselined, statistics=args.statistics)
+    check_run = CheckRun(merged.reports, merged.settings, baselined=merged.baselined, statistics=args.statistics,
+                         fail_on=args.fail_on)
     return publish(check_run, args)

@@ -18,6 +18,7 @@ import sys
 from ..errors import UsageError
 from ..loaders.formats import described
 from ..report import MAX_VIEWS, PLACE_FACES, RENDER_SIZE
+from ..rules import LEVELS
 from . import EXIT_CLEAN, EXIT_ERROR, camera, image_size, pixel_tolerance, require
 
 
@@ -48,6 +49,9 @@ def add_parser(sub) -> None:
     p.add_argument("--place-faces", type=_positive, default=PLACE_FACES, metavar="N",
                    help=f"the most faces a close-up's place holds: a bigger group of flagged faces is cut into "
                         f"places around its worst faces (default: {PLACE_FACES})")
+    p.add_argument("--fail-on", choices=LEVELS, default="error",
+                   help="the level the verdict is given at, as for affinity check: the report says a mesh fails "
+                        "when it has a finding at this level or above (default: error)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no result line")
     p.set_defaults(run=run)
 
@@ -138,7 +142,8 @@ def run(args) -> int:
     with tqdm(total=len(inputs), unit="file", file=sys.stderr, leave=False, delay=1.0,
               disable=args.quiet or not sys.stderr.isatty()) as bar:
         report = collect_run(inputs, lambda path: resolver.resolve(path).settings.for_file(path),
-                             resolver.resolve(os.curdir).settings, bar, options, demo=not args.meshes, start=start)
+                             resolver.resolve(os.curdir).settings, bar, options, demo=not args.meshes, start=start,
+                             fail_on=args.fail_on)
         skipped = [result.file for result in report.meshes if result.file.skipped is not None]
         if len(inputs) == 1 and skipped:  # a report of nothing: say so, write nothing
             raise UsageError(f"{printable(skipped[0].path)}: skipped ({skipped[0].skipped}): nothing to report")

@@ -2,16 +2,21 @@
 
 ``text`` (ruff-style lines), ``json`` (the documented schema), ``sarif`` (SARIF
 2.1.0 for code scanning), ``github`` (workflow annotations) and ``junit`` (XML
-for CI test reports). This package holds what they share: the flat
-:class:`Finding` rows and how a finding is described.
+for CI test reports); :mod:`.cap` keeps a run's SARIF results and GitHub
+annotations within the run cap. This package holds what they share: which
+findings of a file are written and in which order (:func:`select`, a
+:class:`Selection`), the findings as :class:`Columns` (a block of one rule's
+findings, so a format writes many rows at a time: time and memory grow with the
+findings, with small constants) or as :class:`Finding` rows, and how a finding
+is described (:func:`descriptions`, :func:`text_lines`).
 """
 
 from __future__ import annotations
 
-import dataclasses
 import importlib
 import os
-from dataclasses import dataclass
+from collections.abc import Iterator
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -35,10 +40,12 @@ class CheckRun:
 
     ``settings`` are the resolved settings for the working directory (files
     governed by another configuration file have their own); ``baselined`` maps a
-    path to the number of its findings a baseline hid (None: no baseline was used).
+    path to the number of its findings a baseline hid (None: no baseline was used);
+    ``hidden`` counts per level the findings ``--level`` left out (None: no filter).
     ``max_findings`` caps the findings the structured formats keep per file and
     rule (the worst; ``--max-findings``); without it SARIF and GitHub output keep
-    at most ``run_cap`` per run (:meth:`capped`). ``statistics`` asks for per-rule counts.
+    at most ``run_cap`` per run (:func:`affinity.output.cap.cap_findings`). ``fail_on`` is the
+    lowest level that fails the run (``--fail-on``). ``statistics`` asks for per-rule counts.
     ``shard`` (:class:`affinity.shards.selection.ShardRecord`) is set when the run
     checked one shard of a larger one (``--shard K/N``).
     """
@@ -49,6 +56,8 @@ class CheckRun:
     max_findings: int | None = None
     statistics: bool = False
     run_cap: int = RUN_CAP
+    fail_on: str = "error"
+    hidden: dict[str, int] | None = None
     shard: ShardRecord | None = None
 
     def tally(self) -> dict[str, int]:
@@ -64,24 +73,25 @@ class CheckRun:
             "baselined": sum((self.baselined or {}).values()),
         }
 
-    def kept(self, report: FileReport) -> list[Finding]:
-        """The findings of ``report`` a structured format writes: all, or the worst ``max_findings`` per rule."""
-        return file_findings(report, self.max_findings, worst=True)[0]
+    def kept(self, report: FileReport) -> Selection:
+        """The findings of ``report`` a structured format writes, in file order: all, or the worst
+        ``max_findings`` per rule."""
+        return select(report, self.max_findings)
 
-    def capped(self, findings: list[Finding]) -> list[int]:
-        """Indices (rising) of the ``findings`` (of the whole run) a capped format keeps: all with
-        ``--max-findings`` or up to ``run_cap`` of them, else the ``run_cap`` worst (:func:`severity`)."""
-        if self.max_findings is not None or len(findings) <= self.run_cap:
-            return list(range(len(findings)))
-        keys = np.array([severity(f) for f in findings], dtype=float)  # (n, 2)
-        return np.sort(np.lexsort((keys[:, 1], keys[:, 0]))[: self.run_cap]).tolist()
 
-    def cap_notice(self, kept: int, total: int, what: str) -> str | None:
-        """The truncation line (notification and stderr) when the cap left findings out, else None."""
-        if kept == total:
-            return None
-        return (f"{what} truncated: the worst {kept:,} of {total:,} findings are kept (at most {self.run_cap:,} "
-                "per run by default; --max-findings N keeps the worst N per file and rule instead)")
+def at_or_above(reports: list[FileReport], level: str) -> tuple[list[FileReport], dict[str, int]]:
+    """``reports`` keeping only the findings at ``level`` or worse, and how many were left out per level."""
+    hidden = dict.fromkeys(LEVELS[LEVELS.index(level) + 1:], 0)
+    kept = []
+    for report in reports:
+        for hits in report.hits:
+            levels, counts = np.unique(hits.level_ranks(), return_counts=True)
+            for rank, n in zip(levels.tolist(), counts.tolist()):
+                if LEVELS[rank] in hidden:
+                    hidden[LEVELS[rank]] += n
+        shown = [h for h in (h.at_or_above(level) for h in report.hits) if len(h)]
+        kept.append(replace(report, hits=shown))
+    return kept, {level: n for level, n in hidden.items() if n}
 
 
 @dataclass(slots=True)
@@ -118,6 +128,13 @@ class Finding:
 
 #: The Finding fields only a USD stage fills: left out of structured output where they are None.
 USD_FIELDS = ("prim", "layer", "layer_prim", "prims", "prim_values")
+#: The fields of geometry several prims reference (:attr:`Columns.shared`).
+SHARED_FIELDS = USD_FIELDS[1:]
+
+
+def shared_fields(f: Finding) -> dict | None:
+    """The :data:`SHARED_FIELDS` of a finding on geometry several prims reference; None for any other."""
+    return None if f.prims is None else {name: getattr(f, name) for name in SHARED_FIELDS}
 
 
 def finding_dict(f: Finding) -> dict:
@@ -126,8 +143,56 @@ def finding_dict(f: Finding) -> dict:
     Shallow: the lists (``prims``) are the finding's own, not copies (``dataclasses.asdict`` deep-copies
     every value, which took 6 s for 8,827 findings naming 32 prims each).
     """
-    return {field.name: value for field in dataclasses.fields(f)
-            if (value := getattr(f, field.name)) is not None or field.name not in USD_FIELDS}
+    return {name: value for name in Finding.__slots__
+            if (value := getattr(f, name)) is not None or name not in USD_FIELDS}
+
+
+@dataclass(eq=False)
+class Columns:
+    """Findings of one rule in one file as columns, for the formats that write many rows at once.
+
+    ``path``, ``code``, ``name``, ``unit`` and ``threshold`` (None for rules
+    without one: Q204, Q205, Q302 measure something else) are shared; the rest
+    are lists of n, one entry a finding: ``line``, ``column``, ``face`` (within
+    its prim in USD), ``value``, ``level``, ``group``, ``message`` (the rule's
+    summary, with the finding's detail) and ``prim`` (None outside USD and for
+    file-level findings). ``shared`` is None unless some of the findings lie on
+    geometry several prims reference: then one dict (the :data:`SHARED_FIELDS`) or
+    None a finding.
+    """
+
+    path: str
+    code: str
+    name: str
+    unit: str
+    threshold: float | None
+    line: list[int]
+    column: list[int]
+    face: list[int]
+    value: list[float]
+    level: list[str]
+    group: list[str]
+    message: list[str]
+    prim: list[str | None]
+    shared: list[dict | None] | None = None
+
+    def __len__(self) -> int:
+        return len(self.face)
+
+    def findings(self) -> list[Finding]:
+        shared = self.shared or [None] * len(self)
+        return [Finding(self.path, line, column, self.code, self.name, face, value, self.threshold, self.unit, level,
+                        group, message, prim, **(where or {}))
+                for line, column, face, value, level, group, message, prim, where in zip(
+                    self.line, self.column, self.face, self.value, self.level, self.group, self.message, self.prim,
+                    shared)]
+
+    @classmethod
+    def of(cls, f: Finding) -> Columns:
+        """One finding as columns."""
+        where = shared_fields(f)
+        return cls(f.path, f.code, f.name, f.unit, f.threshold, [f.line], [f.column], [f.face], [f.value], [f.level],
+                   [f.group], [f.message], [f.prim], None if where is None else [where])
 
 
 def writer(name: str):
@@ -140,103 +205,159 @@ def group_name(report: FileReport, index: int) -> str:
     return report.group_names[index] if 0 <= index < len(report.group_names) else ""
 
 
-def _rows(report: FileReport, hits: RuleHits, take: np.ndarray) -> list[tuple[int, Finding]]:
-    """``(face in file order, finding)`` for the hits at ``take``."""
+def columns(report: FileReport, hits: RuleHits, take: np.ndarray) -> Columns:
+    """The findings ``take`` (k,) int64 of ``hits`` as :class:`Columns`."""
     rule = RULES[hits.code]
-    # Rules without a threshold (Q204, Q205, Q302) measure something else; no limit to report.
-    threshold = None if rule.default_threshold is None else hits.threshold
     faces, groups, lines = hits.faces[take], hits.groups[take], hits.lines[take]
-    unit = hits.unit if hits.unit is not None else rule.unit
-    details = [None] * len(faces) if hits.details is None else [hits.details[k] for k in np.arange(len(hits))[take]]
     usd = report.prim_face_start is not None
     if usd:  # no lines; faces count within their prim (the file-level face -1 stays -1)
-        faces, lines = faces - report.prim_face_start[groups], np.zeros_like(lines)
-    shared = {entry["prim"]: entry for entry in report.shared}
-    return [
-        (order, _shared_geometry(Finding(
-            path=report.path,
-            line=int(line),
-            column=1 if line > 0 else 0,
-            code=hits.code,
-            name=rule.name,
-            face=int(face),
-            value=float(value),
-            threshold=threshold,
-            unit=unit,
-            level=level,
-            group=group_name(report, g),
-            message=rule.summary if detail is None else f"{rule.summary}: {detail}",
-            prim=group_name(report, g) if usd and order >= 0 else None,
-        ), shared))
-        for order, face, line, value, g, detail, level in zip(
-            hits.faces[take].tolist(), faces.tolist(), lines.tolist(),
-            hits.values[take].tolist(), groups.tolist(), details, hits.levels()[take].tolist(),
-        )
-    ]
+        faces, lines = np.where(faces >= 0, faces - report.prim_face_start[groups], faces), np.zeros_like(lines)
+    names = np.asarray([*report.group_names, ""], dtype=object)
+    group = names[np.where((groups >= 0) & (groups < len(report.group_names)), groups, -1)].tolist()
+    if hits.details is None:
+        message = [rule.summary] * len(take)
+    else:
+        details = hits.details
+        message = [rule.summary if details[i] is None else f"{rule.summary}: {details[i]}" for i in take.tolist()]
+    prim = [g if f >= 0 else None for g, f in zip(group, hits.faces[take].tolist())] if usd else [None] * len(take)
+    shared = _shared_geometry(report, hits.code, prim, faces.tolist()) if usd and report.shared else None
+    return Columns(
+        path=report.path, code=hits.code, name=rule.name,
+        unit=hits.unit if hits.unit is not None else rule.unit,
+        threshold=None if rule.default_threshold is None else hits.threshold,
+        line=lines.tolist(), column=(lines > 0).astype(np.int64).tolist(), face=faces.tolist(),
+        value=hits.values[take].tolist(), level=hits.levels()[take].tolist(), group=group, message=message, prim=prim,
+        shared=shared,
+    )
 
 
-def _shared_geometry(f: Finding, shared: dict[str, dict]) -> Finding:
-    """``f`` with where its geometry is authored and the prims that reference it, when several do."""
-    entry = shared.get(f.prim)
-    if entry is not None:
-        f.layer, f.layer_prim, f.prims = entry["layer"], entry["layer_prim"], entry["prims"]
-        f.prim_values = dict((face, values) for face, values in entry["values"].get(f.code, [])).get(f.face)
-    return f
+def _shared_geometry(report: FileReport, code: str, prims: list[str | None],
+                     faces: list[int]) -> list[dict | None] | None:
+    """Per finding, where its geometry is authored and the prims that reference it (the :data:`SHARED_FIELDS`),
+    None where one prim alone has it; None when no finding lies on shared geometry."""
+    entries = {entry["prim"]: entry for entry in report.shared}
+    values = {prim: dict(entry["values"].get(code, [])) for prim, entry in entries.items()}
+    shared = [None if (entry := entries.get(prim)) is None else
+              {"layer": entry["layer"], "layer_prim": entry["layer_prim"], "prims": entry["prims"],
+               "prim_values": values[prim].get(face)}
+              for prim, face in zip(prims, faces)]
+    return shared if any(where is not None for where in shared) else None
 
 
-def severity(f: Finding) -> tuple[int, float]:
-    """A sort key, lowest the worst: (level rank, error first; minus how far the value is beyond the
-    threshold, as a ratio; findings without a measured ratio (Q204, Q205, ...) first within their level)."""
-    rule = RULES[f.code]
-    measured = f.threshold is not None and f.threshold > 0 and rule.flags == "above"
-    return LEVELS.index(f.level), -(f.value / f.threshold) if measured else -np.inf
+def badness(hits: RuleHits) -> np.ndarray:
+    """(n,) float64 order within a level, lowest the worst: minus how far each value is beyond the threshold, as
+    a ratio; -inf for findings without a measured ratio (Q201, Q204, Q205, ...: first within their level)."""
+    rule = RULES[hits.code]
+    if rule.flags != "above" or rule.default_threshold is None or not hits.threshold > 0:
+        return np.full(len(hits), -np.inf)
+    return -hits.values / hits.threshold
 
 
-def _worst_first(hits: RuleHits) -> np.ndarray:
-    """(n,) int64 order of ``hits`` from the worst value (the rule's ``worst`` end) to the mildest,
-    ties in file order."""
+def worst_first(hits: RuleHits) -> np.ndarray:
+    """(n,) int64 order of ``hits`` from the worst (errors first, then the worst values: the rule's ``worst``
+    end) to the mildest, ties in file order."""
     key = hits.values if RULES[hits.code].worst == "lowest" else -hits.values
-    return np.lexsort((hits.faces, key))
+    return np.lexsort((hits.faces, key, hits.level_ranks()))
 
 
-def file_findings(report: FileReport, limit: int | None = None,
-                  worst: bool = False) -> tuple[list[Finding], dict[str, int]]:
-    """The findings of one file in source order, and how many each rule left out.
+@dataclass(eq=False)
+class Selection:
+    """The findings of one file a format writes, rule by rule, and the order they are written in.
 
-    Parameters
-    ----------
-    limit : int or None
-        Keep at most this many findings per rule; None keeps all.
-    worst : bool
-        Which ones ``limit`` keeps: the first in file order (text output), or
-        the worst values (``--max-findings``).
-
-    Returns
-    -------
-    findings : list of Finding, sorted by (line, face in file order, code)
-    omitted : dict of rule code to the number of findings beyond ``limit``
+    ``parts`` pairs each rule's hits with the rows taken, (k,) int64; ``order``
+    (n,) int64 indexes the concatenation of the parts; ``omitted`` counts per
+    rule what a limit left out.
     """
-    rows: list[tuple[int, Finding]] = []
-    omitted: dict[str, int] = {}
+
+    report: FileReport
+    parts: list[tuple[RuleHits, np.ndarray]]
+    order: np.ndarray
+    omitted: dict[str, int] = field(default_factory=dict)
+
+    def __len__(self) -> int:
+        return len(self.order)
+
+    def _concatenated(self, column) -> np.ndarray:
+        return np.concatenate([column(hits)[take] for hits, take in self.parts] or [np.zeros(0)])[self.order]
+
+    def level_ranks(self) -> np.ndarray:
+        """(n,) int8 level rank of each finding, in order (0 error)."""
+        return self._concatenated(RuleHits.level_ranks).astype(np.int8)
+
+    def badness(self) -> np.ndarray:
+        """(n,) float64 :func:`badness` of each finding, in order."""
+        return self._concatenated(badness)
+
+    def subset(self, positions: np.ndarray) -> Selection:
+        """The findings at ``positions`` (k,) of the order, in that order."""
+        return Selection(self.report, self.parts, self.order[positions], self.omitted)
+
+    def formatted(self, format_rows, block: int = 16384, along: np.ndarray | None = None) -> Iterator[list]:
+        """``format_rows(columns) -> list`` (one entry a finding, :class:`Columns`) over the findings, yielded
+        in order, ``block`` at a time (a format's rows of a big file are never all held at once). With
+        ``along`` (n,), values in the selection's order, ``format_rows(columns, values)`` gets those of its rows."""
+        starts = np.cumsum([0] + [len(take) for _, take in self.parts])
+        for begin in range(0, len(self.order), block):
+            index = self.order[begin : begin + block]
+            part = np.searchsorted(starts, index, side="right") - 1
+            present = np.flatnonzero(np.bincount(part, minlength=len(self.parts))).tolist()
+            out = None if len(present) == 1 else np.empty(len(index), dtype=object)
+            for p in present:
+                where = np.flatnonzero(part == p)
+                hits, take = self.parts[p]
+                found = columns(self.report, hits, take[index[where] - starts[p]])
+                rows = format_rows(found) if along is None else format_rows(found, along[begin + where])
+                if out is None:  # one rule in the block: its rows are the block, in order
+                    yield rows
+                else:
+                    out[where] = np.fromiter(rows, dtype=object, count=len(where))
+            if out is not None:
+                yield out.tolist()
+
+    def findings(self) -> list[Finding]:
+        return [f for rows in self.formatted(Columns.findings) for f in rows]
+
+
+def select(report: FileReport, limit: int | None = None, order: str = "file") -> Selection:
+    """The findings of one file: per rule all, or the worst ``limit`` (errors first); in ``order``:
+
+    ``"file"``: by (line, face, rule code), as the file reads; ``"severity"``:
+    errors first, then warnings, then info, each the worst first (:func:`badness`),
+    ties in file order.
+    """
+    parts, omitted = [], {}
     for hits in report.hits:
+        take = np.arange(len(hits))
         if limit is not None and len(hits) > limit:
             omitted[hits.code] = len(hits) - limit
-            order = np.sort(_worst_first(hits)[:limit]) if worst else np.argsort(hits.faces, kind="stable")[:limit]
-        else:
-            order = np.argsort(hits.faces, kind="stable")
-        rows.extend(_rows(report, hits, order))
-    rows.sort(key=lambda row: (row[1].line, row[0], row[1].code))
-    return [f for _, f in rows], omitted
+            take = np.sort(worst_first(hits)[:limit])
+        parts.append((hits, take))
+    code_rank = {code: i for i, code in enumerate(RULES)}
+    concatenated = Selection(report, parts, np.arange(sum(len(take) for _, take in parts)))
+    face = concatenated._concatenated(lambda h: h.faces)
+    code = np.concatenate([np.full(len(take), code_rank[h.code]) for h, take in parts] or [np.zeros(0)])
+    if order == "file":
+        key = (code, face, concatenated._concatenated(lambda h: h.lines))
+    else:
+        key = (code, face, concatenated.badness(), concatenated.level_ranks())
+    return Selection(report, parts, np.lexsort(key), omitted)
+
+
+def file_findings(report: FileReport, limit: int | None = None) -> tuple[list[Finding], dict[str, int]]:
+    """The findings of one file in source order (per rule all, or the worst ``limit``), and how many each
+    rule left out."""
+    selection = select(report, limit)
+    return selection.findings(), selection.omitted
 
 
 def worst_findings(report: FileReport, hits: RuleHits, n: int) -> list[Finding]:
     """The ``n`` worst findings of one rule in one file, worst first."""
-    return [f for _, f in _rows(report, hits, _worst_first(hits)[:n])]
+    return columns(report, hits, worst_first(hits)[:n]).findings()
 
 
 def first_findings(report: FileReport, hits: RuleHits, n: int) -> list[Finding]:
     """The first ``n`` findings of one rule in one file, in file order."""
-    return [f for _, f in _rows(report, hits, np.argsort(hits.faces, kind="stable")[:n])]
+    return columns(report, hits, np.argsort(hits.faces, kind="stable")[:n]).findings()
 
 
 def truncation(run: CheckRun, max_findings: int | None) -> list[dict]:
@@ -249,23 +370,20 @@ def truncation(run: CheckRun, max_findings: int | None) -> list[dict]:
 
 def level_counts(reports: list[FileReport]) -> dict[str, int]:
     """Findings per level (``error``, ``warning``, ``info``) over all reports, levels without findings left out."""
-    counts = dict.fromkeys(LEVELS, 0)
+    counts = np.zeros(len(LEVELS), dtype=np.int64)
     for report in reports:
         for hits in report.hits:
-            levels, n = np.unique(hits.levels(), return_counts=True)
-            for level, count in zip(levels.tolist(), n.tolist()):
-                counts[level] += count
-    return {level: n for level, n in counts.items() if n}
+            counts += np.bincount(hits.level_ranks(), minlength=len(LEVELS))
+    return {level: int(n) for level, n in zip(LEVELS, counts) if n}
 
 
 def statistics(reports: list[FileReport]) -> list[dict]:
     """Per rule with findings: ``{"code", "name", "level", "count"}`` (the worst level of its findings)."""
-    levels: dict[str, str] = {}
+    levels: dict[str, int] = {}
     for report in reports:
         for hits in report.hits:
-            worst = min(hits.levels().tolist(), key=LEVELS.index)
-            levels[hits.code] = min(levels.get(hits.code, worst), worst, key=LEVELS.index)
-    return [{"code": code, "name": RULES[code].name, "level": levels[code], "count": n}
+            levels[hits.code] = min(levels.get(hits.code, len(LEVELS)), int(hits.level_ranks().min()))
+    return [{"code": code, "name": RULES[code].name, "level": LEVELS[levels[code]], "count": n}
             for code, n in rule_counts(reports).items()]
 
 
@@ -283,16 +401,29 @@ def format_value(value: float) -> str:
     return f"{value:.4g}"
 
 
-def describe(f: Finding) -> str:
-    """The message with the measurement and its unit: ``... (3.2 vs 0.5 texels)``, ``... (0.5 folded fraction)``.
+def _measured(c: Columns) -> tuple[str, str]:
+    """What follows a value in a description: its unit (``" texels"``, ``"/255"``) where there is no threshold,
+    else ``" vs 0.5 texels"``."""
+    unit = with_unit("", c.unit)  # what follows the number: " texels", "/255"
+    if c.threshold is None:
+        return unit, ""
+    return "", f" vs {format_value(c.threshold)}{unit}"
 
-    A finding without a unit (Q902: a missing file measures nothing) is its message alone.
+
+def descriptions(c: Columns) -> list[str]:
+    """Each message with its measurement and unit: ``... (3.2 vs 0.5 texels)``, ``... (0.5 folded fraction)``.
+
+    A rule without a unit (Q902: a missing file measures nothing) gives the message alone.
     """
-    if not f.unit:
-        return f.message
-    measured = (format_value(f.value) if f.threshold is None
-                else f"{format_value(f.value)} vs {format_value(f.threshold)}")
-    return f"{f.message} ({with_unit(measured, f.unit)})"
+    if not c.unit:
+        return list(c.message)
+    unit, against = _measured(c)
+    return [f"{m} ({v:.4g}{unit}{against})" for m, v in zip(c.message, c.value)]
+
+
+def describe(f: Finding) -> str:
+    """:func:`descriptions` of one finding."""
+    return descriptions(Columns.of(f))[0]
 
 
 def face_label(f: Finding) -> str:
@@ -302,29 +433,35 @@ def face_label(f: Finding) -> str:
     return f"face {f.face}" if f.prim is None else f"{f.prim} face {f.face}"
 
 
-def located(f: Finding) -> str:
-    """:func:`describe` naming the face, for formats without a text line: ``..., face 12``."""
-    return ", ".join(filter(None, [describe(f), face_label(f)]))
+def text_lines(c: Columns) -> list[str]:
+    """The ruff-style lines ``path:line:col: CODE level name: message (value vs threshold unit) [face F]``
+    (design.md); ``path:prim:face N: CODE level ...`` in USD; no ``[face]`` for file-level findings."""
+    path, code, name = printable(c.path), c.code, c.name
+    if c.unit and c.prim[0] is None and min(c.face, default=0) >= 0:  # measured faces of a mesh file
+        unit, against = _measured(c)
+        return [f"{path}:{line}:{column}: {code} {level} {name}: {m} ({v:.4g}{unit}{against}) [face {face}]"
+                for line, column, face, level, m, v in zip(c.line, c.column, c.face, c.level, c.message, c.value)]
+    described = descriptions(c)
+    where = [""] * len(c) if c.shared is None else [authored_where(s) for s in c.shared]
+    return [
+        (f"{path}:{prim}:face {face}: " if prim is not None else f"{path}:{line}:{column}: ")
+        + f"{code} {level} {name}: {text}" + (f" [face {face}]" if prim is None and face >= 0 else "") + also
+        for line, column, face, level, prim, text, also in zip(c.line, c.column, c.face, c.level, c.prim, described,
+                                                              where)
+    ]
 
 
-def text_line(f: Finding) -> str:
-    """The ruff-style line ``path:line:col: CODE name: message (value vs threshold unit) [face F]``
-    (design.md); ``path:prim:face N: ...`` in USD, no ``[face]`` for file-level findings."""
-    if f.prim is not None:
-        return f"{printable(f.path)}:{f.prim}:face {f.face}: {f.code} {f.name}: {describe(f)}{authored_where(f)}"
-    face = f" [face {f.face}]" if f.face >= 0 else ""
-    return f"{printable(f.path)}:{f.line}:{f.column}: {f.code} {f.name}: {describe(f)}{face}"
-
-
-def authored_where(f: Finding) -> str:
+def authored_where(shared: dict | None) -> str:
     """`` [authored in LAYER:/prim, referenced by /a (3.2), /b (1.1)]`` for a finding on geometry several
-    prims reference (each prim's own value where they differ); ``""`` otherwise."""
-    if f.prims is None:
+    prims reference (``shared``: its :data:`SHARED_FIELDS`; each prim's own value where they differ); ``""``
+    for one that is not (None)."""
+    if shared is None:
         return ""
-    values = f.prim_values or [None] * len(f.prims)
-    prims = ", ".join(p if v is None and f.prim_values is None else f"{p} ({'-' if v is None else format_value(v)})"
-                      for p, v in zip(f.prims, values))
-    return f" [authored in {printable(working_relative(f.layer) or f.layer)}:{f.layer_prim}, referenced by {prims}]"
+    values = shared["prim_values"]
+    prims = ", ".join(p if values is None else f"{p} ({'-' if v is None else format_value(v)})"
+                      for p, v in zip(shared["prims"], values or shared["prims"]))
+    layer = printable(working_relative(shared["layer"]) or shared["layer"])
+    return f" [authored in {layer}:{shared['layer_prim']}, referenced by {prims}]"
 
 
 def working_relative(path: str) -> str | None:
@@ -337,6 +474,10 @@ def working_relative(path: str) -> str | None:
     return None if rel.startswith("..") else rel.replace(os.sep, "/")
 
 
+#: The format of :func:`value_token`, for formatting many values at once.
+VALUE_TOKEN = "{:.6g}"
+
+
 def value_token(value: float) -> str:
     """A measured value rounded to 6 significant digits: equal for the same quad on every run.
 
@@ -344,5 +485,5 @@ def value_token(value: float) -> str:
     this token (with rule, file and group) identifies a finding across face
     reordering and edits elsewhere in the file (baseline, SARIF fingerprints).
     """
-    return f"{value:.6g}"
+    return VALUE_TOKEN.format(value)
 

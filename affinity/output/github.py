@@ -4,9 +4,10 @@ At most one annotation per file and rule (GitHub shows only a handful per step
 anyway): it stands on the worst finding's line and gives the count, the worst
 value and the first few faces with their lines. Its level is the worst finding's
 (``error`` -> ``::error``, ``warning`` -> ``::warning``, ``info`` -> ``::notice``).
-Without ``--max-findings`` a run writes at most 5,000 of them, those of the worst
-findings (:meth:`affinity.output.CheckRun.capped`), and says what it cut in a
-``::warning`` and one line on stderr;
+Without ``--max-findings`` a run writes at most 5,000 of them, each ranked by its
+worst finding: the failing level first, a fair share per file
+(:func:`affinity.output.cap.cap_findings`); a ``::warning`` and one line on
+stderr say per level what was cut;
 unreadable files are ``::error`` with title ``Q901 unreadable``, skipped files
 ``::notice``. ``--statistics`` adds one ``::notice`` per rule with its count. Paths are
 relative to the working directory (the checkout in a workflow step). Escaping
@@ -19,16 +20,22 @@ from __future__ import annotations
 import sys
 from typing import TextIO
 
+import numpy as np
+
 from ..rules import UNREADABLE
 from . import (
     CheckRun,
+    Finding,
+    badness,
     describe,
     face_label,
     first_findings,
     statistics,
     working_relative,
     worst_findings,
+    worst_first,
 )
+from .cap import cap_findings
 
 #: Faces listed in a rule's annotation.
 FIRST_FACES = 5
@@ -51,9 +58,23 @@ def annotation(level: str, message: str, file: str, line: int = 0, col: int = 0,
     return f"::{level} {text}::{_escape(message, _DATA_ESCAPES)}"
 
 
+def _kept(run: CheckRun) -> tuple[dict[int, Finding], str | None]:
+    """id of a rule's hits -> its worst finding, for the annotations the run cap keeps (each stands for its
+    worst finding: :func:`affinity.output.cap.cap_findings`); and the truncation notice."""
+    worst = [[(hits, worst_first(hits)[0]) for hits in report.hits] for report in run.reports]
+    if run.max_findings is None:
+        ranked = [(np.array([hits.level_ranks()[w] for hits, w in rules], dtype=np.int8),
+                   np.array([badness(hits)[w] for hits, w in rules], dtype=float)) for rules in worst]
+        capped = cap_findings(ranked, run.fail_on, run.run_cap)
+        kept, notice = capped.kept, capped.note("GitHub annotations (one per file and rule)")
+    else:
+        kept, notice = [range(len(rules)) for rules in worst], None
+    return {id(rules[i][0]): worst_findings(report, rules[i][0], 1)[0]
+            for report, rules, rows in zip(run.reports, worst, kept) for i in list(rows)}, notice
+
+
 def write(run: CheckRun, out: TextIO) -> None:
-    rules = [(report, hits, worst_findings(report, hits, 1)[0]) for report in run.reports for hits in report.hits]
-    kept = {id(rules[i][1]): rules[i][2] for i in run.capped([worst for _, _, worst in rules])}
+    kept, truncated = _kept(run)
     for report in run.reports:
         path = working_relative(report.path) or report.path
         if report.error is not None:
@@ -64,7 +85,6 @@ def write(run: CheckRun, out: TextIO) -> None:
         for hits in report.hits:
             if id(hits) in kept:
                 out.write(_rule_annotation(report, hits, kept[id(hits)], path) + "\n")
-    truncated = run.cap_notice(len(kept), len(rules), "GitHub annotations (one per file and rule)")
     if truncated is not None:
         out.write(annotation("warning", truncated, ".", title="truncated") + "\n")
         sys.stderr.write(f"affinity: {truncated}\n")

@@ -1,79 +1,121 @@
 """JUnit XML, for CI systems that show test reports (GitLab, Jenkins, Azure).
 
-One ``<testsuite>`` per file, one ``<testcase>`` per finding with a
-``<failure>`` (type = rule code, body = the text line, properties face, value,
-threshold, line, column, code, name, group, and prim in USD); a clean file gets
-one passing testcase, an unreadable file one testcase with an ``<error>`` (type
-Q901), a skipped file one with ``<skipped>``.
+One ``<testsuite>`` per file, one ``<testcase>`` per finding, named after the
+rule and the face (and the prim in USD), with the file and line as attributes;
+its text line (level, value, threshold and unit included) is its body. A
+finding at or above ``--fail-on`` is a ``<failure>`` (type = rule code,
+message = the rule's code, name and summary, body = the text line with the
+measurement); one below it is reported
+without failing, its text line in the testcase's ``<system-out>``, so the
+report's failures are what fails the run. A clean file gets one passing
+testcase, an unreadable file one testcase with an ``<error>`` (type Q901), a
+skipped file one with ``<skipped>``.
+
+The XML is written as text, file by file and a block of findings at a time:
+time and memory grow with the findings, with small constants. Characters XML
+1.0 cannot carry (control characters, lone surrogates from undecodable file
+names) become U+FFFD.
 """
 
 from __future__ import annotations
 
 import re
-import xml.etree.ElementTree as ET
 from typing import TextIO
 
 from ..findings import FileReport
-from ..rules import UNREADABLE
-from . import CheckRun, Finding, describe, face_label, file_findings, statistics, text_line
+from ..rules import LEVELS, RULES, UNREADABLE
+from . import CheckRun, Columns, Selection, statistics, text_lines
 
 # Characters XML 1.0 cannot carry at all (control characters, lone surrogates from undecodable file names).
 _NOT_XML = re.compile("[^\t\n\r\x20-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
+#: What an attribute value or character data cannot hold as it is.
+_SPECIAL = re.compile("[&<>\"\t\n\r]|" + _NOT_XML.pattern)
 
 
-def _make_xml_safe(root: ET.Element) -> None:
-    """Replace characters XML cannot represent with U+FFFD in every attribute and text."""
-    for element in root.iter():
-        element.attrib.update({k: _NOT_XML.sub("\ufffd", v) for k, v in element.attrib.items()})
-        if element.text:
-            element.text = _NOT_XML.sub("\ufffd", element.text)
+def xml_text(text: str) -> str:
+    """``text`` as XML character data: ``&``, ``<``, ``>`` escaped, what XML cannot carry replaced."""
+    return _NOT_XML.sub("\ufffd", text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;"))
 
 
-def _finding_case(suite: ET.Element, f: Finding) -> None:
-    name = " ".join(filter(None, [f.code, f.name, face_label(f)]))
-    case = ET.SubElement(suite, "testcase", classname=f.path, name=name, file=f.path, line=str(f.line))
-    props = ET.SubElement(case, "properties")
-    keys = (("face", "value", "threshold", "unit", "level", "line", "column", "code", "name", "group")
-            + ("prim",) * (f.prim is not None))
-    for key in keys:
-        ET.SubElement(props, "property", name=key, value=str(getattr(f, key)))
-    failure = ET.SubElement(case, "failure", type=f.code, message=describe(f))
-    failure.text = text_line(f)
+def xml_attribute(text: str) -> str:
+    """``text`` as a double-quoted attribute value (quotes, tabs and line breaks kept as references)."""
+    return (xml_text(text).replace('"', "&quot;").replace("\t", "&#9;").replace("\n", "&#10;")
+            .replace("\r", "&#13;"))
 
 
-def _suite(report: FileReport) -> ET.Element:
-    findings = file_findings(report)[0]
-    suite = ET.Element("testsuite", name=report.path)
+def _needs_escaping(c: Columns) -> bool:
+    """Whether the texts a :class:`Columns` is written from hold anything XML must escape or cannot carry."""
+    texts = {c.path, *c.message, *c.group, *(p for p in c.prim if p is not None)}
+    return any(_SPECIAL.search(text) for text in texts)
+
+
+def _attributes(**values) -> str:
+    return "".join(f' {name}="{xml_attribute(str(value))}"' for name, value in values.items())
+
+
+def _finding_cases(fail_on: str):
+    """The ``<testcase>`` text of each finding of a :class:`Columns`: failing at ``fail_on`` and above."""
+    failing = set(LEVELS[: LEVELS.index(fail_on) + 1])
+
+    def cases(c: Columns) -> list[str]:
+        path = xml_attribute(c.path)
+        rule = f"{xml_attribute(c.code)} {xml_attribute(c.name)}"
+        lines = text_lines(c)
+        if _needs_escaping(c):  # numbers never do: only the path, messages, groups and prims can
+            lines = list(map(xml_text, lines))
+        failure = f'<failure type="{xml_attribute(c.code)}" message="{rule}: {xml_attribute(RULES[c.code].summary)}">'
+        if c.prim[0] is None and min(c.face, default=0) >= 0:  # faces of a mesh file: one shape for every case
+            case = f'<testcase classname="{path}" name="{rule} face '
+            return [f'{case}{face}" file="{path}" line="{line}">{failure}{t}</failure></testcase>\n'
+                    if level in failing else
+                    f'{case}{face}" file="{path}" line="{line}"><system-out>{t}</system-out></testcase>\n'
+                    for face, line, level, t in zip(c.face, c.line, c.level, lines)]
+        names = [rule if face < 0 else f"{rule} face {face}" if prim is None
+                 else f"{rule} {xml_attribute(prim)} face {face}" for face, prim in zip(c.face, c.prim)]
+        return [f'<testcase classname="{path}" name="{name}" file="{path}" line="{line}">'
+                + (f"{failure}{t}</failure></testcase>\n" if level in failing
+                   else f"<system-out>{t}</system-out></testcase>\n")
+                for name, line, level, t in zip(names, c.line, c.level, lines)]
+
+    return cases
+
+
+def _counts(run: CheckRun, report: FileReport, selection: Selection) -> dict[str, int]:
+    """The ``tests``, ``failures``, ``errors``, ``skipped`` of a file's testsuite."""
+    failures = int((selection.level_ranks() <= LEVELS.index(run.fail_on)).sum())
+    return {"tests": max(len(selection), 1), "failures": failures, "errors": int(report.error is not None),
+            "skipped": int(report.skipped is not None)}
+
+
+def _suite(run: CheckRun, selection: Selection, counts: dict[str, int], out: TextIO) -> None:
+    report = selection.report
+    out.write(f"  <testsuite{_attributes(name=report.path, **counts)}>\n")
+    path = xml_attribute(report.path)
     if report.error is not None:
-        case = ET.SubElement(suite, "testcase", classname=report.path, name=f"{UNREADABLE.code} {UNREADABLE.name}")
-        error = ET.SubElement(case, "error", type=UNREADABLE.code, message=report.error)
-        error.text = f"{report.path}:{report.error_line}: {UNREADABLE.code} {UNREADABLE.name}: {report.error}"
+        text = f"{report.path}:{report.error_line}: {UNREADABLE.code} {UNREADABLE.name}: {report.error}"
+        out.write(f'    <testcase classname="{path}" name="{UNREADABLE.code} {UNREADABLE.name}">'
+                  f'<error{_attributes(type=UNREADABLE.code, message=report.error)}>{xml_text(text)}</error>'
+                  "</testcase>\n")
     elif report.skipped is not None:
-        case = ET.SubElement(suite, "testcase", classname=report.path, name="affinity check")
-        ET.SubElement(case, "skipped", message=report.skipped)
-    elif not findings:
-        ET.SubElement(suite, "testcase", classname=report.path, name="affinity check")
-    for f in findings:
-        _finding_case(suite, f)
-    suite.set("tests", str(len(suite)))
-    suite.set("failures", str(len(findings)))
-    suite.set("errors", str(int(report.error is not None)))
-    suite.set("skipped", str(int(report.skipped is not None)))
-    return suite
+        out.write(f'    <testcase classname="{path}" name="affinity check">'
+                  f"<skipped{_attributes(message=report.skipped)}/></testcase>\n")
+    elif not report.hits:
+        out.write(f'    <testcase classname="{path}" name="affinity check"/>\n')
+    for block in selection.formatted(_finding_cases(run.fail_on)):
+        out.write("".join(block))
+    out.write("  </testsuite>\n")
 
 
 def write(run: CheckRun, out: TextIO) -> None:
-    root = ET.Element("testsuites", name="affinity check")
-    if run.statistics:  # per-rule counts as properties of the run
-        props = ET.SubElement(root, "properties")
-        for row in statistics(run.reports):
-            ET.SubElement(props, "property", name=f"{row['code']} {row['name']} ({row['level']})",
-                          value=str(row["count"]))
-    root.extend(_suite(report) for report in run.reports)
-    for key in ("tests", "failures", "errors", "skipped"):
-        root.set(key, str(sum(int(suite.get(key)) for suite in root if suite.tag == "testsuite")))
-    _make_xml_safe(root)
-    ET.indent(root)
+    selections = [run.kept(report) for report in run.reports]
+    counts = [_counts(run, s.report, s) for s in selections]
+    totals = {key: sum(c[key] for c in counts) for key in ("tests", "failures", "errors", "skipped")}
     out.write('<?xml version="1.0" encoding="utf-8"?>\n')
-    out.write(ET.tostring(root, encoding="unicode"))
-    out.write("\n")
+    out.write(f'<testsuites{_attributes(name="affinity check", **totals)}>\n')
+    if run.statistics:  # per-rule counts as properties of the run
+        named = [("{code} {name} ({level})".format(**row), row["count"]) for row in statistics(run.reports)]
+        out.write("  <properties>\n" + "".join(f"    <property{_attributes(name=name, value=count)}/>\n"
+                                                for name, count in named) + "  </properties>\n")
+    for selection, suite_counts in zip(selections, counts):
+        _suite(run, selection, suite_counts, out)
+    out.write("</testsuites>\n")

@@ -23,9 +23,11 @@ changes, which makes it a new finding.
 
 Each result's ``level`` is the finding's (SARIF's ``note`` for ``info``).
 Without ``--max-findings`` the run keeps at most 5,000 results (code scanning
-accepts 25,000), the worst (errors first, then by how far beyond the threshold;
-:meth:`affinity.output.CheckRun.capped`), in file order, and says so in a tool
-execution notification and one line on stderr. With ``--max-findings N`` each
+accepts 25,000): every file's findings at the failing level (``--fail-on``)
+before anyone's below it, a fair share per file where a level does not fit,
+each file's worst first (:func:`affinity.output.cap.cap_findings`), in file
+order; a tool execution notification and one line on stderr say per level
+what was left out. With ``--max-findings N`` each
 file keeps the worst N results per rule instead, and the run's
 ``properties.truncated`` lists, per file and rule cut, how many were kept of
 the total; ``--statistics`` adds ``properties.statistics`` (per-rule
@@ -49,20 +51,24 @@ from pathlib import Path
 from typing import TextIO
 from urllib.parse import quote
 
+import numpy as np
+
 from .. import __version__
 from ..findings import FileReport
 from ..rules import RULES, UNREADABLE, rule_page
 from . import (
+    VALUE_TOKEN,
     CheckRun,
-    Finding,
+    Columns,
+    Selection,
     authored_where,
-    face_label,
-    located,
+    descriptions,
     statistics,
     truncation,
     value_token,
     working_relative,
 )
+from .cap import cap_findings
 
 SARIF_VERSION = "2.1.0"
 SARIF_SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
@@ -114,66 +120,104 @@ def fingerprint(code: str, uri: str, group: str, value: float, ordinal: int) -> 
     return hashlib.sha256(text.encode("utf-8")).hexdigest()[:32]
 
 
-def _numbered(run: CheckRun, report: FileReport) -> list[tuple[Finding, int]]:
-    """The file's findings, each with its ordinal among those of the same rule, group and value."""
-    seen: dict[tuple, int] = {}
-    numbered = []
-    for f in run.kept(report):
-        identity = (f.code, f.group, value_token(f.value))
-        seen[identity] = seen.get(identity, -1) + 1
-        numbered.append((f, seen[identity]))
-    return numbered
+def _ordinals(selection: Selection) -> np.ndarray:
+    """(n,) int64: each finding's ordinal among the file's findings of the same rule, group and value token,
+    in file order (the selection's order)."""
+    ids: dict[str, int] = {}  # value token -> a number, equal for equal tokens
+    token = np.array([ids.setdefault(t, len(ids)) for hits, take in selection.parts
+                      for t in map(VALUE_TOKEN.format, hits.values[take].tolist())], dtype=np.int64)[selection.order]
+    code = np.concatenate([np.full(len(take), i) for i, (_, take) in enumerate(selection.parts)])[selection.order]
+    group = np.concatenate([hits.groups[take] for hits, take in selection.parts])[selection.order]
+    position = np.arange(len(selection))
+    by_identity = np.lexsort((position, token, group, code))  # file order within each identity
+    keys = np.stack([code, group, token])[:, by_identity]
+    starts = np.flatnonzero(np.concatenate([[True], (keys[:, 1:] != keys[:, :-1]).any(axis=0)]))
+    run_start = np.repeat(starts, np.diff(np.append(starts, len(selection))))
+    ordinals = np.empty(len(selection), dtype=np.int64)
+    ordinals[by_identity] = position - run_start
+    return ordinals
 
 
-def _result(f: Finding, ordinal: int, location: dict, rule_index: int) -> dict:
-    result_location: dict = {"physicalLocation": _physical(location, f.line, f.column)}
-    logical = _logical_location(f)
-    if logical:
-        result_location["logicalLocations"] = [logical]
-    result = {
-        "ruleId": f.code,
-        "ruleIndex": rule_index,
-        "level": sarif_level(f.level),
-        "message": {"text": located(f) + authored_where(f)},
-        "locations": [result_location],
-        "partialFingerprints": {FINGERPRINT: fingerprint(f.code, location["uri"], f.group, f.value, ordinal)},
-        "properties": {"name": f.name, "face": f.face, "value": f.value,
-                       "threshold": f.threshold, "unit": f.unit, "level": f.level, "group": f.group,
-                       **({} if f.prim is None else {"prim": f.prim})},
-    }
-    if f.prims is not None:  # geometry several prims reference: where it is authored, and who references it
-        result_location["logicalLocations"] = [_prim_location(prim) for prim in f.prims]
-        result["relatedLocations"] = [{"id": 0, "physicalLocation": {"artifactLocation": artifact_location(f.layer)},
-                                       "logicalLocations": [_prim_location(f.layer_prim)],
-                                       "message": {"text": "where the mesh is authored"}}]
-        result["properties"].update(layer=f.layer, layer_prim=f.layer_prim, prims=f.prims,
-                                    **({} if f.prim_values is None else {"prim_values": f.prim_values}))
-    return result
+PRIM = ',"prim":'
 
 
-def _results(run: CheckRun) -> tuple[list[dict], str | None]:
-    """The run's results (capped, :meth:`CheckRun.capped`) and the truncation notice (None: nothing cut)."""
-    rows = [(f, ordinal, report.path) for report in run.reports for f, ordinal in _numbered(run, report)]
-    kept = run.capped([f for f, _, _ in rows])
+def _result_rows(location: dict, rule_index: dict[str, int]):
+    """The SARIF results of a :class:`Columns` as JSON text, each with its fingerprint (from its ``ordinals``,
+    :func:`_ordinals`); the pieces every result of a rule shares are encoded once."""
+    encode, compact = json.dumps, (",", ":")
+
+    def rows(c: Columns, ordinals: np.ndarray) -> list[str]:
+        head = f'{{"ruleId":{encode(c.code)},"ruleIndex":{rule_index[c.code]},"level":"'
+        shared = f',"threshold":{encode(c.threshold)},"unit":{encode(c.unit)},"level":"'
+        results = []
+        for line, column, face, value, level, group, prim, text, ordinal, where in zip(
+                c.line, c.column, c.face, c.value, c.level, c.group, c.prim, descriptions(c), ordinals.tolist(),
+                c.shared or [None] * len(c)):
+            located: dict = {"physicalLocation": _physical(location, line, column)}
+            logical, label = _logical_location(prim, group, face)
+            if logical:
+                located["logicalLocations"] = [logical]
+            identity = fingerprint(c.code, location["uri"], group, value, ordinal)
+            if where is not None:  # geometry several prims reference: where it is authored, who references it
+                located["logicalLocations"] = [_prim_location(p) for p in where["prims"]]
+                results.append(encode({
+                    "ruleId": c.code, "ruleIndex": rule_index[c.code], "level": sarif_level(level),
+                    "message": {"text": f"{text}, {label}{authored_where(where)}"},
+                    "locations": [located],
+                    "relatedLocations": [{
+                        "id": 0, "physicalLocation": {"artifactLocation": artifact_location(where["layer"])},
+                        "logicalLocations": [_prim_location(where["layer_prim"])],
+                        "message": {"text": "where the mesh is authored"}}],
+                    "partialFingerprints": {FINGERPRINT: identity},
+                    "properties": {"name": c.name, "face": face, "value": value, "threshold": c.threshold,
+                                   "unit": c.unit, "level": level, "group": group, "prim": prim,
+                                   **{k: v for k, v in where.items() if v is not None}},
+                }, separators=compact))
+                continue
+            results.append(
+                f'{head}{sarif_level(level)}","message":{{"text":{encode(f"{text}, {label}" if label else text)}}},'
+                f'"locations":[{encode(located, separators=compact)}],'
+                f'"partialFingerprints":{{"{FINGERPRINT}":"{identity}"}},'
+                f'"properties":{{"name":{encode(c.name)},"face":{face},"value":{encode(value)}{shared}{level}",'
+                f'"group":{encode(group)}{"" if prim is None else PRIM + encode(prim)}}}}}')
+        return results
+
+    return rows
+
+
+def _results(run: CheckRun) -> tuple[list[str], str | None]:
+    """The run's results as JSON text (capped, :func:`affinity.output.cap.cap_findings`, unless
+    ``--max-findings``), and the truncation notice (None: nothing cut)."""
+    selections = [run.kept(report) for report in run.reports]
+    kept, notice = [np.arange(len(s)) for s in selections], None
+    if run.max_findings is None:
+        capped = cap_findings([(s.level_ranks(), s.badness()) for s in selections], run.fail_on, run.run_cap)
+        kept, notice = capped.kept, capped.note("SARIF results")
     rule_index = {code: i for i, code in enumerate(RULES)}  # registered rules, as the driver lists them
-    locations = {report.path: artifact_location(report.path) for report in run.reports}
-    results = [_result(f, ordinal, locations[path], rule_index[f.code])
-               for f, ordinal, path in (rows[i] for i in kept)]
-    return results, run.cap_notice(len(kept), len(rows), "SARIF results")
+    results = []
+    for selection, rows in zip(selections, kept):
+        if len(rows) == 0:
+            continue
+        location = artifact_location(selection.report.path)
+        for block in selection.subset(rows).formatted(_result_rows(location, rule_index),
+                                                      along=_ordinals(selection)[rows]):
+            results += block
+    return results, notice
 
 
 def _prim_location(prim: str) -> dict:
     return {"name": prim.rsplit("/", 1)[-1], "fullyQualifiedName": prim, "kind": "object"}
 
 
-def _logical_location(f: Finding) -> dict | None:
-    """The USD mesh prim, or the face (qualified by its group); None for file-level findings."""
-    if f.prim is not None:
-        return _prim_location(f.prim)
-    if not face_label(f):
-        return None
-    qualified = "/".join(filter(None, [f.group, face_label(f)]))
-    return {"name": face_label(f), "fullyQualifiedName": qualified, "kind": "element"}
+def _logical_location(prim: str | None, group: str, face: int) -> tuple[dict | None, str]:
+    """The USD mesh prim, or the face (qualified by its group), and how the message names the face; (None, "")
+    for file-level findings."""
+    if face < 0:
+        return None, ""
+    if prim is not None:
+        return _prim_location(prim), f"{prim} face {face}"
+    label = f"face {face}"
+    return {"name": label, "fullyQualifiedName": "/".join(filter(None, [group, label])), "kind": "element"}, label
 
 
 def _notifications(reports: list[FileReport], truncated: str | None) -> list[dict]:
@@ -200,8 +244,8 @@ def _folder_uri(folder: Path) -> str:
     return uri if uri.endswith("/") else uri + "/"
 
 
-def document(run: CheckRun) -> dict:
-    """The SARIF log as Python objects."""
+def document(run: CheckRun) -> tuple[dict, list[str]]:
+    """The SARIF log as Python objects, its results standing in as ``[RESULTS]``, and the results as JSON text."""
     properties: dict = {}
     if run.max_findings is not None:
         properties["truncated"] = truncation(run, run.max_findings)
@@ -229,13 +273,18 @@ def document(run: CheckRun) -> dict:
             }],
             "originalUriBaseIds": {SRCROOT: {"uri": _folder_uri(Path.cwd())}},
             "columnKind": "unicodeCodePoints",
-            "results": results,
+            "results": [RESULTS],
             **({} if run.shard is None else {"automationDetails": {"id": shard_category(run.shard)}}),
             **({"properties": properties} if properties else {}),
         }],
-    }
+    }, results
+
+
+#: Where the results go in the log's text (a string no other value of the log can be).
+RESULTS = "\0results\0"
 
 
 def write(run: CheckRun, out: TextIO) -> None:
-    json.dump(document(run), out, separators=(",", ":"))
-    out.write("\n")
+    log, results = document(run)
+    head, tail = json.dumps(log, separators=(",", ":")).split(json.dumps(RESULTS), 1)
+    out.write(head + ",".join(results) + tail + "\n")

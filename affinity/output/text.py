@@ -1,14 +1,17 @@
-"""Text output: ``path:line:col: CODE name: message (value vs threshold unit) [face F]``, one finding a line.
+"""Text output: ``path:line:col: CODE level name: message (value vs threshold unit) [face F]``, one finding a line.
 
-The closing summary counts the findings per level; ``--statistics`` prints
-count, code, name and level per rule instead of the findings.
+Per file, the errors come first, then the warnings, then info, each the worst
+first (:func:`affinity.output.select`), so what fails the gate is what a reader
+sees first; at most :data:`TEXT_LIMIT` per file and rule, the worst, unless
+verbose. The closing summary counts the findings per level; ``--statistics``
+prints count, code, name and level per rule instead of the findings.
 """
 
 from __future__ import annotations
 
 from typing import TextIO
 
-from . import CheckRun, file_findings, level_counts, statistics, text_line
+from . import CheckRun, level_counts, select, statistics, text_lines
 from .names import printable
 
 #: Findings shown per file and rule before "... and N more" (design.md, Clarifications).
@@ -26,13 +29,15 @@ def write(run: CheckRun, out: TextIO, verbose: bool = False, statistics: bool = 
 
 
 def write_findings(run: CheckRun, out: TextIO, verbose: bool = False) -> None:
-    """Every finding of every checked file, capped per file and rule unless verbose."""
+    """Every finding of every checked file, errors first and the worst first, capped per file and rule unless
+    verbose."""
     for report in run.reports:
-        findings, omitted = file_findings(report, None if verbose else TEXT_LIMIT)
-        lines = [text_line(f) + "\n" for f in findings]
-        lines += [f"{printable(report.path)}: ... and {n} more {code} (use --verbose or --format json for all)\n"
-                  for code, n in omitted.items()]
-        out.write("".join(lines))
+        selection = select(report, None if verbose else TEXT_LIMIT, order="severity")
+        for lines in selection.formatted(text_lines):
+            out.write("".join(line + "\n" for line in lines))
+        path = printable(report.path)
+        out.write("".join(f"{path}: ... and {n} more {code} (use --verbose or --format json for all)\n"
+                          for code, n in selection.omitted.items()))
 
 
 def write_statistics(run: CheckRun, out: TextIO) -> None:
@@ -46,6 +51,8 @@ def write_summary(run: CheckRun, out: TextIO) -> None:
     n = run.tally()
     parts = [f"{n['checked']} file{'s' * (n['checked'] != 1)} checked"]
     parts += [f"{n[key]} {key}" for key in ("unreadable", "skipped", "baselined") if n[key]]
+    if run.hidden:
+        parts.append(f"not shown: {', '.join(f'{k} {level}' for level, k in run.hidden.items())}")
     new = "" if run.baselined is None else "new "
     head = f"Found {n['findings']} {new}finding{'s' * (n['findings'] != 1)}" if n["findings"] else f"No {new}findings"
     levels = ", ".join(f"{k} {level}" for level, k in level_counts(run.reports).items())

@@ -155,7 +155,8 @@ class ReportRun:
     ``start`` is the ``time.perf_counter()`` of the command's start (the page
     prints the time from it to the page written); ``seconds`` the time of
     collecting, ``parts`` its seconds by part summed over the meshes, with
-    ``start-up`` the time before the first mesh.
+    ``start-up`` the time before the first mesh. ``fail_on`` is the level the
+    verdict is given at, as ``affinity check --fail-on`` gives it.
     """
 
     meshes: list[MeshResult]
@@ -165,6 +166,7 @@ class ReportRun:
     demo: bool = False
     start: float = 0.0
     parts: dict[str, float] = field(default_factory=dict)
+    fail_on: str = "error"
 
 
 def _texture_label(mesh: Mesh, view: View, texture: str | None = None) -> str:
@@ -316,14 +318,15 @@ def collect_mesh(item: MeshInput, settings: Settings, step: Callable[[str], None
 
 def collect_run(items: list[MeshInput], settings_for: Callable[[str], Settings], settings: Settings,
                 progress, options: ReportOptions = ReportOptions(), demo: bool = False,
-                start: float | None = None) -> ReportRun:
+                start: float | None = None, fail_on: str = "error") -> ReportRun:
     """Collect every input in order.
 
     ``settings_for(path)`` gives the lint settings of a file (its configuration);
     ``settings`` are the current folder's, for the summary's thresholds.
     ``progress`` is a tqdm bar (possibly disabled): it shows the file and step and
     advances once per file. ``demo``: the inputs are the built-in demo scenes.
-    ``start`` is the command's ``time.perf_counter()`` at its start (default: now).
+    ``start`` is the command's ``time.perf_counter()`` at its start (default: now); ``fail_on`` the level of
+    the verdict (``--fail-on``).
     """
     started = datetime.datetime.now().astimezone()
     collecting = time.perf_counter()
@@ -336,4 +339,4 @@ def collect_run(items: list[MeshInput], settings_for: Callable[[str], Settings],
     parts = Counter({"start-up": collecting - start})
     for result in meshes:
         parts.update(result.parts)  # adds the seconds of each part
-    return ReportRun(meshes, settings, started, time.perf_counter() - collecting, demo, start, dict(parts))
+    return ReportRun(meshes, settings, started, time.perf_counter() - collecting, demo, start, dict(parts), fail_on)

@@ -43,7 +43,7 @@ def render_page(run: ReportRun) -> str:
                               trim_blocks=True, lstrip_blocks=True)
     environment.filters["plural"] = plural
     meshes = [
-        {"row": file_row(result), "result": result,
+        {"row": file_row(result, run.fail_on), "result": result,
          "sections": [section(result) for section in MESH_SECTIONS] if result.readable else []}
         for result in run.meshes
     ]

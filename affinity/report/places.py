@@ -1,10 +1,10 @@
 """Places: neighbouring flagged faces of one rule, grouped, ranked, and chosen for close-ups.
 
 A place is a connected set of faces flagged by the same rule, faces being
-neighbours when they share a vertex. Places are ranked by the rule's level, then
-by how far their worst face is beyond the threshold, and chosen taking turns
-between rules, so every flagged rule gets a close-up before any rule gets a
-second one.
+neighbours when they share a vertex. Places are chosen level by level (errors,
+then warnings, then info: the close-ups show first what fails the gate), and
+within a level taking turns between rules, each rule's worst first, so every
+rule with errors gets a close-up before any rule gets a second one.
 """
 
 from __future__ import annotations
@@ -173,20 +173,17 @@ def places_of(mesh: Mesh, hits: RuleHits, limit: int = PLACE_FACES) -> list[Plac
 
 
 def choose_places(by_rule: dict[str, list[Place]], limit: int) -> list[Place]:
-    """Up to ``limit`` places, taking turns between rules.
+    """Up to ``limit`` places: every error place before any warning place, every warning before any info.
 
-    Rules go in order of their worst place's level (errors first), then of how far beyond the threshold it is; round
-    ``k`` takes each rule's ``k``-th place, so each flagged rule has a close-up
-    when ``limit`` is at least the number of rules.
+    Within a level the rules take turns: they go in order of how far their worst place of that level is beyond
+    the threshold, and round ``k`` takes each rule's ``k``-th place of the level, so each rule with errors has a
+    close-up before any rule gets a second one.
     """
-    rules = sorted((code for code in by_rule if by_rule[code]),
-                   key=lambda code: (LEVEL_ORDER[by_rule[code][0].level], -by_rule[code][0].beyond, code))
     chosen: list[Place] = []
-    rounds = max((len(by_rule[code]) for code in rules), default=0)
-    for k in range(rounds):
-        for code in rules:
-            if len(chosen) == limit:
-                return chosen
-            if k < len(by_rule[code]):
-                chosen.append(by_rule[code][k])
-    return chosen
+    for level in sorted(LEVEL_ORDER, key=LEVEL_ORDER.get):
+        of_level = {code: [p for p in places if p.level == level] for code, places in by_rule.items()}
+        rules = sorted((code for code in of_level if of_level[code]),
+                       key=lambda code: (-of_level[code][0].beyond, code))
+        rounds = max((len(of_level[code]) for code in rules), default=0)
+        chosen += [of_level[code][k] for k in range(rounds) for code in rules if k < len(of_level[code])]
+    return chosen[:limit]

@@ -15,7 +15,8 @@ from pathlib import Path
 import numpy as np
 
 from ..attributes import ATTRIBUTE_NAMES, ATTRIBUTES
-from ..rules import RULES, resolve_codes, with_unit
+from ..findings import FileReport
+from ..rules import LEVELS, RULES, resolve_codes, with_unit
 from ..study.run import PACKAGE_TABLE
 from .build import MeshResult, ReportRun
 from .images import data_uri, heat_bar, heatmap_uri, image_uri, png_bytes
@@ -81,20 +82,35 @@ def parts_text(parts: dict[str, float]) -> str:
 
 
 
-def file_row(result: MeshResult) -> dict:
-    """One file's row: label, status (clean, findings, failed, skipped), message, counts, flags, time."""
+def verdict(files: list[FileReport], fail_on: str) -> dict:
+    """What ``affinity check --fail-on`` with the same settings decides: ``fails`` (a finding at ``fail_on`` or
+    above, or an unreadable file), ``fail_on``, ``levels`` (every level -> its findings) and ``unreadable``."""
+    from ..output import level_counts
+
+    counts = level_counts(files)
+    unreadable = sum(file.error is not None for file in files)
+    failing = LEVELS[: LEVELS.index(fail_on) + 1]
+    return {"fails": bool(unreadable) or any(counts.get(level) for level in failing), "fail_on": fail_on,
+            "levels": {level: counts.get(level, 0) for level in LEVELS}, "unreadable": unreadable}
+
+
+def file_row(result: MeshResult, fail_on: str) -> dict:
+    """One file's row: label, status (passes, fails, unreadable, skipped) at ``fail_on``, message, counts, findings
+    per level, flags, time."""
     file = result.file
+    judged = verdict([file], fail_on)
     if file.error is not None:
-        status, message = "failed", f"Q901 unreadable: line {file.error_line}: {file.error}"
+        status, message = "unreadable", f"Q901 unreadable: line {file.error_line}: {file.error}"
     elif file.skipped is not None:
         status, message = "skipped", f"skipped ({file.skipped})"
     else:
-        status, message = ("findings" if file.hits else "clean"), ""
+        status, message = ("fails" if judged["fails"] else "passes"), ""
     return {
         "label": result.input.label,
         "status": status,
         "message": message,
         "counts": file.counts,
+        "levels": judged["levels"],
         "flags": [(hits.code, len(hits)) for hits in file.hits],
         "seconds": result.seconds,
         "parts": parts_text(result.parts),
@@ -131,8 +147,9 @@ def summary_section(run: ReportRun) -> Section:
         ("run time", RUN_TIME),
     ]
     return Section("summary", "Summary", {
+        "verdict": verdict([r.file for r in run.meshes], run.fail_on),
         "facts": facts, "parts": f"{parts_text(run.parts)} · page {PAGE_TIME}",
-        "files": [file_row(r) for r in run.meshes], "totals": totals, "rules": _rule_rows(run),
+        "files": [file_row(r, run.fail_on) for r in run.meshes], "totals": totals, "rules": _rule_rows(run),
     })
 
 
@@ -165,19 +182,24 @@ def findings_section(result: MeshResult) -> Section:
     title = "Findings"
     if not result.file.hits:
         return leave_out("findings", title, "nothing flagged: every quad passes every enabled rule")
+    from ..output import worst_first
+
     rows = []
     for hits in result.file.hits:
-        severity = hits.values if RULES[hits.code].worst == "lowest" else -hits.values
         unit = RULES[hits.code].unit_for(result.settings.measure)
+        levels = hits.levels()
         worst = [
-            {"face": int(hits.faces[i]), "line": int(hits.lines[i]),
+            {"face": int(hits.faces[i]), "line": int(hits.lines[i]), "level": str(levels[i]),
              "group": result.file.group_names[hits.groups[i]], "value": with_unit(number(hits.values[i]), unit)}
-            for i in np.argsort(severity, kind="stable")[:WORST_LISTED]
+            for i in worst_first(hits)[:WORST_LISTED]
         ]
+        by_level = dict(zip(*np.unique(levels, return_counts=True)))
         rows.append({
             "code": hits.code, "name": RULES[hits.code].name, "count": len(hits),
+            "levels": [(level, int(by_level[level])) for level in LEVELS if level in by_level],
             "threshold": _threshold_text(hits.code, hits.threshold, result.settings), "worst": worst,
         })
+    rows.sort(key=lambda row: LEVELS.index(row["levels"][0][0]))  # the rules with errors first
     return Section("findings", title, {"rows": rows})
 
 
@@ -396,16 +418,19 @@ def _layout_notes(layout) -> list[str]:
 
 
 def uv_layout_section(result: MeshResult) -> Section:
-    """Every face in texture space, flagged faces in the flag colour, the worst places labelled."""
+    """Every face in texture space, the faces the uv rules flag in the flag colour, their worst places labelled."""
     from .uvlayout import LABELLED, LAYOUT_SIZE, layout_image, layout_svg
 
     title = "UV layout"
     if result.mesh.texcoords is None:
         return leave_out("uv-layout", title, "the mesh has no texture coordinates")
+    # Only the texture-space rules' faces: a colour or normal finding is not fixed in the UV editor.
+    uv_rules = {code for code, rule in RULES.items() if rule.attribute == "texcoords"}
     flagged = np.zeros(result.mesh.n_faces, dtype=bool)
     for hits in result.file.hits:
-        flagged[hits.faces[hits.faces >= 0]] = True
-    labelled = list(dict.fromkeys((place.worst, place.code) for place in result.places))
+        if hits.code in uv_rules:
+            flagged[hits.faces[hits.faces >= 0]] = True
+    labelled = list(dict.fromkeys((place.worst, place.code) for place in result.places if place.code in uv_rules))
     layout = layout_image(result.mesh, flagged, LAYOUT_SIZE)
     if layout is None:
         return leave_out("uv-layout", title, "no face has texture coordinates at every corner")

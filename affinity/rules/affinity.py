@@ -59,16 +59,17 @@ def uv_disaffinity(quads) -> tuple:
         f 1/1 2/2 3/3 4/4
 
     Prints:
-        example.obj:10:1: Q101 uv-disaffine: texture coordinates are not an affine image of the positions: no texture found, texels of an assumed 1024x1024 texture (give the size with --texture-size or the texture-size setting) (175.7 vs 0.5 texels) [face 0]
+        example.obj:10:1: Q101 error uv-disaffine: texture coordinates are not an affine image of the positions: no texture found, texels of an assumed 1024x1024 texture (give the size with --texture-size or the texture-size setting) (175.7 vs 0.5 texels) [face 0]
 
     How to fix:
-        Run affinity fix: it refines the quad into n x n quads on its own bilinear
-        surface, carrying the bilinear uv, until each piece's split error is under
-        the threshold (the texture looks as the quad describes it; up to n^2 - 1
-        more faces, the neighbours re-cut so nothing cracks). Where that needs more
-        than --max-refine, re-UV the quad as a parallelogram matching its shape
-        (Blender: UV > Follow Active Quads) and re-bake. Triangulating only fixes
-        which diagonal every tool uses; it does not remove the crease.
+        Refine the quad: affinity fix splits it into n x n quads on its own
+        bilinear surface, carrying the bilinear uv, until each piece's crease is
+        under the threshold (up to n^2 - 1 more faces, the neighbours re-cut so
+        nothing cracks); subdividing does the same. Where that needs more than
+        --max-refine, re-UV it as a parallelogram matching its shape (Blender: UV >
+        Follow Active Quads, or straighten the island); the texture then has to be
+        re-baked. Triangulating does not remove the crease: it only makes every
+        tool draw the same one, along the diagonal you chose.
     """
     rows, uv = quads.uv
     diagonal = quads.settings.diagonal
@@ -96,13 +97,14 @@ def color_disaffinity(quads) -> tuple:
         f 1 2 3 4
 
     Prints:
-        example.obj:6:1: Q102 color-disaffine: vertex colours are not an affine image of the positions (110.4 vs 2/255) [face 0]
+        example.obj:6:1: Q102 error color-disaffine: vertex colours are not an affine image of the positions (110.4 vs 2/255) [face 0]
 
     How to fix:
-        Run affinity fix to refine the quad into n x n quads carrying the bilinear
-        colours (up to n^2 - 1 more faces), or repaint the corner colours so
-        opposite corners average to the same colour. Triangulating only fixes which
-        diagonal every tool uses; it does not remove the seam.
+        Refine the quad (affinity fix, or subdivide it) so each piece carries a
+        smaller change of colour, or repaint its corner colours so they vary
+        evenly across it: the two diagonals then average to the same colour
+        (c0 + c2 = c1 + c3). Triangulating does not remove the seam: it only
+        makes every tool draw the same one.
     """
     rows, colors = quads.complete("colors")
     return rows, color_steps(quads.split_error(rows, colors).T)
@@ -132,13 +134,14 @@ def normal_disaffinity(quads) -> tuple:
         f 1//1 2//2 3//3 4//4
 
     Prints:
-        example.obj:10:1: Q103 normal-disaffine: normals are not an affine image of the positions (9.847 vs 2 degrees) [face 0]
+        example.obj:10:1: Q103 error normal-disaffine: normals are not an affine image of the positions (9.847 vs 2 degrees) [face 0]
 
     How to fix:
-        Run affinity fix to refine the quad into n x n quads carrying the bilinear
-        normals (up to n^2 - 1 more faces), or even out its corner normals (Blender:
-        Mesh > Clean Up, or relax the loop). Triangulating only fixes which diagonal
-        every tool uses; it does not remove the bend.
+        Refine the quad (affinity fix, or subdivide it) so each piece spans a
+        smaller turn of the normals, or smooth its corner normals so they turn
+        evenly across it (Blender: Mesh > Normals > Smooth Vectors, or relax the
+        loop). Triangulating before baking normals does not remove the bend: it
+        only makes every tool shade the same one.
     """
     rows, unit = quads.complete("normals")  # unit length already (see affinity.lint.CornerTables.gather)
     m = quads.split_error(rows, unit)

@@ -33,7 +33,7 @@ def no_faces(mesh, settings) -> tuple | None:
         v 0 1 0
 
     Prints:
-        example.obj:1:1: Q205 no-faces: the mesh has vertices but no faces (4 vertices)
+        example.obj:1:1: Q205 warning no-faces: the mesh has vertices but no faces (4 vertices)
 
     How to fix:
         Re-export the mesh with faces enabled in the exporter's geometry options.
@@ -88,7 +88,7 @@ def missing_resources(mesh, settings) -> tuple | None:
         f 1 2 3
 
     Prints:
-        example.obj:2:1: Q902 missing-resource: an mtllib or map_Kd named by the file cannot be found or read: mtllib missing.mtl not found
+        example.obj:2:1: Q902 info missing-resource: an mtllib or map_Kd named by the file cannot be found or read: mtllib missing.mtl not found
 
     How to fix:
         Add the file next to the mesh (git lfs pull for LFS pointers), or fix the

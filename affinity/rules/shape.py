@@ -27,7 +27,11 @@ def degenerate(quads) -> tuple:
 
     What it does:
         Flags quads with a repeated corner, a collapsed edge or an area at or below
-        the threshold relative to their size.
+        the threshold relative to their size. A quad whose whole area is at or below
+        the threshold gets no Q101-Q103, whether or not this rule is selected (one
+        finding per defect; the message says so); a quad with one repeated corner
+        (a pole quad) is a triangle with area and keeps them: their value is exact
+        there.
 
     Why it matters:
         One of the two triangles of the split covers no pixels, so the half of the
@@ -42,11 +46,13 @@ def degenerate(quads) -> tuple:
         f 1 2 3 3
 
     Prints:
-        example.obj:5:1: Q201 degenerate-quad: zero area, collapsed edge or repeated corner (0 vs 1e-09 relative area) [face 0]
+        example.obj:5:1: Q201 warning degenerate-quad: zero area, collapsed edge or repeated corner (0 vs 1e-09 relative area) [face 0]
 
     How to fix:
         Merge the collapsed corners (Blender: Mesh > Clean Up > Merge by Distance)
-        so the face becomes the triangle it really is.
+        so the face becomes the triangle it really is; a face with no area at all
+        is dissolved (Blender: Mesh > Clean Up > Degenerate Dissolve), and its
+        neighbours' attributes are then measured as usual.
     """
     return slice(None), degeneracy(quads.planar)
 
@@ -117,7 +123,7 @@ def nonplanar(quads) -> tuple:
         f 1 2 3 4
 
     Prints:
-        example.obj:6:1: Q202 nonplanar-quad: the split folds: the two triangles meet at an angle along the diagonal (60 vs 45 degrees) [face 0]
+        example.obj:6:1: Q202 warning nonplanar-quad: the split folds: the two triangles meet at an angle along the diagonal (60 vs 45 degrees) [face 0]
 
     How to fix:
         Flatten the quad (Blender: Mesh > Clean Up > Make Planar Faces), subdivide
@@ -149,7 +155,7 @@ def concave(quads) -> tuple:
         f 1 2 3 4
 
     Prints:
-        example.obj:6:1: Q203 concave-quad: one corner is reflex (233.1 vs 180 degrees) [face 0]
+        example.obj:6:1: Q203 info concave-quad: one corner is reflex (233.1 vs 180 degrees) [face 0]
 
     How to fix:
         Move the reflex corner outward, or split the quad into two triangles along
@@ -173,7 +179,8 @@ def bowtie(quads) -> tuple:
 
     What it does:
         Flags quads whose edges cross (a bow-tie) in their own plane; the value
-        reported is the folded fraction of the quad.
+        reported is the folded fraction of the quad. A bow-tie gets no Q101-Q103,
+        whether or not this rule is selected (one finding per defect).
 
     Why it matters:
         A self-crossing quad has no consistent orientation; one half renders
@@ -188,7 +195,7 @@ def bowtie(quads) -> tuple:
         f 1 2 3 4
 
     Prints:
-        example.obj:6:1: Q204 bowtie-quad: the quad crosses itself (0.5 folded fraction) [face 0]
+        example.obj:6:1: Q204 error bowtie-quad: the quad crosses itself (0.5 folded fraction) [face 0]
 
     How to fix:
         Reorder the corners (flip the crossing edge) or delete and refill the face

@@ -15,7 +15,9 @@ def uv_degenerate(quads) -> tuple:
 
     What it does:
         Flags quads whose texture-space area is at or below the threshold relative
-        to their UV size.
+        to their UV size. Such a quad gets no Q101 (its uv has no affine map to
+        measure), whether or not this rule is selected: one finding per defect,
+        and the message says so.
 
     Why it matters:
         The whole quad samples a line or a point of the texture: it smears.
@@ -31,13 +33,15 @@ def uv_degenerate(quads) -> tuple:
         f 1/1 2/2 3/2 4/1
 
     Prints:
-        example.obj:8:1: Q301 uv-degenerate: zero area in texture space (0 vs 1e-09 relative area) [face 0]
+        example.obj:8:1: Q301 warning uv-degenerate: zero area in texture space: the texture smears over it, so Q101 is not measured on it (0 vs 1e-09 relative area) [face 0]
 
     References:
         Bloomenthal 2022, §2 (the barycentric test divides by the uv triangles' areas).
 
     How to fix:
-        Unwrap the face again so it gets its own area in UV space.
+        Unwrap the face again so it gets its own area in UV space (Blender: select
+        it, UV > Unwrap); the texture no longer smears over it, and Q101 then
+        measures its affinity.
     """
     return quads.uv[0], np.abs(relative_signed_area(quads.uv_planar))
 
@@ -72,7 +76,7 @@ def uv_flipped(quads) -> tuple:
         f 1/1 2/2 3/3 4/4
 
     Prints:
-        example.obj:10:1: Q302 uv-flipped: texture orientation reversed against the surface (-1 relative area) [face 0]
+        example.obj:10:1: Q302 info uv-flipped: texture orientation reversed against the surface (-1 relative area) [face 0]
 
     References:
         Mikkelsen 2008, Simulation of wrinkled surfaces revisited (tangent frames at mirrored UVs).

@@ -139,9 +139,9 @@ def family_findings(family, prim) -> PrimFindings:
 def finding_message(f: Finding) -> str:
     """``/prim face F: CODE name: message (value vs threshold unit)`` and, for geometry several prims
     reference, where it is authored and who references it: a line of ``affinity check`` without the path."""
-    from ..output import authored_where, describe, face_label
+    from ..output import authored_where, describe, face_label, shared_fields
 
-    return f"{face_label(f) or f.prim or f.group}: {f.code} {f.name}: {describe(f)}{authored_where(f)}"
+    return f"{face_label(f) or f.prim or f.group}: {f.code} {f.name}: {describe(f)}{authored_where(shared_fields(f))}"
 
 
 def exception_reason(error: Exception) -> str:
