@@ -464,10 +464,22 @@ def _viridis_bar(low: float, top: float, label: str) -> str:
     return colour_bar(stops, [(0.0, f"{low:.2g}"), (0.5, f"{middle:.2g}"), (1.0, f"{top:.2g}")], label)
 
 
+def view3d_section(result: MeshResult) -> Section:
+    """The mesh in a 3-D view drawn by the browser (:mod:`affinity.report.scene3d`): split, exact and their
+    difference, the findings one click away."""
+    title = "3-D view"
+    if result.mesh.n_faces == 0 or result.camera is None:
+        return leave_out("view3d", title, "the mesh has no faces to show")
+    from .scene3d import script_json, shown_text, view_data
+
+    data, notes = view_data(result)
+    return Section("view3d", title, {"json": script_json(data), "shown": shown_text(data)}, notes)
+
+
 #: Sections of each readable mesh, in page order.
 MESH_SECTIONS = (
-    findings_section, closeups_section, uv_layout_section, renders_section, overlay_section, error_heatmaps_section,
-    score_histograms_section, stability_section, overview_section,
+    findings_section, view3d_section, closeups_section, uv_layout_section, renders_section, overlay_section,
+    error_heatmaps_section, score_histograms_section, stability_section, overview_section,
 )
 #: Sections after the meshes, about the whole product.
 CLOSING_SECTIONS = (study_section,)
