@@ -94,14 +94,20 @@ def _console_errors(browser) -> list:
             or (e.get("method") == "Runtime.consoleAPICalled" and e["params"]["type"] in ("error", "assert"))]
 
 
+LEVELS = ("error", "warning", "info")
+
+
 def _worst_findings(lint: dict, count: int) -> list[tuple[int, dict]]:
-    """(file index, finding) of each file's ``count`` worst findings: the lint's own order (failing level first,
-    worst first) is the one the JSON keeps."""
+    """(file index, finding) of each file's ``count`` worst findings: errors first, then by value over threshold."""
     paths = [entry["path"] for entry in lint["files"]]
     by_file: dict[int, list] = {}
     for finding in lint["findings"]:
-        by_file.setdefault(paths.index(finding["path"]), []).append(finding)
-    return [(index, finding) for index, findings in sorted(by_file.items()) for finding in findings[:count]]
+        if finding["face"] >= 0:
+            by_file.setdefault(paths.index(finding["path"]), []).append(finding)
+    def severity(finding):
+        return LEVELS.index(finding["level"]), -finding["value"] / (finding["threshold"] or 1.0)
+    return [(index, finding) for index, findings in sorted(by_file.items())
+            for finding in sorted(findings, key=severity)[:count]]
 
 
 def _check_fly_to(chromium, session, view: int, finding: dict) -> None:
@@ -114,6 +120,8 @@ def _check_fly_to(chromium, session, view: int, finding: dict) -> None:
     own = ids == face
     assert own.sum() >= FACE_PIXELS, (finding, int(own.sum()))
     if attribute and finding["level"] == "error":
+        # uv as grid lines: a texture's flat patches hide a crease the lint rightly measures in texels
+        evaluate(chromium, session, f"affinityViews[{view}].setGrid(true)")
         split = _png(_snapshot(chromium, session, view, "split"))
         exact = _png(_snapshot(chromium, session, view, "exact"))
         changed = (np.abs(split - exact).max(axis=-1) >= CHANGED_STEP) & own

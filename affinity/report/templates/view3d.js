@@ -12,6 +12,7 @@
   var TEXELS_PER_QUAD = 8;
   var DATA_WIDTH = 4096;
   var FLY_FILL = 0.4;
+  var CLIP_RADII = 2;
 
   function bytes(b64) {
     if (Uint8Array.fromBase64) { return Uint8Array.fromBase64(b64); }
@@ -158,6 +159,8 @@
     this.status = figure.querySelector(".view3d-status");
     this.mode = "split";
     this.raw = false;
+    this.grid = false;
+    this.clip = null;
     this.selected = null;
     this.build();
   }
@@ -303,8 +306,15 @@
     this.uniforms.visible.value = attribute.visible || 1;
     var texture = this.data.texture;
     if (kind === 0 && texture) { this.uniforms.texels.value.set(texture.width, texture.height); }
-    this.look = kind === 0 ? (this.uniforms.map.value ? 1 : 0) : kind === 1 ? 2 : 3;
+    this.look = kind === 0 ? (this.uniforms.map.value && !this.grid ? 1 : 0) : kind === 1 ? 2 : 3;
     this.updateButtons();
+  };
+
+  /* uv drawn with the texture or as grid lines (which show a crease where the texture is flat). */
+  View.prototype.setGrid = function (grid) {
+    this.grid = grid;
+    this.chooseAttribute(this.attribute.name);
+    this.render();
   };
 
   View.prototype.buildControls = function () {
@@ -321,6 +331,16 @@
       bar.appendChild(button);
       view.buttons[mode] = button;
     });
+    if (this.data.texture) {
+      var grid = document.createElement("button");
+      grid.type = "button";
+      grid.className = "grid";
+      grid.textContent = "uv grid";
+      grid.title = "uv as grid lines instead of the texture (key g)";
+      grid.addEventListener("click", function () { view.setGrid(!view.grid); });
+      bar.appendChild(grid);
+      this.buttons.grid = grid;
+    }
     if (this.data.attributes.length > 1) {
       this.data.attributes.forEach(function (a) {
         var button = document.createElement("button");
@@ -336,6 +356,7 @@
     canvas.tabIndex = 0;
     canvas.addEventListener("keydown", function (event) {
       if (KEYS[event.key]) { view.setMode(KEYS[event.key]); event.preventDefault(); }
+      if (event.key === "g" && view.data.texture) { view.setGrid(!view.grid); }
       if (event.key === " ") { view.setMode(view.mode === "split" ? "exact" : "split"); event.preventDefault(); }
     });
     var drag = null;
@@ -366,7 +387,7 @@
   View.prototype.updateButtons = function () {
     if (!this.buttons) { return; }
     for (var key in this.buttons) {
-      var on = key === this.mode || key === "attribute " + this.attribute.name;
+      var on = key === this.mode || key === "attribute " + this.attribute.name || (key === "grid" && this.grid);
       this.buttons[key].setAttribute("aria-pressed", on ? "true" : "false");
     }
   };
@@ -426,12 +447,14 @@
     this.render();
   };
 
-  /* The projection of affinity.draw.framing.camera_for: far = distance + 2 max(extent, distance), near 1e-4 far. */
+  /* The projection of affinity.draw.framing.camera_for: far = distance + 2 max(extent, distance), near 1e-4 far;
+     after a flight to a face, near is moved up to ``clip`` before the target, so what lies between the eye and
+     the face (lips before a tongue, a car's body before its seats) is cut away while the view turns about it. */
   View.prototype.updateProjection = function () {
     if (!this.eye) { return; }
     var distance = this.eye.distanceTo(this.target), forward = this.target.clone().sub(this.eye).normalize();
     this.camera.far = distance + 2 * Math.max(this.extent, distance);
-    this.camera.near = this.camera.far * 1e-4;
+    this.camera.near = Math.max(this.camera.far * 1e-4, this.clip ? distance - this.clip : 0);
     this.camera.position.copy(this.eye);
     this.camera.up.copy(workingUp(forward, this.data.up));
     this.camera.lookAt(this.target);
@@ -453,6 +476,7 @@
   };
 
   View.prototype.pan = function (dx, dy) {
+    this.clip = null;
     var distance = this.eye.distanceTo(this.target);
     var scale = 2 * distance * Math.tan(THREE.MathUtils.degToRad(this.camera.fov) / 2) / this.canvas.height;
     var right = new THREE.Vector3().setFromMatrixColumn(this.camera.matrixWorld, 0);
@@ -497,6 +521,7 @@
     var place = this.faceGeometry(face);
     if (!place) { this.say("face " + face + " is not in this view (left out to keep the page small)"); return false; }
     this.selected = face;
+    this.clip = CLIP_RADII * place.radius;
     var distance = place.radius / Math.tan(THREE.MathUtils.degToRad(this.camera.fov) / 2) / FLY_FILL;
     var fromSide = function (sign) {
       return [place.centre.clone().addScaledVector(place.normal, sign * distance), place.centre.clone()];
