@@ -203,3 +203,25 @@ def test_view_agrees_with_numpy_on_spot(chromium, shared_report):
     camera = ((1.6, 1.1, 2.3), (0.0, 0.2, 0.0), 35.0)
     shares = _agreement(chromium, shared_report, 0, SPOT, camera, "uv")
     assert min(shares.values()) >= 0.99, shares
+
+
+HOSTILE = "</script><img src=x onerror=alert(1)>"
+
+
+def test_hostile_names_load_as_text_and_run_nothing(chromium, tmp_path):
+    """A group, a material and a file named to break out of a script tag: the page shows them as text, and no
+    script from them runs (an alert would open a dialog; the img would exist in the document)."""
+    path = tmp_path / "<img src=x onerror=alert(1)>.obj"
+    path.write_text(f"g {HOSTILE}\nusemtl {HOSTILE}\n"
+                    "v -1 0 0\nv 1 0 0\nv 0.5 1 0\nv -0.5 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n")
+    report = _report(tmp_path, path)
+    session = _open(chromium, report)
+    evaluate(chromium, session, "new Promise(r => setTimeout(r, 500))")  # an img's onerror would have fired
+    assert [e for e in chromium.events if e.get("method") == "Page.javascriptDialogOpening"] == []
+    assert _console_errors(chromium) == []
+    stray = "document.querySelectorAll('img[src=\"x\"], img:not([src^=\"data:\"])').length"
+    assert evaluate(chromium, session, stray) == 0
+    cells = evaluate(chromium, session,
+                     "Array.from(document.querySelectorAll('.view3d-findings td')).map(td => td.textContent)")
+    assert HOSTILE in cells
+    assert evaluate(chromium, session, "affinityViews.length") == 1
