@@ -109,16 +109,15 @@ def _findings(result: MeshResult) -> tuple[list[dict], np.ndarray]:
     """The table's rows (worst first per rule, :data:`TABLE_ROWS_PER_RULE` per rule) and every face's worst
     level as an index into ``LEVELS`` plus one (F,) uint8 (0: not flagged)."""
     mesh, file = result.mesh, result.file
-    worst_level = np.zeros(mesh.n_faces, dtype=np.uint8)
+    unflagged = len(LEVELS) + 1
+    rank = np.full(mesh.n_faces, unflagged, dtype=np.uint8)
     rows = []
     for hits in file.hits:
         rule = RULES[hits.code]
         levels = hits.levels()
-        level_rank = np.array([LEVELS.index(level) + 1 for level in levels], dtype=np.uint8)
         valid = hits.faces >= 0
-        faces = hits.faces[valid]
-        current = worst_level[faces]
-        np.minimum.at(worst_level, faces, np.where(current == 0, level_rank[valid], current))
+        level_rank = np.select([levels == level for level in LEVELS], np.arange(1, len(LEVELS) + 1)).astype(np.uint8)
+        np.minimum.at(rank, hits.faces[valid], level_rank[valid])
         severity = hits.values if rule.worst == "lowest" else -hits.values
         unit = hits.unit or rule.unit_for(result.settings.measure)
         for i in np.argsort(severity, kind="stable")[:TABLE_ROWS_PER_RULE]:
@@ -128,7 +127,7 @@ def _findings(result: MeshResult) -> tuple[list[dict], np.ndarray]:
                          "line": int(hits.lines[i]), "group": file.group_names[hits.groups[i]],
                          "value": float(hits.values[i]), "unit": unit,
                          "attribute": ATTRIBUTE_NAMES.get(rule.attribute)})
-    return rows, worst_level
+    return rows, np.where(rank == unflagged, 0, rank).astype(np.uint8)
 
 
 def view_data(result: MeshResult, budget: int = VIEW_QUAD_BUDGET) -> tuple[dict, list[str]]:

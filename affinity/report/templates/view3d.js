@@ -106,7 +106,7 @@
     "    float line = 1.0 - clamp(min(d.x, d.y) - 0.5, 0.0, 1.0);",
     "    ink = max(ink, line * (k == 0 ? 1.0 - blend : 1.0));",
     "  }",
-    "  return ink;",
+    "  return ink * clamp(-level, 0.0, 1.0);", /* lines a uv unit apart are face edges (per-face uv): fade them */
     "}",
     "vec3 appearance(vec3 a, float light) {",
     "  if (look == 4) { return kind == 0 ? vec3(fract(a.xy), 0.0) : kind == 1 ? a : normalize(a) * 0.5 + 0.5; }",
@@ -231,7 +231,8 @@
     this.fitCanvas();
     this.setCamera(data.camera);
     this.fromUrl();
-    this.firstFrame = performance.now();
+    this.renderer.getContext().readPixels(0, 0, 1, 1, 0x1908, 0x1401, new Uint8Array(4)); /* RGBA, UNSIGNED_BYTE */
+    this.firstFrame = performance.now(); /* ms from the page's navigation, the first frame drawn and read */
     var view = this;
     window.addEventListener("resize", function () { view.fitCanvas(); view.render(); });
     window.addEventListener("hashchange", function () { view.fromUrl(); });
@@ -245,22 +246,25 @@
 
   /* Edges of the flagged render quads, each in the colour of its face's worst finding's level. */
   View.prototype.outlineMesh = function () {
-    var data = this.data, order = data.levels_order, points = [], colours = [];
-    var colourOf = order.map(function (level) { return new THREE.Color(data.level_colours[level]); });
-    for (var q = 0; q < data.quads; q++) {
-      var level = this.levels[q];
-      if (!level) { continue; }
-      var colour = colourOf[level - 1];
-      for (var k = 0; k < 4; k++) {
-        [this.corners[q * 4 + k], this.corners[q * 4 + (k + 1) % 4]].forEach(function (v) {
-          points.push(this.positions[v * 3], this.positions[v * 3 + 1], this.positions[v * 3 + 2]);
-          colours.push(colour.r, colour.g, colour.b);
-        }, this);
+    var data = this.data, flagged = 0, q, k, e;
+    var colourOf = data.levels_order.map(function (level) { return new THREE.Color(data.level_colours[level]); });
+    for (q = 0; q < data.quads; q++) { if (this.levels[q]) { flagged++; } }
+    var points = new Float32Array(flagged * 24), colours = new Float32Array(flagged * 24), at = 0;
+    for (q = 0; q < data.quads; q++) {
+      if (!this.levels[q]) { continue; }
+      var colour = colourOf[this.levels[q] - 1];
+      for (k = 0; k < 4; k++) {
+        for (e = 0; e < 2; e++) {
+          var v = this.corners[q * 4 + (k + e) % 4];
+          points.set(this.positions.subarray(v * 3, v * 3 + 3), at);
+          colours[at] = colour.r; colours[at + 1] = colour.g; colours[at + 2] = colour.b;
+          at += 3;
+        }
       }
     }
     var geometry = new THREE.BufferGeometry();
-    geometry.setAttribute("position", new THREE.Float32BufferAttribute(points, 3));
-    geometry.setAttribute("color", new THREE.Float32BufferAttribute(colours, 3));
+    geometry.setAttribute("position", new THREE.BufferAttribute(points, 3));
+    geometry.setAttribute("color", new THREE.BufferAttribute(colours, 3));
     var lines = new THREE.LineSegments(geometry, new THREE.LineBasicMaterial({ vertexColors: true }));
     lines.frustumCulled = false;
     return lines;
