@@ -67,20 +67,29 @@ def kept_faces(mesh: Mesh, flagged: np.ndarray, budget: int) -> np.ndarray:
 
 def _attribute_block(mesh: Mesh, corners: np.ndarray, field: str, settings) -> dict | None:
     """One attribute of the render quads: its corner values (R, 4, width) float32 as base64 and how to read a
-    difference of it (the unit, the visibility threshold of its scored rule), or None when the mesh lacks it."""
+    difference of it (the unit, the visibility threshold of its scored rule), or None when the mesh lacks it.
+    Normals missing at a corner (or in the whole mesh) are the face's flat normal, as the renderer shades."""
     from ..draw.shading import flat_normals
 
     values = mesh.corner_attribute(field, corners)
-    if values is None:
-        return None
     if field == "normals":
         fallback = flat_normals(mesh.corner_attribute("positions", corners))
-        values = np.where(np.isnan(values), fallback, values)
+        values = fallback if values is None else np.where(np.isnan(values), fallback, values)
+    if values is None:
+        return None
     codes = scoring_rules(field)
     visible = (settings.error_above(codes[0]) or RULES[codes[0]].visible_threshold) if codes else None
     attribute = ATTRIBUTES[field]
     return {"name": attribute.name, "width": attribute.width, "unit": attribute.unit, "visible": visible,
             "values": _b64(np.nan_to_num(values), np.float32)}
+
+
+def drawn_fields(result: MeshResult) -> list[str]:
+    """The attributes the view embeds, in :data:`ATTRIBUTES` order: the one the renders show and those of the
+    flagged rules (normals cost 48 bytes a quad: only where a finding is about them), else the normals (shading)."""
+    wanted = {RULES[code].attribute for code in (result.shown, *(hits.code for hits in result.file.hits)) if code}
+    fields = [field for field in ATTRIBUTES if field in wanted and getattr(result.mesh, field) is not None]
+    return fields or ["normals"]
 
 
 def _texture(result: MeshResult) -> dict | None:
@@ -148,7 +157,7 @@ def view_data(result: MeshResult, budget: int = VIEW_QUAD_BUDGET) -> tuple[dict,
     shown = kept[faces]
     faces, corners = faces[shown], corners[shown]
     vertices, vertex_of = np.unique(mesh.corner_vertex[corners], return_inverse=True)
-    attributes = [block for field in ATTRIBUTES
+    attributes = [block for field in drawn_fields(result)
                   if (block := _attribute_block(mesh, corners, field, result.settings))]
     notes = []
     left = int((~kept).sum())

@@ -473,7 +473,8 @@ def view3d_section(result: MeshResult) -> Section:
     from .scene3d import script_json, shown_text, view_data
 
     data, notes = view_data(result)
-    return Section("view3d", title, {"json": script_json(data), "shown": shown_text(data)}, notes)
+    return Section("view3d", title, {"json": script_json(data), "shown": shown_text(data),
+                                     "texture": data["texture"] is not None}, notes)
 
 
 #: Sections of each readable mesh, in page order.
