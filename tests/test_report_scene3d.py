@@ -4,6 +4,7 @@ JSON, a budget that keeps flagged faces and their neighbours, JSON that cannot c
 from __future__ import annotations
 
 import base64
+import io
 import json
 import subprocess
 import sys
@@ -52,21 +53,25 @@ def test_script_json_cannot_end_its_script_and_round_trips():
     assert json.loads(text) == data
 
 
+def _result(path):
+    from affinity.pipeline.check import load_and_check
+    from affinity.report.build import MeshResult
+    from affinity.report.demo import MeshInput
+    from affinity.settings import Settings
+
+    file, mesh = load_and_check(str(path), Settings())
+    return MeshResult(MeshInput(str(path), path.name), file, Settings(), mesh=mesh, shown="Q101",
+                      camera=((3, 0, 0), (0, 0, 0), 40), up="y")  # the renders show uv, as collect_mesh picks
+
+
 @pytest.mark.skipif(not SPOT.is_file(), reason="../shared/meshes is absent")
 def test_view_data_rebuilds_spot_and_levels_agree_with_the_lint(tmp_path):
     """Spot (quads, triangles and pentagons): the embedded corners give back every face's positions, fanned as
     the renderer fans them, and each face's outline level is the worst level the lint's JSON gives it."""
     from affinity.loaders import load
-    from affinity.pipeline.check import load_and_check
-    from affinity.report.build import MeshResult
-    from affinity.report.demo import MeshInput
     from affinity.report.scene3d import view_data
-    from affinity.settings import Settings
 
-    file, mesh = load_and_check(str(SPOT), Settings())
-    result = MeshResult(MeshInput(str(SPOT), "spot"), file, Settings(), mesh=mesh, camera=((3, 0, 0), (0, 0, 0), 40),
-                        up="y")
-    data, notes = view_data(result)
+    data, notes = view_data(_result(SPOT))
     assert notes == []
     positions = _array(data["positions"], np.float32).reshape(-1, 3)
     corners = _array(data["corners"], np.uint32).reshape(-1, 4)
@@ -91,3 +96,46 @@ def test_view_data_rebuilds_spot_and_levels_agree_with_the_lint(tmp_path):
         worst[finding["face"]] = min(worst.get(finding["face"], rank), rank)
     levels = _array(data["levels"], np.uint8)
     assert {int(f): int(level) for f, level in zip(faces, levels) if level} == worst
+
+
+def test_over_budget_the_view_keeps_flagged_faces_and_says_what_it_left_out(tmp_path):
+    """A 6 x 6 grid whose one quad has a bent uv: with a budget of 10 render quads the view keeps that face and its
+    8 vertex neighbours, and its note counts the other 27."""
+    from affinity.report.scene3d import view_data
+
+    n = 6
+    i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
+    uv = np.stack([j.ravel(), i.ravel()], axis=1) / n
+    uv[3 * (n + 1) + 3] += 0.05  # the vertex shared by faces 14, 15, 20, 21
+    lines = [f"v {x} {y} 0" for y, x in zip(i.ravel(), j.ravel())] + [f"vt {u} {v}" for u, v in uv]
+    a = (np.arange(n)[:, None] * (n + 1) + np.arange(n)[None, :]).ravel() + 1
+    lines += [f"f {p}/{p} {p + 1}/{p + 1} {p + n + 2}/{p + n + 2} {p + n + 1}/{p + n + 1}" for p in a]
+    path = tmp_path / "grid.obj"
+    path.write_text("\n".join(lines) + "\n")
+    result = _result(path)
+    flagged = sorted({int(face) for hits in result.file.hits for face in hits.faces})
+    assert flagged == [14, 15, 20, 21]
+    data, notes = view_data(result, budget=16)
+    kept = sorted(set(_array(data["faces"], np.uint32).tolist()))
+    rows, columns = np.divmod(np.arange(n * n), n)
+    ring = [f for f in range(n * n) if 1 <= rows[f] <= 4 and 1 <= columns[f] <= 4]  # the flagged 2 x 2 and its ring
+    assert kept == ring
+    assert notes == [f"the 3-D view keeps the 4 flagged faces and their neighbourhoods: {n * n - 16} of {n * n} faces "
+                     "are left out of it to keep the page small"]
+    assert data["left_out"] == n * n - 16
+
+
+def test_texture_is_embedded_at_most_2048_px_with_its_real_size(tmp_path):
+    from PIL import Image
+
+    from affinity.report.scene3d import view_data
+
+    Image.new("RGB", (3000, 600), (200, 30, 30)).save(tmp_path / "wide.png")
+    (tmp_path / "m.mtl").write_text("newmtl m\nmap_Kd wide.png\n")
+    (tmp_path / "quad.obj").write_text("mtllib m.mtl\nusemtl m\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+                                       "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n")
+    texture = view_data(_result(tmp_path / "quad.obj"))[0]["texture"]
+    assert (texture["width"], texture["height"], texture["name"]) == (3000, 600, "wide.png")
+    embedded = Image.open(io.BytesIO(base64.b64decode(texture["uri"].split(",", 1)[1])))
+    assert embedded.size == (2048, 410)
+    assert embedded.convert("RGB").getpixel((1000, 200)) == (200, 30, 30)
