@@ -84,8 +84,10 @@ def shared_report(tmp_path_factory):
 
 
 def _open(chromium, report: Path, fragment: str = "") -> str:
+    """The report in a new tab, every view's texture decoded and its canvas at the NumPy renders' size."""
     session = open_page(chromium, report.as_uri() + fragment, 1280, 1000)
     evaluate(chromium, session, "Promise.all(affinityViews.map(v => v.ready))")
+    evaluate(chromium, session, f"affinityViews.forEach(v => v.setSize({SIZE[0]}, {SIZE[1]}))")
     return session
 
 
@@ -176,7 +178,6 @@ def _agreement(chromium, report: Path, view: int, mesh_path: Path, camera, show:
     fragment = f"#file={view}&camera=" + ",".join(f"{x:.9g}" for x in (*camera[0], *camera[1], camera[2]))
     session = _open(chromium, report, fragment)
     index = evaluate(chromium, session, f"affinityViews.findIndex(v => v.index === {view})")
-    evaluate(chromium, session, f"affinityViews[{index}].setSize({SIZE[0]}, {SIZE[1]})")
     up = evaluate(chromium, session, f"affinityViews[{index}].data.up")
     shown = evaluate(chromium, session, f"affinityViews[{index}].cameraText()")
     assert [float(x) for x in shown.split(",")] == [*camera[0], *camera[1], camera[2]]  # the URL's camera
