@@ -346,3 +346,14 @@ def test_view_screenshot_outlines_the_flagged_quads(tmp_path):
     pixels = np.asarray(Image.open(out).convert("RGB")).reshape(-1, 3).astype(int)
     flag = np.array([int(FLAG_COLOUR[i:i + 2], 16) for i in (1, 3, 5)])
     assert (np.abs(pixels - flag).max(axis=1) < 40).sum() > 100  # the trapezoid's magenta outline
+
+
+def test_renders_note_agrees_with_the_lint_when_the_view_is_too_far_for_mvc(tmp_path):
+    """The paper's trapezoid (Q101 error) seen from 1,000 units away covers a pixel: routing sends nothing to mvc,
+    and the note says why next to the lint's finding instead of claiming there is no split error."""
+    (tmp_path / "trapezoid.obj").write_text(TRAPEZOID)
+    result = run_report("trapezoid.obj", "-o", "out.html", "--camera", "0,0,1000,0,0,0,40", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    renders = section(parse(tmp_path / "out.html"), "renders").text()
+    assert "less than 0.5 pixel on the quad Q101 flags" in " ".join(renders.split())
+    assert "no split error reaches" not in renders

@@ -202,7 +202,14 @@ def renders_section(result: MeshResult) -> Section:
     hybrid = result.renders["hybrid"]
     routed = int(np.count_nonzero(hybrid.methods == MVC))
     notes = []
-    if routed == 0:
+    flagged = sum(len(hits) for hits in result.file.hits if hits.code == result.shown)
+    if routed == 0 and flagged:
+        which = (f"the quad {result.shown} flags" if flagged == 1
+                 else f"each of the {flagged:,} quads {result.shown} flags")
+        notes.append(f"nothing needed mvc: the hybrid drew all {len(hybrid.methods)} quads as split, because at this "
+                     f"distance the split moves the picture by less than {result.options.pixel_tolerance:g} pixel on "
+                     f"{which}; the 3-D view and the close-ups show them near, and the comparison with mvc is left out")
+    elif routed == 0:
         notes.append(f"nothing needed mvc: the hybrid drew all {len(hybrid.methods)} quads as split (no split error "
                      "reaches the pixel tolerance in this view), so the comparison with mvc is left out")
     figures = [
