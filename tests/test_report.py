@@ -6,6 +6,8 @@ assertions are about elements and text, not about substrings of markup.
 
 from __future__ import annotations
 
+import base64
+import io
 import json
 import os
 import subprocess
@@ -357,3 +359,21 @@ def test_renders_note_agrees_with_the_lint_when_the_view_is_too_far_for_mvc(tmp_
     renders = section(parse(tmp_path / "out.html"), "renders").text()
     assert "less than 0.5 pixel on the quad Q101 flags" in " ".join(renders.split())
     assert "no split error reaches" not in renders
+
+
+def test_a_mesh_with_uv_whose_findings_are_colours_is_drawn_in_colour(tmp_path):
+    """Affine uv, disaffine vertex colours (a terrain's case): the renders show the colours the lint flags, not
+    the uv checker. Truth: the four corner colours are saturated primaries, the checker is grey."""
+    from PIL import Image
+
+    (tmp_path / "terrain.obj").write_text(
+        "v -1 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0.5 1 0 0 0 1\nv -0.5 1 0 1 1 0\n"
+        "vt 0 0\nvt 1 0\nvt 0.75 1\nvt 0.25 1\nf 1/1 2/2 3/3 4/4\n")
+    result = run_report("terrain.obj", "-o", "out.html", "--camera", "0,0.5,3,0,0.5,0,40", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    renders = section(parse(tmp_path / "out.html"), "renders")
+    assert "vertex colours" in renders.text()
+    src = renders.find_all("img")[0].attrs["src"]
+    pixels = np.asarray(Image.open(io.BytesIO(base64.b64decode(src.split(",", 1)[1]))).convert("RGB")).astype(int)
+    saturation = pixels.max(axis=-1) - pixels.min(axis=-1)
+    assert (saturation > 128).mean() > 0.05  # the quad in colour covers a good part of the picture

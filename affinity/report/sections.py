@@ -184,8 +184,10 @@ def findings_section(result: MeshResult) -> Section:
 def _shown_text(result: MeshResult) -> str:
     if result.shown == "Q101":
         return f"uv, {result.texture}"
-    if result.shown == "Q102":
+    if result.shown == "Q102" and result.mesh.texcoords is None:
         return "vertex colours (the mesh has no texture coordinates)"
+    if result.shown == "Q102":
+        return "vertex colours (the findings are about them, not the uv)"
     return "shading (the mesh has no texture coordinates or vertex colours)"
 
 
