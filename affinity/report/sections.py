@@ -479,11 +479,11 @@ def view3d_section(result: MeshResult) -> Section:
     title = "3-D view"
     if result.mesh.n_faces == 0 or result.camera is None:
         return leave_out("view3d", title, "the mesh has no faces to show")
-    from .scene3d import script_json, shown_text, view_data
+    from .scene3d import LEVEL_COLOURS, script_json, shown_text, view_data
 
     data, notes = view_data(result)
     return Section("view3d", title, {"json": script_json(data), "shown": shown_text(data),
-                                     "texture": data["texture"] is not None}, notes)
+                                     "texture": data["texture"] is not None, "level_colours": LEVEL_COLOURS}, notes)
 
 
 #: Sections of each readable mesh, in page order.

@@ -223,6 +223,10 @@
     this.scene.add(this.mesh);
     this.outlines = this.outlineMesh();
     this.scene.add(this.outlines);
+    this.selection = new THREE.LineSegments(new THREE.BufferGeometry(),
+                                            new THREE.LineBasicMaterial({ color: 0x1d4ed8, depthTest: false }));
+    this.selection.frustumCulled = false;
+    this.scene.add(this.selection);
     this.camera = new THREE.PerspectiveCamera(40, 4 / 3, 0.01, 100);
     this.loadTexture();
     this.chooseAttribute(this.firstAttribute());
@@ -399,6 +403,11 @@
   View.prototype.setMode = function (mode) {
     this.mode = mode;
     this.updateButtons();
+    if (mode === "difference") {
+      var a = this.attribute;
+      this.say("|split - exact| in " + a.unit + ": white 0, yellow " + (a.visible || 1) / 2 + ", red " + (a.visible || 1) +
+               " (the " + a.name + " visibility threshold) and above");
+    }
     this.render();
   };
 
@@ -524,7 +533,7 @@
   View.prototype.flyTo = function (face, animate) {
     var place = this.faceGeometry(face);
     if (!place) { this.say("face " + face + " is not in this view (left out to keep the page small)"); return false; }
-    this.selected = face;
+    this.select(face);
     this.clip = CLIP_RADII * place.radius;
     var distance = place.radius / Math.tan(THREE.MathUtils.degToRad(this.camera.fov) / 2) / FLY_FILL;
     var fromSide = function (sign) {
@@ -556,12 +565,33 @@
     return true;
   };
 
+  /* Mark ``face`` (its render quads' edges, drawn over everything) and its rows in the table. */
+  View.prototype.select = function (face) {
+    this.selected = face;
+    var points = [];
+    for (var q = 0; q < this.data.quads; q++) {
+      if (this.faces[q] !== face) { continue; }
+      for (var k = 0; k < 4; k++) {
+        for (var e = 0; e < 2; e++) {
+          var v = this.corners[q * 4 + (k + e) % 4];
+          points.push(this.positions[v * 3], this.positions[v * 3 + 1], this.positions[v * 3 + 2]);
+        }
+      }
+    }
+    this.selection.geometry.dispose();
+    this.selection.geometry = new THREE.BufferGeometry();
+    this.selection.geometry.setAttribute("position", new THREE.Float32BufferAttribute(points, 3));
+    this.figure.querySelectorAll(".view3d-findings tr[data-face]").forEach(function (tr) {
+      tr.classList.toggle("selected", tr.dataset.face === String(face));
+    });
+  };
+
   View.prototype.say = function (text) { if (this.status) { this.status.textContent = text; } };
 
   View.prototype.draw = function (mode, raw) {
     this.uniforms.mode.value = mode === "faces" ? 3 : MODES.indexOf(mode);
     this.uniforms.look.value = raw ? 4 : this.look;
-    this.outlines.visible = mode !== "faces" && !raw;
+    this.outlines.visible = this.selection.visible = mode !== "faces" && !raw;
     this.renderer.render(this.scene, this.camera);
   };
 
@@ -602,7 +632,7 @@
     var face = pixel[0] + pixel[1] * 256 + pixel[2] * 65536 - 1;
     if (face >= 0 && pixel[3] === 255 && !(pixel[0] === 255 && pixel[1] === 255 && pixel[2] === 255)) {
       var rows = this.data.findings.filter(function (row) { return row.face === face; });
-      this.selected = face;
+      this.select(face);
       this.say("face " + face + (rows.length ? ": " + rows.map(function (r) {
         return r.code + " " + r.name + " " + Number(r.value).toPrecision(3) + " " + r.unit;
       }).join("; ") : ": not flagged"));
