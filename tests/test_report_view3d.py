@@ -254,3 +254,13 @@ def test_report_of_a_100k_quad_car_stays_under_budget_and_opens(chromium, tmp_pa
     evaluate(chromium, session, "new Promise(r => setTimeout(r, 1000))")  # the flight takes 0.45 s
     assert f"face={face}&" in evaluate(chromium, session, "location.hash")
     assert (_face_ids(_snapshot(chromium, session, 0, "faces")) == face).sum() >= FACE_PIXELS
+
+
+def test_a_link_naming_a_face_opens_on_it(chromium, shared_report):
+    """``#file=1&face=F`` (design.md): the second file's view flies to face F, selects it, and the face fills
+    the view; the first file's view is left where it was."""
+    face = _worst_findings(_lint(SPOT, MAKEHUMAN), 1)[1][1]["face"]
+    session = _open(chromium, shared_report, f"#file=1&face={face}")
+    evaluate(chromium, session, "new Promise(r => setTimeout(r, 1000))")  # the flight takes 0.45 s
+    assert evaluate(chromium, session, "affinityViews.map(v => v.selected)") == [None, face]
+    assert (_face_ids(_snapshot(chromium, session, 1, "faces")) == face).sum() >= FACE_PIXELS
