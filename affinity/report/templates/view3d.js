@@ -416,7 +416,7 @@
     this.data.findings.forEach(function (row) {
       var tr = document.createElement("tr");
       tr.tabIndex = 0;
-      tr.dataset.face = String(row.face);
+      tr.dataset.shows = String(row.face);
       var value = Number(row.value).toPrecision(3) + " " + row.unit;
       [row.level, row.code, String(row.face), value, row.group, String(row.line)].forEach(function (text, k) {
         var td = document.createElement("td");
@@ -581,8 +581,8 @@
     this.selection.geometry.dispose();
     this.selection.geometry = new THREE.BufferGeometry();
     this.selection.geometry.setAttribute("position", new THREE.Float32BufferAttribute(points, 3));
-    this.figure.querySelectorAll(".view3d-findings tr[data-face]").forEach(function (tr) {
-      tr.classList.toggle("selected", tr.dataset.face === String(face));
+    this.figure.querySelectorAll(".view3d-findings tr[data-shows]").forEach(function (tr) {
+      tr.classList.toggle("selected", tr.dataset.shows === String(face));
     });
   };
 
