@@ -6,6 +6,9 @@ assertions are about elements and text, not about substrings of markup.
 
 from __future__ import annotations
 
+import base64
+import io
+import json
 import math
 import os
 import subprocess
@@ -186,7 +189,13 @@ def test_demo_report_references_nothing_outside_itself(demo):
                   for node in doc.find_all(tag) for name in ("src", "href") if name in node.attrs]
     assert references, "the report has pictures and links"
     assert all(ref.startswith(("data:", "#")) for ref in references), [r[:40] for r in references]
+    from affinity.report.threejs import three_script
+
+    # three.js names the XHTML namespace and cites papers by URL in its shader comments; it fetches nothing
+    # (test_report_browser.py watches the network), so its text is left out of the search
     text = path.read_text(encoding="utf-8")
+    assert text.count(three_script()) == 1
+    text = text.replace(three_script(), "")
     assert "http://" not in text and "https://" not in text
 
 
@@ -245,7 +254,11 @@ def test_file_and_group_named_like_markup_render_as_text(tmp_path):
     assert result.returncode == 0, result.stderr
     doc = parse(tmp_path / "out.html")
     scripts = doc.find_all("script")
-    assert len(scripts) == 1 and "alert" not in scripts[0].text()  # only the page's own table sorter
+    data = [script for script in scripts if script.attrs.get("type") == "application/json"]
+    code = [script for script in scripts if "type" not in script.attrs]
+    assert len(code) == 3 and not any("alert(1)" in script.text() for script in code)  # sorter, three.js, view
+    assert len(data) == 1 and "<" not in data[0].text()  # the 3-D view's data: the names as JSON strings
+    assert "<script>alert(1)</script>" in json.loads(data[0].text())["findings"][0]["group"]
     article = mesh_article(doc, name)
     assert name in article.find_all("h2")[0].text()
     assert "<script>alert(1)</script>" in section(article, "findings").text()  # the group of the flagged quad
@@ -407,3 +420,32 @@ def test_view_screenshot_outlines_the_flagged_quads(tmp_path):
     pixels = np.asarray(Image.open(out).convert("RGB")).reshape(-1, 3).astype(int)
     flag = np.array([int(FLAG_COLOUR[i:i + 2], 16) for i in (1, 3, 5)])
     assert (np.abs(pixels - flag).max(axis=1) < 40).sum() > 100  # the trapezoid's magenta outline
+
+
+def test_renders_note_agrees_with_the_lint_when_the_view_is_too_far_for_mvc(tmp_path):
+    """The paper's trapezoid (Q101 error) seen from 1,000 units away covers a pixel: routing sends nothing to mvc,
+    and the note says why next to the lint's finding instead of claiming there is no split error."""
+    (tmp_path / "trapezoid.obj").write_text(TRAPEZOID)
+    result = run_report("trapezoid.obj", "-o", "out.html", "--camera", "0,0,1000,0,0,0,40", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    renders = section(parse(tmp_path / "out.html"), "renders").text()
+    assert "less than 0.5 pixel on the quad Q101 flags" in " ".join(renders.split())
+    assert "no split error reaches" not in renders
+
+
+def test_a_mesh_with_uv_whose_findings_are_colours_is_drawn_in_colour(tmp_path):
+    """Affine uv, disaffine vertex colours (a terrain's case): the renders show the colours the lint flags, not
+    the uv checker. Truth: the four corner colours are saturated primaries, the checker is grey."""
+    from PIL import Image
+
+    (tmp_path / "terrain.obj").write_text(
+        "v -1 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0.5 1 0 0 0 1\nv -0.5 1 0 1 1 0\n"
+        "vt 0 0\nvt 1 0\nvt 0.75 1\nvt 0.25 1\nf 1/1 2/2 3/3 4/4\n")
+    result = run_report("terrain.obj", "-o", "out.html", "--camera", "0,0.5,3,0,0.5,0,40", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    renders = section(parse(tmp_path / "out.html"), "renders")
+    assert "vertex colours" in renders.text()
+    src = renders.find_all("img")[0].attrs["src"]
+    pixels = np.asarray(Image.open(io.BytesIO(base64.b64decode(src.split(",", 1)[1]))).convert("RGB")).astype(int)
+    saturation = pixels.max(axis=-1) - pixels.min(axis=-1)
+    assert (saturation > 128).mean() > 0.05  # the quad in colour covers a good part of the picture

@@ -479,7 +479,7 @@ def test_two_separated_flagged_patches_give_two_closeups_each_outlined(tmp_path)
     parser = Figures()
     parser.feed((tmp_path / "out.html").read_text(encoding="utf-8"))
     assert sorted((f["face"], f["rule"]) for f in parser.figures) == [(2 * 12 + 2, "Q101"), (9 * 12 + 9, "Q101")]
-    assert parser.views == ["uv-layout"]
+    assert parser.views == ["3d", "uv-layout"]  # the 3-D view, then the texture-space view
     for figure in parser.figures:
         assert has_outline_colour(figure["images"][0])
 

@@ -22,6 +22,7 @@ import numpy as np
 from ..findings import FileReport
 from ..lint import QuadScores, quad_scores, scored_codes
 from ..mesh import Mesh
+from ..rules import RULES
 from ..scenes import View
 from ..settings import Settings
 from . import MAX_VIEWS, PLACE_FACES, RENDER_SIZE
@@ -110,7 +111,8 @@ class MeshResult:
 
     ``file`` is the lint outcome (with ``error`` or ``skipped`` set, nothing
     else is collected). ``shown`` is the rule code of the attribute the renders
-    show (None: plain shading). ``renders`` maps a method (``hybrid`` and, when
+    show: the first scored rule with findings, else the first scored (uv, colours, normals); None: plain
+    shading. ``renders`` maps a method (``hybrid`` and, when
     it sent quads to mvc, ``split``, ``mvc``, ``exact``) to its render (the
     hybrid's ``tinted`` image is the overlay of the quads it sent to mvc). ``overview`` is the pyvista picture
     (H, W, 3) uint8, else ``overview_note`` says why there is none. ``camera``
@@ -192,9 +194,11 @@ def _render(result: MeshResult, texture: np.ndarray | None, step: StepTimer) -> 
     from ..draw.texture import TextureError
 
     size = result.options.size
+    # a mesh with uv whose findings are its vertex colours (a terrain) is drawn in its colours, not the checker
+    show = "color" if result.shown and RULES[result.shown].attribute == "colors" else None
 
     def draw(warn=lambda line: None, **options):
-        chosen = RenderOptions(width=size[0], height=size[1], camera=result.camera, up=result.up,
+        chosen = RenderOptions(width=size[0], height=size[1], camera=result.camera, up=result.up, show=show,
                                texture=texture, pixel_tolerance=result.options.pixel_tolerance, **options)
         return render_mesh(result.mesh, chosen, warn)
 
@@ -296,7 +300,8 @@ def collect_mesh(item: MeshInput, settings: Settings, step: Callable[[str], None
         timer("scores")
         import_in_background(SLOW_IMPORTS)
         result.scores = {code: quad_scores(result.mesh, settings, code) for code in scored_codes(result.mesh)}
-        result.shown = next(iter(result.scores), None)  # uv, else colours, else normals
+        flagged = {hits.code for hits in file.hits}  # the flagged attribute, else uv, else colours, else normals
+        result.shown = next((code for code in result.scores if code in flagged), next(iter(result.scores), None))
         result.texture = _texture_label(result.mesh, item.view, options.texture)
         has_uv = result.mesh.texcoords is not None
         _view(result)

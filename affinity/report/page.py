@@ -7,6 +7,7 @@ import time
 from pathlib import Path
 
 from .build import ReportRun
+from .scene3d import VIEW_SCRIPTS, view_scripts
 from .sections import CLOSING_SECTIONS, MESH_SECTIONS, PAGE_TIME, RUN_TIME, file_row, summary_section
 
 TEMPLATES = Path(__file__).parent / "templates"
@@ -49,8 +50,9 @@ def render_page(run: ReportRun) -> str:
     ]
     html = compact(environment.get_template("report.html.j2").render(
         run=run, version=__version__, summary=summary_section(run), meshes=meshes,
-        closing=[section(run) for section in CLOSING_SECTIONS], run_time=RUN_TIME,
+        closing=[section(run) for section in CLOSING_SECTIONS], run_time=RUN_TIME, view_scripts=VIEW_SCRIPTS,
     ))
+    html = html.replace(VIEW_SCRIPTS, view_scripts(), 1) if VIEW_SCRIPTS in html else html
     # Both stand-ins come before any text from the user's files (the header and the summary's facts).
     finished = time.perf_counter()
     html = html.replace(PAGE_TIME, f"{finished - begun:.1f} s", 1)

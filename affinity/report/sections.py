@@ -206,8 +206,10 @@ def findings_section(result: MeshResult) -> Section:
 def _shown_text(result: MeshResult) -> str:
     if result.shown == "Q101":
         return f"uv, {result.texture}"
-    if result.shown == "Q102":
+    if result.shown == "Q102" and result.mesh.texcoords is None:
         return "vertex colours (the mesh has no texture coordinates)"
+    if result.shown == "Q102":
+        return "vertex colours (the findings are about them, not the uv)"
     return "shading (the mesh has no texture coordinates or vertex colours)"
 
 
@@ -224,7 +226,14 @@ def renders_section(result: MeshResult) -> Section:
     hybrid = result.renders["hybrid"]
     routed = int(np.count_nonzero(hybrid.methods == MVC))
     notes = []
-    if routed == 0:
+    flagged = sum(len(hits) for hits in result.file.hits if hits.code == result.shown)
+    if routed == 0 and flagged:
+        which = (f"the quad {result.shown} flags" if flagged == 1
+                 else f"each of the {flagged:,} quads {result.shown} flags")
+        notes.append(f"nothing needed mvc: the hybrid drew all {len(hybrid.methods)} quads as split, because at this "
+                     f"distance the split moves the picture by less than {result.options.pixel_tolerance:g} pixel on "
+                     f"{which}; the 3-D view and the close-ups show them near, and the comparison with mvc is left out")
+    elif routed == 0:
         notes.append(f"nothing needed mvc: the hybrid drew all {len(hybrid.methods)} quads as split (no split error "
                      "reaches the pixel tolerance in this view), so the comparison with mvc is left out")
     figures = [
@@ -489,10 +498,23 @@ def _viridis_bar(low: float, top: float, label: str) -> str:
     return colour_bar(stops, [(0.0, f"{low:.2g}"), (0.5, f"{middle:.2g}"), (1.0, f"{top:.2g}")], label)
 
 
+def view3d_section(result: MeshResult) -> Section:
+    """The mesh in a 3-D view drawn by the browser (:mod:`affinity.report.scene3d`): split, exact and their
+    difference, the findings one click away."""
+    title = "3-D view"
+    if result.mesh.n_faces == 0 or result.camera is None:
+        return leave_out("view3d", title, "the mesh has no faces to show")
+    from .scene3d import LEVEL_COLOURS, script_json, shown_text, view_data
+
+    data, notes = view_data(result)
+    return Section("view3d", title, {"json": script_json(data), "shown": shown_text(data),
+                                     "texture": data["texture"] is not None, "level_colours": LEVEL_COLOURS}, notes)
+
+
 #: Sections of each readable mesh, in page order.
 MESH_SECTIONS = (
-    findings_section, closeups_section, uv_layout_section, renders_section, overlay_section, error_heatmaps_section,
-    score_histograms_section, stability_section, overview_section,
+    findings_section, view3d_section, closeups_section, uv_layout_section, renders_section, overlay_section,
+    error_heatmaps_section, score_histograms_section, stability_section, overview_section,
 )
 #: Sections after the meshes, about the whole product.
 CLOSING_SECTIONS = (study_section,)

@@ -1,0 +1,217 @@
+"""The data of the report's 3-D view: one mesh as typed arrays, its findings, its texture, as JSON for the page.
+
+The page's script (``templates/view3d.js``) draws it with three.js. Everything
+from the asset (group names, paths, findings) enters the page here, as JSON in
+a non-executable ``<script type="application/json">`` with every ``<`` escaped,
+and the script shows it with ``textContent``: never markup, never code. Arrays
+travel as base64 of little-endian typed arrays.
+
+Above :data:`VIEW_QUAD_BUDGET` render quads the view keeps the flagged faces
+and rings of their neighbours, and says how many faces it left out.
+"""
+
+from __future__ import annotations
+
+import base64
+import io
+import json
+from pathlib import Path
+
+import numpy as np
+
+from ..attributes import ATTRIBUTE_NAMES, ATTRIBUTES, scoring_rules
+from ..mesh import Mesh
+from ..rules import LEVELS, RULES
+from .build import MeshResult
+
+#: Render quads the view embeds at most (about 100 bytes of page each, all attributes).
+VIEW_QUAD_BUDGET = 250_000
+#: Findings the view's table lists per rule (the worst); the lint's JSON has them all.
+TABLE_ROWS_PER_RULE = 100
+#: Largest side of the embedded texture, pixels.
+TEXTURE_SIDE = 2048
+TEMPLATES = Path(__file__).parent / "templates"
+#: Stand-in for the view's style and scripts (three.js and ``templates/view3d.js``): the page puts them in after
+#: folding its line breaks (:func:`affinity.report.page.compact`), which three.js's shader strings need kept.
+VIEW_SCRIPTS = "\x00view scripts\x00"
+#: Outline colour of a flagged face by its worst finding's level.
+LEVEL_COLOURS = {"error": "#ff1a99", "warning": "#f59e0b", "info": "#3b82f6"}
+
+
+def _b64(array: np.ndarray, dtype) -> str:
+    return base64.b64encode(np.ascontiguousarray(array, dtype=np.dtype(dtype).newbyteorder("<")).tobytes()).decode()
+
+
+def kept_faces(mesh: Mesh, flagged: np.ndarray, budget: int) -> np.ndarray:
+    """(F,) bool: the faces the view embeds.
+
+    Every face when the mesh's render quads fit ``budget``; else the ``flagged``
+    (F,) bool faces and rings of their vertex neighbours, grown while the next
+    ring still fits (at least the flagged faces themselves).
+    """
+    sizes = mesh.face_sizes
+    quads_of = np.where(sizes == 4, 1, np.maximum(sizes - 2, 1))  # render quads per face (fans for n-gons)
+    if quads_of.sum() <= budget:
+        return np.ones(mesh.n_faces, dtype=bool)
+    owner = np.repeat(np.arange(mesh.n_faces), sizes)
+    kept = flagged.copy()
+    while True:
+        touched = np.zeros(len(mesh.positions), dtype=bool)
+        touched[mesh.corner_vertex[kept[owner]]] = True
+        ring = np.zeros(mesh.n_faces, dtype=bool)
+        np.logical_or.at(ring, owner, touched[mesh.corner_vertex])
+        if quads_of[ring].sum() > budget or ring.sum() == kept.sum():
+            return kept
+        kept = ring
+
+
+def _attribute_block(mesh: Mesh, corners: np.ndarray, field: str, settings) -> dict | None:
+    """One attribute of the render quads: its corner values (R, 4, width) float32 as base64 and how to read a
+    difference of it (the unit, the visibility threshold of its scored rule), or None when the mesh lacks it.
+    Normals missing at a corner (or in the whole mesh) are the face's flat normal, as the renderer shades."""
+    from ..draw.shading import flat_normals
+
+    values = mesh.corner_attribute(field, corners)
+    if field == "normals":
+        fallback = flat_normals(mesh.corner_attribute("positions", corners))
+        values = fallback if values is None else np.where(np.isnan(values), fallback, values)
+    if values is None:
+        return None
+    codes = scoring_rules(field)
+    visible = (settings.error_above(codes[0]) or RULES[codes[0]].visible_threshold) if codes else None
+    attribute = ATTRIBUTES[field]
+    return {"name": attribute.name, "width": attribute.width, "unit": attribute.unit, "visible": visible,
+            "values": _b64(np.nan_to_num(values), np.float32)}
+
+
+def drawn_fields(result: MeshResult) -> list[str]:
+    """The attributes the view embeds, in :data:`ATTRIBUTES` order: the one the renders show and those of the
+    flagged rules (normals cost 48 bytes a quad: only where a finding is about them), else the normals (shading)."""
+    wanted = {RULES[code].attribute for code in (result.shown, *(hits.code for hits in result.file.hits)) if code}
+    fields = [field for field in ATTRIBUTES if field in wanted and getattr(result.mesh, field) is not None]
+    return fields or ["normals"]
+
+
+def _texture(result: MeshResult) -> dict | None:
+    """The mesh's own texture (map_Kd), downscaled to :data:`TEXTURE_SIDE`, as a data URI with its real size."""
+    path = result.options.texture or result.mesh.texture_path()
+    if not path or result.mesh.texcoords is None:
+        return None
+    from PIL import Image, UnidentifiedImageError
+
+    try:
+        with Image.open(path) as image:
+            size = image.size
+            image = image.convert("RGBA" if "A" in image.getbands() else "RGB")
+            image.thumbnail((TEXTURE_SIDE, TEXTURE_SIDE), Image.Resampling.LANCZOS)
+            buffer = io.BytesIO()
+            image.save(buffer, format="PNG", optimize=False)
+    except (OSError, UnidentifiedImageError):
+        return None
+    import os
+
+    return {"uri": "data:image/png;base64," + base64.b64encode(buffer.getvalue()).decode(),
+            "width": size[0], "height": size[1], "name": os.path.basename(path)}
+
+
+def _findings(result: MeshResult) -> tuple[list[dict], np.ndarray]:
+    """The table's rows (worst first per rule, :data:`TABLE_ROWS_PER_RULE` per rule) and every face's worst
+    level as an index into ``LEVELS`` plus one (F,) uint8 (0: not flagged)."""
+    mesh, file = result.mesh, result.file
+    unflagged = len(LEVELS) + 1
+    rank = np.full(mesh.n_faces, unflagged, dtype=np.uint8)
+    rows = []
+    for hits in file.hits:
+        rule = RULES[hits.code]
+        levels = hits.levels()
+        valid = hits.faces >= 0
+        level_rank = np.select([levels == level for level in LEVELS], np.arange(1, len(LEVELS) + 1)).astype(np.uint8)
+        np.minimum.at(rank, hits.faces[valid], level_rank[valid])
+        severity = hits.values if rule.worst == "lowest" else -hits.values
+        unit = hits.unit or rule.unit_for(result.settings.measure)
+        for i in np.argsort(severity, kind="stable")[:TABLE_ROWS_PER_RULE]:
+            if hits.faces[i] < 0:
+                continue
+            rows.append({"code": hits.code, "name": rule.name, "level": str(levels[i]), "face": int(hits.faces[i]),
+                         "line": int(hits.lines[i]), "group": file.group_names[hits.groups[i]],
+                         "value": float(hits.values[i]), "unit": unit,
+                         "attribute": ATTRIBUTE_NAMES.get(rule.attribute)})
+    return rows, np.where(rank == unflagged, 0, rank).astype(np.uint8)
+
+
+def view_data(result: MeshResult, budget: int = VIEW_QUAD_BUDGET) -> tuple[dict, list[str]]:
+    """Everything the 3-D view draws for one mesh, JSON-ready, and notes on what it left out.
+
+    The arrays: ``positions`` (V', 3) float32 of the used vertices, ``corners``
+    (R, 4) uint32 into them (a triangle repeats its last corner, an n-gon is
+    fanned), ``faces`` (R,) uint32 the mesh face of each render quad, ``levels``
+    (R,) uint8 the worst finding level of its face (1 error, 2 warning, 3 info,
+    0 none), and per attribute the corner values (R, 4, width) float32.
+    """
+    from ..draw.quads import render_corners
+
+    mesh = result.mesh
+    rows, worst_level = _findings(result)
+    kept = kept_faces(mesh, worst_level > 0, budget)
+    faces, corners = render_corners(mesh)
+    shown = kept[faces]
+    faces, corners = faces[shown], corners[shown]
+    vertices, vertex_of = np.unique(mesh.corner_vertex[corners], return_inverse=True)
+    attributes = [block for field in drawn_fields(result)
+                  if (block := _attribute_block(mesh, corners, field, result.settings))]
+    notes = []
+    left = int((~kept).sum())
+    if left:
+        notes.append(f"the 3-D view keeps the {int((worst_level > 0).sum()):,} flagged faces and their "
+                     f"neighbourhoods: {left:,} of {mesh.n_faces:,} faces are left out of it to keep the page small")
+    eye, target, fov = result.camera
+    data = {
+        "quads": len(faces),
+        "positions": _b64(mesh.positions[vertices], np.float32),
+        "corners": _b64(vertex_of.reshape(-1, 4), np.uint32),
+        "faces": _b64(faces, np.uint32),
+        "levels": _b64(worst_level[faces], np.uint8),
+        "attributes": attributes,
+        "texture": _texture(result) if any(a["name"] == "uv" for a in attributes) else None,
+        "findings": rows,
+        "counts": {hits.code: len(hits) for hits in result.file.hits},
+        "rules": {code: {"name": rule.name, "attribute": ATTRIBUTE_NAMES.get(rule.attribute)}
+                  for code, rule in RULES.items()},
+        "levels_order": list(LEVELS),
+        "level_colours": LEVEL_COLOURS,
+        "camera": [*map(float, eye), *map(float, target), float(fov)],
+        "up": result.up,
+        "left_out": left,
+    }
+    return data, notes
+
+
+def script_json(data: dict) -> str:
+    """``data`` as JSON safe inside ``<script type="application/json">``: every ``<`` (so ``</script>`` and
+    ``<!--``) escaped, and the line separators JavaScript once treated as line ends."""
+    text = json.dumps(data, ensure_ascii=False, separators=(",", ":"), allow_nan=False)
+    return text.replace("<", "\\u003c").replace("\u2028", "\\u2028").replace("\u2029", "\\u2029")
+
+
+def shown_text(data: dict) -> str:
+    """What the view draws, for its caption."""
+    names = [attribute["name"] for attribute in data["attributes"]]
+    drawn = []
+    if "uv" in names:
+        texture = data["texture"]
+        drawn.append(f"uv with the texture {texture['name']} (embedded)" if texture
+                     else "uv as grid lines a few pixels apart at any zoom (the mesh names no readable texture)")
+    if "color" in names:
+        drawn.append("vertex colours")
+    if "normal" in names:
+        drawn.append("normals, shaded")
+    return "It draws " + "; ".join(drawn) + "." if drawn else ""
+
+
+def view_scripts() -> str:
+    """The view's style and scripts, once per page: three.js as a classic script, then ``view3d.js``."""
+    from .threejs import three_script
+
+    style = (TEMPLATES / "view3d.css").read_text(encoding="utf-8")
+    script = (TEMPLATES / "view3d.js").read_text(encoding="utf-8")
+    return f"<style>\n{style}</style>\n<script>\n{three_script()}\n</script>\n<script>\n{script}</script>\n"
