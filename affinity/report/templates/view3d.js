@@ -510,22 +510,26 @@
 
   /* The face's render quads: centre, area-weighted normal (corner order's side) and radius. */
   View.prototype.faceGeometry = function (face) {
-    var centre = new THREE.Vector3(), normal = new THREE.Vector3(), points = [];
+    var centre = new THREE.Vector3(), normal = new THREE.Vector3(), points = [], area = 0;
     for (var q = 0; q < this.data.quads; q++) {
       if (this.faces[q] !== face) { continue; }
       var p = [0, 1, 2, 3].map(function (k) {
         var v = this.corners[q * 4 + k];
         return new THREE.Vector3(this.positions[v * 3], this.positions[v * 3 + 1], this.positions[v * 3 + 2]);
       }, this);
-      normal.add(new THREE.Vector3().crossVectors(p[2].clone().sub(p[0]), p[3].clone().sub(p[1])));
+      var doubled = new THREE.Vector3().crossVectors(p[2].clone().sub(p[0]), p[3].clone().sub(p[1]));
+      normal.add(doubled);
+      area += doubled.length() / 2;
       points.push.apply(points, p);
     }
     if (!points.length) { return null; }
     points.forEach(function (p) { centre.add(p); });
     centre.multiplyScalar(1 / points.length);
     var radius = Math.max.apply(null, points.map(function (p) { return p.distanceTo(centre); })) || this.extent * 0.01;
+    /* A sliver framed whole would be a hairline: it is framed on the side of a square of its area instead,
+       so it covers about as many pixels as a compact face (its long ends may leave the view). */
     return { centre: centre, normal: normal.lengthSq() > 0 ? normal.normalize() : new THREE.Vector3(0, 0, 1),
-             radius: radius };
+             radius: radius, size: Math.min(radius, Math.sqrt(area)) || radius };
   };
 
   /* Fly to a face so it fills about FLY_FILL of the view's height, looking along its normal from the side
@@ -535,17 +539,26 @@
     if (!place) { this.say("face " + face + " is not in this view (left out to keep the page small)"); return false; }
     this.select(face);
     this.clip = CLIP_RADII * place.radius;
-    var distance = place.radius / Math.tan(THREE.MathUtils.degToRad(this.camera.fov) / 2) / FLY_FILL;
-    var fromSide = function (sign) {
-      return [place.centre.clone().addScaledVector(place.normal, sign * distance), place.centre.clone()];
-    };
-    var best = null;
+    var distance = place.size / Math.tan(THREE.MathUtils.degToRad(this.camera.fov) / 2) / FLY_FILL;
+    /* Along the normal from either side, then tilted 40 degrees four ways from each (a face in a hollow, a
+       leg's inside, shows better at a slant); the id pass counts its pixels from each. */
+    var across = new THREE.Vector3().crossVectors(place.normal, Math.abs(place.normal.x) < 0.9 ?
+      new THREE.Vector3(1, 0, 0) : new THREE.Vector3(0, 1, 0)).normalize();
+    var other = new THREE.Vector3().crossVectors(place.normal, across);
+    var directions = [];
     [1, -1].forEach(function (sign) {
-      var eyeTarget = fromSide(sign);
-      this.eye = eyeTarget[0]; this.target = eyeTarget[1];
+      var along = place.normal.clone().multiplyScalar(sign);
+      directions.push(along);
+      [across, other].forEach(function (t) {
+        [1, -1].forEach(function (tilt) { directions.push(along.clone().addScaledVector(t, tilt * 0.84).normalize()); });
+      });
+    });
+    var best = null;
+    directions.forEach(function (direction) {
+      this.eye = place.centre.clone().addScaledVector(direction, distance); this.target = place.centre.clone();
       this.updateProjection();
       var shown = this.facePixels(face);
-      if (best === null || shown > best.shown) { best = { shown: shown, eye: eyeTarget[0], target: eyeTarget[1] }; }
+      if (best === null || shown > best.shown) { best = { shown: shown, eye: this.eye, target: this.target }; }
     }, this);
     var start = this.previous || { eye: best.eye, target: best.target }, flight = this.flight = {};
     this.say("face " + face);
