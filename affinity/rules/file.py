@@ -44,15 +44,19 @@ def no_faces(mesh, settings) -> tuple | None:
 
 
 def _unusable(path: str, image: bool) -> str | None:
-    """Why the resource at ``path`` cannot be used (``"not found"``, ...), or None when it can."""
+    """Why the resource at ``path`` cannot be used (``"not found"``, ``"is a FIFO (named pipe), not a
+    regular file: not read"``, over the side-file budget: an image is read in part, others whole), or None."""
     from ..loaders import LFS_POINTER
     from ..loaders.imagesize import image_size
+    from ..loaders.regular import SIDE_FILE_BUDGET, RefusedFile, open_regular
 
     try:
-        with open(path, "rb") as fh:
+        with open_regular(path, None if image else SIDE_FILE_BUDGET) as fh:
             head = fh.read(len(LFS_POINTER))
     except FileNotFoundError:
         return "not found"
+    except RefusedFile as err:
+        return err.strerror
     except OSError as err:
         return f"cannot be read ({err.strerror or err})"
     if head == LFS_POINTER:
