@@ -983,10 +983,13 @@ class _Assembly:
 def _diffuse_textures(resources: list) -> dict[str, str]:
     """Material -> ``map_Kd`` path: the first library naming a material wins, and within a
     library its last ``map_Kd`` (as a renderer reads the libraries in order)."""
+    by_library: dict[str, dict[str, str]] = {}  # one pass over the maps: linear in the mtllib lines
+    for r in resources:
+        if r.role == "map_Kd":
+            by_library.setdefault(r.library, {})[r.material] = r.path
     textures: dict[str, str] = {}
     for library in (r for r in resources if r.role == "mtllib"):
-        own = {r.material: r.path for r in resources if r.role == "map_Kd" and r.library == library.name}
-        for material, texture in own.items():
+        for material, texture in by_library.get(library.name, {}).items():
             textures.setdefault(material, texture)
     return textures
 
