@@ -47,7 +47,7 @@ batch's image in bands of rows holding about ``batch_fragments`` fragments
 (estimated from the triangles' areas), and by setting quads up in chunks of
 ``SETUP_QUADS``. A scene whose fragments (overdraw) exceed
 ``MAX_FRAGMENTS``, or whose single row holds more than ``MAX_ROW_FRAGMENTS``
-(a row is never split), stops with a ValueError saying so before it is drawn:
+(a row is never split), stops with an ``OverBudget`` error (a ValueError) saying so before it is drawn:
 ten million triangles stacked on one spot would otherwise take hours. These
 Python loops are the only ones: their trip counts grow with the fragment and
 quad counts divided by batch sizes, never per quad or per pixel, and small
@@ -90,9 +90,9 @@ SETUP_QUADS = 1 << 13  # quads set up at once: their temporaries stay small enou
 #: Quads set up and drawn at once: a batch's scene takes about 600 bytes a quad (planes, corners,
 #: screen triangles), so 2^19 quads hold some 300 MB whatever the mesh's size.
 BATCH_QUADS = 1 << 19
-#: Fragments a render may draw in all (about 20 s on one core, at some 50 million a second):
-#: 100 times the pixels of a 4K image. More means quads stacked many deep.
-MAX_FRAGMENTS = 1 << 30
+#: Fragments a render may draw in all (a few seconds: 30 million a second measured on a busy
+#: 2-core machine): 32 times the pixels of a 4K image. More means quads stacked many deep.
+MAX_FRAGMENTS = 1 << 28
 #: Fragments one row of one batch may hold (a band is never narrower than a row): some 1 GB of
 #: per-fragment temporaries.
 MAX_ROW_FRAGMENTS = 1 << 24
@@ -236,7 +236,7 @@ class _Scene:
 
         Bands hold about ``batch_fragments`` fragments each by the estimate of
         ``ScreenTriangles.size`` spread evenly over each triangle's rows; a
-        single row is never split. Triangle indices are increasing. ValueError,
+        single row is never split. Triangle indices are increasing. OverBudget,
         before any band, when the estimate exceeds ``max_fragments`` or one row
         :data:`MAX_ROW_FRAGMENTS`.
         """
@@ -267,11 +267,15 @@ class _Scene:
                 yield int(starts[b]), int(stops[b]), members[limits[b] : limits[b + 1]]
 
 
+class OverBudget(ValueError):
+    """A scene that would take more time or memory than a render's budgets allow."""
+
+
 def _check_overdraw(row_fragments: np.ndarray, max_fragments: float, width: int) -> None:
-    """ValueError when the fragments estimated per row, (H,) float64, are more than a render draws."""
+    """OverBudget when the fragments estimated per row, (H,) float64, are more than a render draws."""
     total, widest = float(row_fragments.sum()), float(row_fragments.max())
     if total > max_fragments or widest > MAX_ROW_FRAGMENTS:
-        raise ValueError(
+        raise OverBudget(
             f"the quads would draw about {total:.3g} fragments ({total / (width * len(row_fragments)):.3g} times the "
             f"image's pixels, up to {widest:.3g} in one row): over the render's budget of {MAX_FRAGMENTS:.3g} "
             f"({MAX_ROW_FRAGMENTS:.3g} a row); the faces are stacked many deep: render a part of the mesh")

@@ -25,7 +25,8 @@ from .shading import OVERLAY_TINT, ShadingInputs, shade, shading_inputs
 
 #: Quads (and triangles) one render draws: on the way to the rasterizer each holds about 1 KB (its
 #: corners, attributes, clip coordinates and route; 985 MB peak measured for a million triangles,
-#: the mesh included), so a render stays near 2 GB; a bigger mesh stops with a ValueError saying so.
+#: the mesh included), so a render stays near 2 GB; a bigger mesh stops with ``render.raster.OverBudget``
+#: (a ValueError) saying so.
 MAX_RENDER_QUADS = 1 << 21
 
 if TYPE_CHECKING:
@@ -226,6 +227,7 @@ def render_mesh(source: str | Mesh | None, options: RenderOptions,
     everything behind the camera, nothing of what ``show`` needs).
     """
     from render import rasterize_quads, to_clip
+    from render.raster import OverBudget
 
     from ..config import file_settings
     from ..loaders import load
@@ -243,7 +245,7 @@ def render_mesh(source: str | Mesh | None, options: RenderOptions,
     sizes = mesh.face_sizes
     drawn = int(np.where(sizes == 4, 1, sizes - 2).sum())  # quads, and triangles of triangles and fans
     if drawn > MAX_RENDER_QUADS:
-        raise ValueError(f"{mesh.path}: {drawn:,} quads and triangles to draw, over the renderer's budget of "
+        raise OverBudget(f"{mesh.path}: {drawn:,} quads and triangles to draw, over the renderer's budget of "
                          f"{MAX_RENDER_QUADS:,} (about 1 KB of memory each): render a part of the mesh")
     faces, corners = render_corners(mesh)
     inputs = shading_inputs(mesh, corners, show)
@@ -262,8 +264,8 @@ def render_mesh(source: str | Mesh | None, options: RenderOptions,
     try:
         frame = rasterize_quads(clip, inputs.attrs, options.width, options.height, method=methods,
                                 cull_backfaces=options.cull)
-    except ValueError as err:  # over the rasterizer's fragment budget: say which mesh
-        raise ValueError(f"{mesh.path}: {err}") from None
+    except OverBudget as err:  # over the rasterizer's fragment budget: say which mesh
+        raise OverBudget(f"{mesh.path}: {err}") from None
     seconds = time.perf_counter() - start
     covered = frame.face >= 0
     if not covered.any():

@@ -196,11 +196,15 @@ def _render(result: MeshResult, texture: np.ndarray | None, step: StepTimer) -> 
                                texture=texture, pixel_tolerance=result.options.pixel_tolerance, **options)
         return render_mesh(result.mesh, chosen, warn)
 
+    from render.raster import OverBudget
+
     step("render hybrid", "renders")
     try:
         hybrid = draw(warn=result.warnings.append, method="hybrid")
     except (ValueError, TextureError) as err:
         result.render_error = str(err)
+        if isinstance(err, OverBudget):  # pyvista would draw the same stack of faces, for minutes
+            result.overview_note = "the mesh is over the renderer's budget (see the render's line)"
         return
     result.renders["hybrid"] = hybrid
     if not (hybrid.methods == MVC).any():
@@ -213,6 +217,8 @@ def _render(result: MeshResult, texture: np.ndarray | None, step: StepTimer) -> 
 def _overview(result: MeshResult, step: StepTimer) -> None:
     from ..view import INSTALL_HINT, overview_image, pyvista_installed
 
+    if result.overview_note:  # left out already, and why
+        return
     if not pyvista_installed():
         result.overview_note = f"pyvista is not installed (the view extra: {INSTALL_HINT})"
         return
