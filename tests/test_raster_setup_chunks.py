@@ -37,14 +37,16 @@ def test_frame_does_not_depend_on_the_setup_chunks(method, monkeypatch):
     assert np.array_equal(whole.depth, chunked.depth)
 
 
-def test_depth_ties_go_to_the_earlier_quad_across_chunks(monkeypatch):
-    # The same square three times, in three chunks: equal depths everywhere, so the first drawn
-    # (quad 0) must own every pixel, as with the depth test "less".
+@pytest.mark.parametrize("one_quad_each", ["SETUP_QUADS", "BATCH_QUADS"])
+@pytest.mark.parametrize("method", ["mvc", "split"])
+def test_depth_ties_go_to_the_earlier_quad_across_chunks_and_batches(monkeypatch, one_quad_each, method):
+    # The same square three times, in three setup chunks or drawing batches: equal depths everywhere,
+    # so the first drawn (quad 0) must own every pixel, as with the depth test "less".
     square = np.array([[[-1, -1, 0.2, 1], [1, -1, 0.2, 1], [1, 1, 0.2, 1], [-1, 1, 0.2, 1]]], dtype=float)
     clip = np.repeat(square, 3, axis=0)
     values = np.arange(3.0)[:, None, None] * np.ones((3, 4, 1))
-    monkeypatch.setattr(render.raster, "SETUP_QUADS", 1)
-    frame = rasterize_quads(clip, values, 8, 8, "mvc")
+    monkeypatch.setattr(render.raster, one_quad_each, 1)
+    frame = rasterize_quads(clip, values, 8, 8, method)
     assert (frame.face == 0).all() and (frame.attrs == 0.0).all()
 
 
@@ -65,14 +67,6 @@ def test_frame_does_not_depend_on_the_quad_batches(method, monkeypatch):
     assert np.array_equal(whole.depth, batched.depth)
     assert whole.fragments == batched.fragments
 
-
-def test_depth_ties_go_to_the_earlier_quad_across_batches(monkeypatch):
-    square = np.array([[[-1, -1, 0.2, 1], [1, -1, 0.2, 1], [1, 1, 0.2, 1], [-1, 1, 0.2, 1]]], dtype=float)
-    clip = np.repeat(square, 3, axis=0)
-    values = np.arange(3.0)[:, None, None] * np.ones((3, 4, 1))
-    monkeypatch.setattr(render.raster, "BATCH_QUADS", 1)
-    frame = rasterize_quads(clip, values, 8, 8, "split")
-    assert (frame.face == 0).all() and (frame.attrs == 0.0).all()
 
 
 def test_quads_stacked_past_the_fragment_budget_stop_with_a_clear_error(monkeypatch):
