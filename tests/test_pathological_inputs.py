@@ -314,3 +314,25 @@ def test_usd_stage_of_many_empty_prims_is_skipped_and_nested_references_are_read
     result = run("check", "--no-cache", "--format", "json", str(tmp_path / "level0.usda"))
     assert result.returncode == 0, result.stderr
     assert json.loads(result.stdout)["files"][0]["quads"] == 1
+
+
+@pytest.mark.skipif(importlib.util.find_spec("pyvista") is None, reason="needs the view extra (pyvista)")
+def test_a_big_face_reaches_vtk_as_its_fan_and_cell_f_stays_face_f():
+    # VTK triangulates a polygon in quadratic time: the report's overview of one 100,000-corner face
+    # took 103 s. A quad, a regular 1,000-gon of circumradius 1 and a triangle: the area is a closed form.
+    import numpy as np
+
+    from affinity.mesh import Mesh
+    from affinity.view import VTK_POLYGON_CORNERS, polydata
+
+    n = 1000
+    angle = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    positions = np.vstack([[[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]],
+                           np.c_[np.cos(angle), np.sin(angle), np.ones(n)], [[5, 5, 5], [6, 5, 5], [5, 6, 5]]])
+    mesh = Mesh(path="three.obj", positions=positions, face_start=np.array([0, 4, 4 + n, 7 + n]),
+                corner_vertex=np.arange(7 + n), face_line=np.array([1, 2, 3]))
+    surface = polydata(mesh)
+    assert n > VTK_POLYGON_CORNERS
+    assert surface.n_cells == 3 + (n - 3)
+    assert surface.area == pytest.approx(1 + n / 2 * np.sin(2 * np.pi / n) + 0.5, rel=1e-12)
+    assert surface.get_cell(0).point_ids == [0, 1, 2, 3] and surface.get_cell(2).point_ids == [4 + n, 5 + n, 6 + n]
