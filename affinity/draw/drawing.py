@@ -216,6 +216,16 @@ def resolve_texture(mesh: Mesh, options: RenderOptions, warn: Callable[[str], No
     return checker()
 
 
+def over_render_budget(mesh: Mesh) -> str | None:
+    """Why ``mesh`` is not drawn (more quads and triangles than :data:`MAX_RENDER_QUADS`), or None."""
+    sizes = mesh.face_sizes
+    drawn = int(np.where(sizes == 4, 1, sizes - 2).sum())  # quads, and triangles of triangles and fans
+    if drawn <= MAX_RENDER_QUADS:
+        return None
+    return (f"{mesh.path}: {drawn:,} quads and triangles to draw, over the renderer's budget of "
+            f"{MAX_RENDER_QUADS:,} (about 1 KB of memory each): render a part of the mesh")
+
+
 def render_mesh(source: str | Mesh | None, options: RenderOptions,
                 warn: Callable[[str], None] = lambda line: None) -> RenderResult:
     """Route, rasterize and shade a mesh: a path to load, a loaded Mesh, or None for the demo.
@@ -242,11 +252,9 @@ def render_mesh(source: str | Mesh | None, options: RenderOptions,
     if mesh.n_faces == 0:
         raise ValueError(f"{mesh.path}: the mesh has no faces to render")
     show = options.show or default_show(mesh)
-    sizes = mesh.face_sizes
-    drawn = int(np.where(sizes == 4, 1, sizes - 2).sum())  # quads, and triangles of triangles and fans
-    if drawn > MAX_RENDER_QUADS:
-        raise OverBudget(f"{mesh.path}: {drawn:,} quads and triangles to draw, over the renderer's budget of "
-                         f"{MAX_RENDER_QUADS:,} (about 1 KB of memory each): render a part of the mesh")
+    problem = over_render_budget(mesh)
+    if problem:
+        raise OverBudget(problem)
     faces, corners = render_corners(mesh)
     inputs = shading_inputs(mesh, corners, show)
     camera = camera_for(mesh, options.width, options.height, options.camera, options.up)

@@ -288,6 +288,7 @@ def collect_mesh(item: MeshInput, settings: Settings, step: Callable[[str], None
 
     ``step`` is called with each step's name as it starts (the progress bar).
     """
+    from ..draw.drawing import over_render_budget
     from ..draw.texture import checker
     from ..pipeline.check import load_and_check
 
@@ -303,17 +304,21 @@ def collect_mesh(item: MeshInput, settings: Settings, step: Callable[[str], None
         result.shown = next(iter(result.scores), None)  # uv, else colours, else normals
         result.texture = _texture_label(result.mesh, item.view, options.texture)
         has_uv = result.mesh.texcoords is not None
-        _view(result)
-        texture = options.texture or (checker(512, item.view.checks) if item.view.checks and has_uv else None)
-        _render(result, texture, timer)
-        if "hybrid" in result.renders:
-            from .stiffness import render_stability
+        result.render_error = over_render_budget(result.mesh)
+        if result.render_error:  # no pictures: framing and drawing it would take gigabytes
+            result.overview_note = "the mesh is over the renderer's budget (see the render's line)"
+        else:
+            _view(result)
+            texture = options.texture or (checker(512, item.view.checks) if item.view.checks and has_uv else None)
+            _render(result, texture, timer)
+            if "hybrid" in result.renders:
+                from .stiffness import render_stability
 
-            timer("stability")
-            result.stability = render_stability(result.renders["hybrid"])
-        _overview(result, timer)
-        if result.mesh.n_faces:
-            _closeups(result, timer)
+                timer("stability")
+                result.stability = render_stability(result.renders["hybrid"])
+            _overview(result, timer)
+            if result.mesh.n_faces:
+                _closeups(result, timer)
     import_in_background(SLOW_IMPORTS).join()  # nothing half-imported is left to the caller
     result.parts = timer.stop()
     result.seconds = time.perf_counter() - start
