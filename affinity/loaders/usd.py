@@ -112,7 +112,7 @@ def _regular_layers(path) -> list:
     or cannot be opened is left to the stage to report."""
     from pxr import Sdf, Tf
 
-    layers, todo, seen = [], [os.path.abspath(path)], set()
+    layers, todo, seen = [], [os.fspath(path)], set()  # the root as the stage names it: opened once
     while todo:
         layer_path = todo.pop()
         if layer_path in seen:
