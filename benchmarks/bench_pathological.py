@@ -210,7 +210,7 @@ def main(argv=None) -> None:
                 seconds, mb, code, last = measured(bad_args)
                 valid_seconds, valid_mb, _, _ = measured(commands(valid, folder)[command])
                 ratios = seconds / valid_seconds, mb / valid_mb
-                outcome = last.split(": ", 1)[-1][:90] if code else "read"
+                outcome = last.replace(scratch + os.sep, "").split(": ", 1)[-1][:90] if code else "read"
                 if code == 0:
                     worst = max(worst, *ratios)
                 lines.append(f"| {case} | {command} | {seconds:.2f}, {mb:.0f}, {code} | {valid_seconds:.2f}, "

@@ -31,9 +31,10 @@ from .regular import open_regular
 #: 2 MB parses in 15% less CPU than 512 KB, and 4 MB gains little more.
 CHUNK_BYTES = 1 << 21
 
-#: The longest line read: a face of some 800,000 ``v/vt/vn`` corners (some 750 MB of parsing
-#: temporaries). A longer one is not a mesh's line, and reading on would hold the file in memory.
-MAX_LINE_BYTES = 16 << 20
+#: The longest line read, two chunks: a face of some 200,000 ``v/vt/vn`` corners. A longer one is
+#: not a mesh's line; parsing it would cost some 45 bytes of temporaries a byte (a 10 MB face line
+#: held 470 MB: five times a chunk's), and reading on would hold the file in memory.
+MAX_LINE_BYTES = 4 << 20
 #: A line this long must open with a statement that may be long (a face of some 3,000 corners);
 #: the bound does not depend on the chunk size, so neither does what a file reads as.
 LONG_LINE_BYTES = 64 << 10
