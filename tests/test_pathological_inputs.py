@@ -336,3 +336,23 @@ def test_a_big_face_reaches_vtk_as_its_fan_and_cell_f_stays_face_f():
     assert surface.n_cells == 3 + (n - 3)
     assert surface.area == pytest.approx(1 + n / 2 * np.sin(2 * np.pi / n) + 0.5, rel=1e-12)
     assert surface.get_cell(0).point_ids == [0, 1, 2, 3] and surface.get_cell(2).point_ids == [4 + n, 5 + n, 6 + n]
+
+
+def test_a_mesh_over_the_render_budget_stops_with_one_line_and_the_report_says_so(tmp_path, monkeypatch):
+    # 1,000 one-triangle faces against a budget of 999: the count is the file's, the cut-off the budget's.
+    import affinity.draw.drawing as drawing
+    from affinity.report.build import MeshInput, ReportOptions, collect_mesh
+    from affinity.settings import Settings
+    from render.raster import OverBudget
+
+    path = write(tmp_path, "stack.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n" + "f 1 2 3\n" * 1000)
+    monkeypatch.setattr(drawing, "MAX_RENDER_QUADS", 999)
+    reason = (f"{path}: 1,000 quads and triangles to draw, over the renderer's budget of 999 (about 1 KB of memory "
+              "each): render a part of the mesh")
+    with pytest.raises(OverBudget) as caught:
+        drawing.render_mesh(str(path), drawing.RenderOptions(width=32, height=24))
+    assert str(caught.value) == reason
+    result = collect_mesh(MeshInput(path=str(path), label="stack"), Settings(), options=ReportOptions(size=(32, 24)))
+    assert result.render_error == reason and not result.renders and result.overview is None
+    monkeypatch.setattr(drawing, "MAX_RENDER_QUADS", 1000)
+    assert len(drawing.render_mesh(str(path), drawing.RenderOptions(width=32, height=24)).faces) == 1000
