@@ -139,11 +139,13 @@ def test_render_draws_with_the_checker_for_a_special_texture_and_says_why(tmp_pa
 
 
 @pytest.mark.parametrize("kind", ["fifo", "device"])
-def test_render_with_a_special_mtllib_draws(tmp_path, kind):
-    special(tmp_path, "lib.mtl", kind)
+def test_render_with_a_special_mtllib_draws_with_the_checker_and_says_why(tmp_path, kind):
+    library = special(tmp_path, "lib.mtl", kind)
     mesh = write(tmp_path, "mesh.obj", TEXTURED.format(mtl="lib.mtl"))
     result = run("render", str(mesh), "-o", str(tmp_path / "out.png"), "--size", "32x24", "-q")
     assert result.returncode == 0, result.stderr
+    assert result.stderr.splitlines() == [
+        f"affinity render: warning: {library}: mtllib {WORDS[kind]}: not read; using the checker texture"]
     assert (tmp_path / "out.png").read_bytes().startswith(b"\x89PNG")
 
 

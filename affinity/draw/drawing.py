@@ -213,6 +213,13 @@ def resolve_texture(mesh: Mesh, options: RenderOptions, warn: Callable[[str], No
             return load_image(path)
         except TextureError as err:
             warn(f"{err}; using the checker texture")
+        return checker()
+    from ..rules.file import unusable_resource
+
+    for library in (r for r in mesh.resources if r.role == "mtllib"):  # why no map_Kd was found
+        problem = unusable_resource(library.path, image=False)
+        if problem:
+            warn(f"{library.path}: mtllib {problem}; using the checker texture")
     return checker()
 
 

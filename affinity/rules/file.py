@@ -43,7 +43,7 @@ def no_faces(mesh, settings) -> tuple | None:
     return np.array([-1]), np.array([1]), np.array([float(len(mesh.positions))])
 
 
-def _unusable(path: str, image: bool) -> str | None:
+def unusable_resource(path: str, image: bool) -> str | None:
     """Why the resource at ``path`` cannot be used (``"not found"``, ``"is a FIFO (named pipe), not a
     regular file: not read"``, over the side-file budget: an image is read in part, others whole), or None."""
     from ..loaders import LFS_POINTER
@@ -115,7 +115,7 @@ def missing_resources(mesh, settings) -> tuple | None:
         if role is None or role.named_in == "usd" or resource.path in seen:
             continue
         seen.add(resource.path)
-        problem = _unusable(resource.path, image=role.image)
+        problem = unusable_resource(resource.path, image=role.image)
         if not problem:
             continue
         lines.append(resource.line)
