@@ -127,25 +127,18 @@ def test_render_refuses_a_special_mesh_and_writes_nothing(tmp_path, kind):
 
 
 @pytest.mark.parametrize("kind", ["fifo", "device"])
-def test_render_draws_with_the_checker_for_a_special_texture_and_says_why(tmp_path, kind):
-    write(tmp_path, "lib.mtl", "newmtl wood\nmap_Kd wood.png\n")
-    texture = special(tmp_path, "wood.png", kind)
+@pytest.mark.parametrize("role", ["mtllib", "map_Kd"])
+def test_render_draws_with_the_checker_for_a_special_side_file_and_says_why(tmp_path, kind, role):
+    if role == "mtllib":
+        side, named = special(tmp_path, "lib.mtl", kind), "mtllib "
+    else:
+        write(tmp_path, "lib.mtl", "newmtl wood\nmap_Kd wood.png\n")
+        side, named = special(tmp_path, "wood.png", kind), ""
     mesh = write(tmp_path, "mesh.obj", TEXTURED.format(mtl="lib.mtl"))
     result = run("render", str(mesh), "-o", str(tmp_path / "out.png"), "--size", "32x24", "-q")
     assert result.returncode == 0, result.stderr
     assert result.stderr.splitlines() == [
-        f"affinity render: warning: {texture}: {WORDS[kind]}: not read; using the checker texture"]
-    assert (tmp_path / "out.png").read_bytes().startswith(b"\x89PNG")
-
-
-@pytest.mark.parametrize("kind", ["fifo", "device"])
-def test_render_with_a_special_mtllib_draws_with_the_checker_and_says_why(tmp_path, kind):
-    library = special(tmp_path, "lib.mtl", kind)
-    mesh = write(tmp_path, "mesh.obj", TEXTURED.format(mtl="lib.mtl"))
-    result = run("render", str(mesh), "-o", str(tmp_path / "out.png"), "--size", "32x24", "-q")
-    assert result.returncode == 0, result.stderr
-    assert result.stderr.splitlines() == [
-        f"affinity render: warning: {library}: mtllib {WORDS[kind]}: not read; using the checker texture"]
+        f"affinity render: warning: {side}: {named}{WORDS[kind]}: not read; using the checker texture"]
     assert (tmp_path / "out.png").read_bytes().startswith(b"\x89PNG")
 
 
