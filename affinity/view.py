@@ -25,8 +25,15 @@ def pyvista_installed() -> bool:
     return importlib.util.find_spec("pyvista") is not None
 
 
+#: Corners of the biggest face VTK gets as a polygon: it triangulates a polygon in quadratic time
+#: (8.6 s for one face of 20,000 corners), so a bigger face goes as the fan the renderer draws.
+VTK_POLYGON_CORNERS = 64
+
+
 def polydata(mesh: Mesh):
-    """The mesh as a ``pyvista.PolyData``, every face kept as the polygon it is.
+    """The mesh as a ``pyvista.PolyData``, cell F being face F: every face kept as the polygon it
+    is, but for faces of more than :data:`VTK_POLYGON_CORNERS` corners, whose cell is the first
+    triangle (corners 0, 1, 2) of their fan, the fan's other triangles appended after the last face.
 
     VTK's face array is ``[n, v0 .. v(n-1), n, ...]``: each face's corner list
     preceded by its size, built here without a loop over faces.
@@ -34,12 +41,23 @@ def polydata(mesh: Mesh):
     import pyvista as pv
 
     sizes = mesh.face_sizes
-    flat = np.empty(len(mesh.corner_vertex) + mesh.n_faces, dtype=np.int64)
-    markers = mesh.face_start[:-1] + np.arange(mesh.n_faces)
+    big = sizes > VTK_POLYGON_CORNERS
+    counts = np.where(big, 3, sizes)
+    first = np.cumsum(counts) - counts
+    corner = np.arange(counts.sum()) - np.repeat(first - mesh.face_start[:-1], counts)  # the corners kept
+    flat = np.empty(len(corner) + mesh.n_faces, dtype=np.int64)
+    markers = first + np.arange(mesh.n_faces)
     is_marker = np.zeros(len(flat), dtype=bool)
     is_marker[markers] = True
-    flat[markers] = sizes
-    flat[~is_marker] = mesh.corner_vertex
+    flat[markers] = counts
+    flat[~is_marker] = mesh.corner_vertex[corner]
+    if big.any():
+        faces = np.flatnonzero(big)
+        rest = sizes[faces] - 3  # triangles (0, i, i + 1) for i = 2 .. n - 2
+        owner = np.repeat(mesh.face_start[faces], rest)
+        i = 2 + np.arange(rest.sum()) - np.repeat(np.cumsum(rest) - rest, rest)
+        fan = np.stack([np.full(len(i), 3), *(mesh.corner_vertex[owner + k] for k in (0, i, i + 1))], axis=1)
+        flat = np.concatenate([flat, fan.ravel()])
     return pv.PolyData(mesh.positions, flat)
 
 
@@ -64,7 +82,7 @@ def build_scene(plotter, mesh: Mesh, scores: QuadScores | None, scalar_bar: bool
         plotter.add_mesh(surface, color=SURFACE_GREY, show_edges=True, edge_color="#6b7280")
         return
     low, top = score_range(scores)
-    per_face = np.full(mesh.n_faces, np.nan)
+    per_face = np.full(surface.n_cells, np.nan)  # the cells past the faces are fans of big faces
     per_face[scores.faces] = np.clip(scores.values, low, top)
     surface.cell_data[scores.unit] = per_face
     plotter.add_mesh(surface, scalars=scores.unit, cmap="viridis", log_scale=True, clim=(low, top),

@@ -40,12 +40,18 @@ The pipeline, all of it vectorised over quads, triangles, rows or fragments:
    from the per-method corner weights of ``render.methods`` and the quad's
    clip-space corners for mvc, bilinear and exact.
 
-Memory is bounded by drawing the image in bands of rows, each holding about
-``batch_fragments`` fragments (estimated from the triangles' areas), and by
-setting quads up in chunks of ``SETUP_QUADS``. These two Python loops are the
-only ones: their trip counts grow with the fragment and quad counts divided by
-batch sizes, never per quad or per pixel, and small batches keep the
-temporaries in cache. (Bands are independent -- every triangle touching a
+Memory is bounded by drawing the quads in batches of ``BATCH_QUADS`` (each set
+up and drawn whole, its winners kept where they are strictly nearer than what
+earlier batches left: the depth test "less", ties to the earlier quad), each
+batch's image in bands of rows holding about ``batch_fragments`` fragments
+(estimated from the triangles' areas), and by setting quads up in chunks of
+``SETUP_QUADS``. A scene whose fragments (overdraw) exceed
+``MAX_FRAGMENTS``, or whose single row holds more than ``MAX_ROW_FRAGMENTS``
+(a row is never split), stops with an ``OverBudget`` error (a ValueError) saying so before it is drawn:
+ten million triangles stacked on one spot would otherwise take hours. These
+Python loops are the only ones: their trip counts grow with the fragment and
+quad counts divided by batch sizes, never per quad or per pixel, and small
+batches keep the temporaries in cache. (Bands are independent -- every triangle touching a
 band is drawn into it -- but drawing them in threads was measured slower
 here: with arrays this small NumPy spends much of its time holding the GIL.)
 """
@@ -81,6 +87,15 @@ NEAR_FAR_PLANES = np.array([[0, 0, 1.0, 1.0], [0, 0, -1.0, 1.0]])  # -w <= z <= 
 SCREEN_PLANES = np.array([[-1.0, 0, 0, 1], [1.0, 0, 0, 1], [0, -1.0, 0, 1], [0, 1.0, 0, 1]])
 DEFAULT_BATCH_FRAGMENTS = 1 << 16
 SETUP_QUADS = 1 << 13  # quads set up at once: their temporaries stay small enough to be reused
+#: Quads set up and drawn at once: a batch's scene takes about 600 bytes a quad (planes, corners,
+#: screen triangles), so 2^19 quads hold some 300 MB whatever the mesh's size.
+BATCH_QUADS = 1 << 19
+#: Fragments a render may draw in all (a few seconds: 30 million a second measured on a busy
+#: 2-core machine): 32 times the pixels of a 4K image. More means quads stacked many deep.
+MAX_FRAGMENTS = 1 << 28
+#: Fragments one row of one batch may hold (a band is never narrower than a row): some 1 GB of
+#: per-fragment temporaries.
+MAX_ROW_FRAGMENTS = 1 << 24
 SHADE_BLOCK = 1 << 14  # pixels shaded at once: temporaries stay in cache
 
 
@@ -137,8 +152,13 @@ def rasterize_quads(
     if not batch_fragments >= 1:
         raise ValueError(f"batch_fragments must be at least 1, got {batch_fragments!r}")
     frame = Frame.empty(height, width, attrs.shape[2])
-    scene = _Scene.build(clip, attrs, method_of_quad, names, width, height, cull_backfaces)
-    frame.fragments = sum(_draw_band(frame, scene, *band) for band in scene.bands(batch_fragments))
+    frame.fragments = 0
+    for first in range(0, clip.shape[0], BATCH_QUADS):
+        batch = slice(first, first + BATCH_QUADS)
+        scene = _Scene.build(clip[batch], attrs[batch], method_of_quad[batch], names, width, height, cull_backfaces)
+        scene.first_quad = first
+        frame.fragments += sum(_draw_band(frame, scene, *band)
+                               for band in scene.bands(batch_fragments, MAX_FRAGMENTS - frame.fragments))
     return frame
 
 
@@ -172,6 +192,7 @@ class _Scene:
     screen: ScreenTriangles
     parent: np.ndarray
     exclusive: np.ndarray
+    first_quad: int = 0  # the index of the batch's first quad among all the call's quads
 
     @classmethod
     def build(cls, clip, attrs, method_of_quad, names, width, height, cull_backfaces):
@@ -210,12 +231,14 @@ class _Scene:
             exclusive=np.concatenate(exclusives),
         )
 
-    def bands(self, batch_fragments):
+    def bands(self, batch_fragments, max_fragments=MAX_FRAGMENTS):
         """Yield (row_start, row_stop, screen-triangle indices) per band of rows.
 
         Bands hold about ``batch_fragments`` fragments each by the estimate of
         ``ScreenTriangles.size`` spread evenly over each triangle's rows; a
-        single row is never split. Triangle indices are increasing.
+        single row is never split. Triangle indices are increasing. OverBudget,
+        before any band, when the estimate exceeds ``max_fragments`` or one row
+        :data:`MAX_ROW_FRAGMENTS`.
         """
         screen, height = self.screen, self.height
         if screen.row0.size == 0:
@@ -224,7 +247,9 @@ class _Scene:
         spread = np.bincount(screen.row0, per_row, height + 1) - np.bincount(
             screen.row1 + 1, per_row, height + 1
         )
-        cumulative = np.cumsum(np.cumsum(spread)[:height])
+        row_fragments = np.cumsum(spread)[:height]
+        _check_overdraw(row_fragments, max_fragments, self.width)
+        cumulative = np.cumsum(row_fragments)
         cuts = np.searchsorted(
             cumulative, np.arange(batch_fragments, cumulative[-1], batch_fragments), side="right"
         )
@@ -240,6 +265,20 @@ class _Scene:
         for b in range(starts.size):
             if limits[b] < limits[b + 1]:
                 yield int(starts[b]), int(stops[b]), members[limits[b] : limits[b + 1]]
+
+
+class OverBudget(ValueError):
+    """A scene that would take more time or memory than a render's budgets allow."""
+
+
+def _check_overdraw(row_fragments: np.ndarray, max_fragments: float, width: int) -> None:
+    """OverBudget when the fragments estimated per row, (H,) float64, are more than a render draws."""
+    total, widest = float(row_fragments.sum()), float(row_fragments.max())
+    if total > max_fragments or widest > MAX_ROW_FRAGMENTS:
+        raise OverBudget(
+            f"the quads would draw about {total:.3g} fragments ({total / (width * len(row_fragments)):.3g} times the "
+            f"image's pixels, up to {widest:.3g} in one row): over the render's budget of {MAX_FRAGMENTS:.3g} "
+            f"({MAX_ROW_FRAGMENTS:.3g} a row); the faces are stacked many deep: render a part of the mesh")
 
 
 def _triangle_setup(clip, attrs, rho, fills_quad, width, height, cull_backfaces):
@@ -349,12 +388,16 @@ def _exclusive_or(scene, selection, pixel, tag, n_pixels) -> np.ndarray:
 def _shade(frame, scene, row, col, triangle):
     """Depth and attributes of the winning fragments at pixels (row, col), (N,) each."""
     width = scene.width
-    quad = triangle >> 1
     flat = row * width + col
     col, row = col.astype(np.float64), row.astype(np.float64)  # once, not in every plane's product
-    frame.face.reshape(-1)[flat] = quad
     depth = evaluate(np.take(scene.depth_planes, triangle, axis=1), col, row)
-    frame.depth.reshape(-1)[flat] = np.clip(depth, -1.0, 1.0, out=depth)
+    np.clip(depth, -1.0, 1.0, out=depth)
+    if scene.first_quad:  # a later batch: only where it is nearer than the batches before
+        nearer = np.flatnonzero(depth < frame.depth.reshape(-1)[flat])
+        flat, col, row, triangle, depth = flat[nearer], col[nearer], row[nearer], triangle[nearer], depth[nearer]
+    quad = triangle >> 1
+    frame.face.reshape(-1)[flat] = quad + scene.first_quad
+    frame.depth.reshape(-1)[flat] = depth
     # One channel at a time: scattering rows of K values is several times slower than K scatters.
     channels = frame.attrs.reshape(scene.height * width, frame.attrs.shape[2]).T
     method = scene.method_of_quad[quad] if len(scene.names) > 1 else None

@@ -41,11 +41,15 @@ def load_image(path: str) -> np.ndarray:
     """Read an image file as (H, W, 3) float32 RGB in [0, 1] (Pillow, imported here)."""
     from PIL import Image, UnidentifiedImageError
 
+    from ..loaders.regular import RefusedFile, open_regular
+
     try:
-        with Image.open(path) as image:
+        with open_regular(path) as fh, Image.open(fh) as image:
             return np.asarray(image.convert("RGB"), dtype=np.float32) / 255.0
     except FileNotFoundError:
         raise TextureError(f"{path}: no such texture file") from None
+    except RefusedFile as err:
+        raise TextureError(f"{path}: {err.strerror}") from None
     except (UnidentifiedImageError, OSError) as err:
         raise TextureError(f"{path}: not a readable image ({err.__class__.__name__})") from None
 

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 
 from ..errors import MeshError, SkippedFile
 from .formats import LOADERS
+from .regular import RefusedFile, open_regular
 
 if TYPE_CHECKING:
     from ..mesh import Mesh
@@ -25,12 +26,13 @@ LFS_POINTER = b"version https://git-lfs.github.com/spec/"
 
 
 def _opened(path, read):
-    """``read(fh)`` of the file at ``path`` opened for bytes; MeshError for a directory or an unreadable file."""
+    """``read(fh)`` of the file at ``path`` opened for bytes; MeshError for a directory, a FIFO,
+    a device or an unreadable file (:func:`.regular.open_regular`), before any byte is read."""
     try:
-        with open(path, "rb") as fh:
+        with open_regular(path) as fh:
             return read(fh)
-    except IsADirectoryError:
-        raise MeshError(path, 0, "is a directory, not a mesh file") from None
+    except RefusedFile as error:
+        raise MeshError(path, 0, error.strerror) from None
     except OSError as error:
         raise MeshError(path, 0, f"cannot read: {error.strerror or error}") from None
 

@@ -9,6 +9,8 @@ from __future__ import annotations
 import os
 import struct
 
+from .regular import open_regular
+
 _PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 # JPEG start-of-frame markers: C0-CF except DHT (C4), JPG (C8) and DAC (CC).
 _JPEG_FRAME_MARKERS = frozenset(range(0xC0, 0xD0)) - {0xC4, 0xC8, 0xCC}
@@ -28,7 +30,7 @@ def image_size(path: str | os.PathLike | None) -> tuple[int, int] | None:
     if path is None:
         return None
     try:
-        with open(path, "rb") as file:
+        with open_regular(path) as file:
             head = file.read(32)
             if head.startswith(_PNG_SIGNATURE) and head[12:16] == b"IHDR":
                 size = struct.unpack(">II", head[16:24])

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import os
 
+from .regular import SIDE_FILE_BUDGET, read_regular
+
 #: ``map_Kd`` options with a fixed number of arguments.
 _FIXED_ARGUMENTS = {
     "-blendu": 1, "-blendv": 1, "-bm": 1, "-boost": 1, "-cc": 1, "-clamp": 1,
@@ -27,8 +29,7 @@ def material_maps(path) -> list[tuple[str, str, str, str]]:
     from .resources import roles_named_in
 
     try:
-        with open(path, "rb") as fh:
-            text = fh.read().decode("utf-8", "replace")
+        text = read_regular(path, SIDE_FILE_BUDGET).decode("utf-8", "replace")
     except OSError:
         return []
     statements = {role.statement: role.name for role in roles_named_in("mtl")}

@@ -287,8 +287,9 @@ def parse_ints(buf, starts, ends):
     Returns
     -------
     values : int64, shaped like ``starts``
-    bad : (n,) int64
-        Flat indices of the tokens that are not integers (``values`` there is 0).
+    bad : (0,) or (1,) int64
+        Flat index of the first token that is not an integer (``values`` is 0 there, and
+        unspecified for the long tokens after it).
     """
     length = ends - starts
     np.minimum(length, 9, out=length)
@@ -312,5 +313,6 @@ def parse_ints(buf, starts, ends):
         except (ValueError, OverflowError):
             bad.append(rest[k])
             signed[k] = 0
+            break  # the first is the error; junk of millions of tokens is not read one by one
     values.reshape(-1)[rest] = signed
     return values, np.array(bad, dtype=np.int64)

@@ -46,8 +46,9 @@ from ..mesh import Mesh
 from .columns import Group, alike_groups
 from .faces import check_indices, color_note, ragged_positions
 from .numbers import PAD, eight_digits, parse_floats, parse_ints
+from .regular import read_regular
 from .resources import obj_resources, uncommented
-from .text import BufferReader, Tokens, floats_or_raise, read_chunks, tokenize
+from .text import BufferReader, NotText, Tokens, floats_or_raise, read_chunks, tokenize
 
 _V, _VT, _VN, _F = 1, 2, 3, 4
 #: Numbers a line of each kind may carry: ``v x y z [w]``, ``v x y z r g b [a]``,
@@ -93,6 +94,16 @@ class _Part:
 #: Chunks parsed in parallel (NumPy releases the GIL inside its loops).
 _WORKERS = 2
 
+#: Every keyword of the OBJ format (Advanced Visualizer manual, Appendix B1), and ``fo``, an
+#: old spelling of ``f``: a chunk holding none of them is not OBJ (prose, a CSV, a log).
+_OBJ_KEYWORDS = frozenset(
+    "v vt vn vp f fo l p cstype deg bmat step curv curv2 surf parm trim hole scrv sp end con g s mg o "
+    "bevel c_interp d_interp lod usemtl mtllib shadow_obj trace_obj ctech stech maplib usemap".split()
+)
+#: Statements that may run longer than a chunk: faces, lines and points of many corners,
+#: free-form lists, group names, comments.
+_LONG_LINE = re.compile(rb"[ \t]*(?:#|(?:fo?|l|p|g|curv2?|surf|parm|trim|hole|scrv|sp|con)[ \t])")
+
 
 def load_obj(path, chunk_bytes: int | None = None, source: bytes | None = None) -> Mesh:
     """Read a Wavefront OBJ file (and the texture maps of its ``mtllib`` files, ``Mesh.resources``).
@@ -105,15 +116,21 @@ def load_obj(path, chunk_bytes: int | None = None, source: bytes | None = None) 
     from concurrent.futures import ThreadPoolExecutor  # here, not at import: off a cached check's path
 
     if source is None:
-        with open(path, "rb") as fh:
-            source = fh.read()
+        source = read_regular(path)
     pending = []
     with ThreadPoolExecutor(_WORKERS) as pool:
         assembly = _Assembly(len(source))
-        for chunk in read_chunks(BufferReader(source), continuations=True, size=chunk_bytes, count_lines=False):
-            pending.append(pool.submit(_parse_chunk, chunk, path))
-            if len(pending) > 2 * _WORKERS:  # bound the chunks held in memory
-                assembly.add(assembly.result(pending.pop(0)))
+        chunks = read_chunks(BufferReader(source), path, continuations=True, size=chunk_bytes, count_lines=False,
+                             long_line=_LONG_LINE)
+        try:
+            for chunk in chunks:
+                pending.append(pool.submit(_parse_chunk, chunk, path))
+                if len(pending) > 2 * _WORKERS:  # bound the chunks held in memory
+                    assembly.add(assembly.result(pending.pop(0)))
+        except NotText as error:  # the lines before the bad bytes speak first; then its line is known
+            for future in pending:
+                assembly.add(assembly.result(future))
+            raise MeshError(path, assembly.n_lines + 1, error.reason) from None
         for future in pending:
             assembly.add(assembly.result(future))
     # Only a file with an mtllib statement has resources: the others' bytes are not searched again.
@@ -152,6 +169,8 @@ def _parse_chunk(chunk, path) -> _Part:
         mtllib=chunk.find(b"mtllib") >= 0,
     )
     statements = np.flatnonzero((counts > 0) & (kind == 0))
+    if len(statements) and not kind.any():
+        _require_statement(tokens, path, statements, chunk.offset)
     if len(statements):
         faces_before = np.cumsum(kind == _F)
         for line in statements:
@@ -161,6 +180,9 @@ def _parse_chunk(chunk, path) -> _Part:
 
 #: Layouts a chunk may hold and still be read as groups of lines laid out alike.
 _ALIKE_LIMIT = 32
+#: The longest line the column reader takes: a layout is read from a group's first line byte by
+#: byte, in Python, so a face of many corners (a line of megabytes) goes to the token reader.
+_ALIKE_LINE_BYTES = 4096
 _TEXT_LINE = re.compile(rb"[\t -~]*\r?\n")
 _OBJ_TOKEN = re.compile(rb"[^ \t\r\n/]+")
 _DECIMAL = re.compile(rb"([-+]?)(\d+)(?:\.(\d+))?")
@@ -257,6 +279,8 @@ def _alike_part(chunk) -> _Part | None:
     begin = np.empty_like(end)
     begin[:1] = PAD
     np.add(end[:-1], 1, out=begin[1:])
+    if (end - begin).max(initial=0) > _ALIKE_LINE_BYTES:
+        return None
     groups = alike_groups(buf, begin, end, _ALIKE_LIMIT)
     if groups is None:
         return None
@@ -674,6 +698,18 @@ def _mixed_faces(tokens: Tokens, path, kind, face_lines):
     return sizes, corners, relative, bounds, _slash_count(layout)
 
 
+def _require_statement(tokens: Tokens, path, lines: np.ndarray, offset: int) -> None:
+    """MeshError unless one of ``lines`` (a chunk's non-blank lines, none of them v/vt/vn/f)
+    opens with an OBJ keyword; looked at until the first that does."""
+    for line in lines:
+        if tokens.text(tokens.first[line]) in _OBJ_KEYWORDS:
+            return
+    size = int(tokens.end[lines[-1]] - tokens.begin[lines[0]])
+    raise MeshError(path, int(tokens.number[lines[0]]),
+                    f"no OBJ statement in the {size:,} bytes at offset {offset + int(tokens.begin[lines[0]]) - PAD:,}:"
+                    f" not an OBJ file")
+
+
 def _statement(tokens: Tokens, path, line, faces_before, part: _Part) -> None:
     """Handle one rare line: ``g``/``o``/``usemtl`` become events (``mtllib`` lines are read from the
     file's bytes with the resources, :func:`affinity.loaders.resources.mtllib_statements`)."""
@@ -947,10 +983,13 @@ class _Assembly:
 def _diffuse_textures(resources: list) -> dict[str, str]:
     """Material -> ``map_Kd`` path: the first library naming a material wins, and within a
     library its last ``map_Kd`` (as a renderer reads the libraries in order)."""
+    by_library: dict[str, dict[str, str]] = {}  # one pass over the maps: linear in the mtllib lines
+    for r in resources:
+        if r.role == "map_Kd":
+            by_library.setdefault(r.library, {})[r.material] = r.path
     textures: dict[str, str] = {}
     for library in (r for r in resources if r.role == "mtllib"):
-        own = {r.material: r.path for r in resources if r.role == "map_Kd" and r.library == library.name}
-        for material, texture in own.items():
+        for material, texture in by_library.get(library.name, {}).items():
             textures.setdefault(material, texture)
     return textures
 

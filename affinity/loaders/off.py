@@ -15,6 +15,7 @@ import numpy as np
 from ..errors import MeshError
 from ..mesh import Mesh
 from .faces import polygon_mesh, ragged_positions, unit_colors
+from .regular import open_regular
 from .text import read_rows
 
 _KEYWORD = re.compile(rb"(ST)?(C)?(N)?OFF")
@@ -22,7 +23,7 @@ _KEYWORD = re.compile(rb"(ST)?(C)?(N)?OFF")
 
 def load_off(path) -> Mesh:
     """Read an ASCII OFF file."""
-    with open(path, "rb") as fh:
+    with open_regular(path) as fh:
         line, prefix, counts = _header(fh, path)
         rows = read_rows(fh, path, line + 1)
     has_st, has_color, has_normal = (bool(p) for p in prefix.groups())

@@ -25,6 +25,7 @@ import numpy as np
 from ..errors import MeshError, SkippedFile
 from ..mesh import Mesh
 from .faces import check_indices, polygon_mesh, ragged_positions, unit_colors, whole_indices
+from .regular import open_regular
 from .text import read_rows
 
 _TYPES = {
@@ -55,7 +56,7 @@ class _Element:
 
 def load_ply(path) -> Mesh:
     """Read a PLY file (ASCII or binary)."""
-    with open(path, "rb") as fh:
+    with open_regular(path) as fh:
         order, elements, header_lines = _header(fh, path)
         if order is None:
             columns = _read_ascii(path, fh, elements, header_lines)

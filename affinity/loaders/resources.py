@@ -162,8 +162,9 @@ def named_files(path: str, data=None) -> list[str]:
     suffix = os.path.splitext(path)[1].lower()
     if suffix == ".obj":
         if data is None:
-            with open(path, "rb") as fh:
-                data = fh.read()
+            from .regular import read_regular
+
+            data = read_regular(path)
         folder = os.path.dirname(path)
         return list(dict.fromkeys(os.path.normpath(os.path.join(folder, name))
                                   for _, name in mtllib_statements(data)))

@@ -4,23 +4,40 @@ A file is read in chunks of whole lines, so memory stays bounded whatever the
 file size; each chunk is split into tokens with one vectorized pass (a token is
 a run of bytes that are not whitespace, nor '/' where asked), and every line
 knows its first token and its 1-based number in the file.
+
+Bytes that cannot be text end the read as they are read (issue 45), before any
+parsing and whatever the file's size: a NUL byte (what a zero-filled file, a
+crashed copy or a preallocated download holds), or a line longer than a chunk
+that does not open with a statement allowed to be that long (text with no
+line breaks), or longer than :data:`MAX_LINE_BYTES`. The error names the
+byte offset in the file.
 """
 
 from __future__ import annotations
 
 import mmap
+import re
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import MeshError
 from .numbers import PAD, parse_floats
+from .regular import open_regular
 
 #: Bytes read per chunk: large enough that per-chunk overhead (and the GIL it holds,
 #: against the other parsing threads) vanishes, small enough that the per-token
 #: temporaries stay in cache-friendly sizes. Measured on a 166 MB OBJ on 2 cores:
 #: 2 MB parses in 15% less CPU than 512 KB, and 4 MB gains little more.
 CHUNK_BYTES = 1 << 21
+
+#: The longest line read, two chunks: a face of some 200,000 ``v/vt/vn`` corners. A longer one is
+#: not a mesh's line; parsing it would cost some 45 bytes of temporaries a byte (a 10 MB face line
+#: held 470 MB: five times a chunk's), and reading on would hold the file in memory.
+MAX_LINE_BYTES = 4 << 20
+#: A line this long must open with a statement that may be long (a face of some 3,000 corners);
+#: the bound does not depend on the chunk size, so neither does what a file reads as.
+LONG_LINE_BYTES = 64 << 10
 
 _NEWLINE, _CR, _SLASH, _HASH, _BACKSLASH = (ord(c) for c in "\n\r/#\\")
 
@@ -36,11 +53,14 @@ class Chunk:
         1-based number of the chunk's first line.
     joined : (j,) int64
         Sorted offsets in ``buf`` of newlines removed by a '\\' continuation.
+    offset : int
+        Byte offset in the file of the chunk's first line (``buf[PAD]``).
     """
 
     buf: np.ndarray
     first_line: int
     joined: np.ndarray
+    offset: int = 0
 
     def _bytearray(self) -> bytearray | None:
         """The bytearray ``buf`` views (as :func:`read_chunks` makes it), else None."""
@@ -74,10 +94,13 @@ def mapped_file(path) -> Mapped | None:
 
     A map shows the file as it is while it is read: a file truncated meanwhile ends the
     process (SIGBUS) instead of reading short; a check reads a file once, right after mapping it.
+    A file whose first bytes hold a NUL (zero-filled) is mapped page by page as read, not
+    whole: its reader stops in the first chunk.
     """
     try:
-        with open(path, "rb") as fh:
-            if hasattr(mmap, "MAP_POPULATE"):  # Linux: every page mapped in one call, not one fault each
+        with open_regular(path) as fh:
+            text = b"\0" not in fh.read(1 << 16)
+            if text and hasattr(mmap, "MAP_POPULATE"):  # Linux: every page mapped in one call, not one fault each
                 return Mapped(fh.fileno(), 0, flags=mmap.MAP_SHARED | mmap.MAP_POPULATE, prot=mmap.PROT_READ)
             return Mapped(fh.fileno(), 0, access=mmap.ACCESS_READ)
     except (OSError, ValueError):
@@ -85,12 +108,15 @@ def mapped_file(path) -> Mapped | None:
 
 
 class BufferReader:
-    """``readinto`` over a bytes-like buffer, for :func:`read_chunks` (``io.BytesIO`` copies
-    any buffer but ``bytes`` whole first)."""
+    """``readinto`` and ``tell`` over a bytes-like buffer, for :func:`read_chunks` (``io.BytesIO``
+    copies any buffer but ``bytes`` whole first)."""
 
     def __init__(self, data):
         self.view = memoryview(data)
         self.offset = 0
+
+    def tell(self) -> int:
+        return self.offset
 
     def readinto(self, into) -> int:
         count = min(len(into), len(self.view) - self.offset)
@@ -99,9 +125,21 @@ class BufferReader:
         return count
 
 
-def read_chunks(fh, first_line: int = 1, continuations: bool = False, size: int | None = None,
-                count_lines: bool = True):
-    """Yield :class:`Chunk` s of whole lines from the binary file object ``fh``.
+class NotText(MeshError):
+    """Bytes that cannot be a text mesh, found while reading (see the module docstring).
+
+    ``offset`` is the byte offset in the file; ``line`` is 0 when the reader does
+    not count lines (the caller knows the lines of the chunks it was given).
+    """
+
+    def __init__(self, path, line: int, offset: int, what: str, hint: str = ""):
+        super().__init__(path, line, f"{what} at offset {offset:,}: not a text mesh{hint}")
+        self.offset = offset
+
+
+def read_chunks(fh, path, first_line: int = 1, continuations: bool = False, size: int | None = None,
+                count_lines: bool = True, long_line: re.Pattern | None = None):
+    """Yield :class:`Chunk` s of whole lines from the binary file object ``fh`` (``readinto``, ``tell``).
 
     With ``continuations`` a '\\' right before a line break joins the two lines
     (the backslash and the break become spaces, so byte offsets and line
@@ -110,24 +148,44 @@ def read_chunks(fh, first_line: int = 1, continuations: bool = False, size: int 
     caller adds the lines of the chunks before; counting them here would cost
     a pass over every chunk on the reading thread). ``size`` defaults to
     :data:`CHUNK_BYTES`, read at call time (tests shrink it).
+
+    Raises :class:`NotText` (naming ``path``) as soon as the bytes read hold a NUL, or
+    a line runs past a chunk and :data:`LONG_LINE_BYTES` without ``long_line`` matching
+    its start (only statements ``long_line`` names may be that long: faces), or past
+    :data:`MAX_LINE_BYTES`. The whole lines before the bad byte are
+    yielded first, so a parse error earlier in the file is found first. Time and
+    memory are those of the bytes read up to there: a long line is read in blocks
+    that double, never copied more than twice over.
     """
     size = CHUNK_BYTES if size is None else size
+    offset = fh.tell()  # of the first byte of ``carry`` in the file
     carry = b""
     line = first_line
     while True:
         head = PAD + len(carry)
-        buf = bytearray(head + size + PAD)
+        block = max(size, len(carry))  # a long line: double the read, linear in the line's length
+        buf = bytearray(head + block + PAD)
         buf[:PAD] = b" " * PAD
         buf[PAD:head] = carry
-        end = head + fh.readinto(memoryview(buf)[head : head + size])
-        if end == head:  # end of file
-            if not carry:
+        end = head + fh.readinto(memoryview(buf)[head : head + block])
+        nul = buf.find(b"\0", head, end)
+        if nul >= 0:
+            end = buf.rfind(b"\n", PAD, nul) + 1 or PAD  # the whole lines before it are read
+            bad_line = line + buf.count(b"\n", PAD, end) if count_lines else 0
+            error = NotText(path, bad_line, offset + nul - PAD, "binary data (byte 0x00)",
+                            " (a zero-filled or damaged file?)")
+        if end == head or nul >= 0:  # end of file, or of its text
+            if end == PAD:
+                if nul >= 0:
+                    raise error
                 return
-            buf[end : end + 1] = b"\n"
-            cut = end + 1
+            if nul < 0:
+                buf[end : end + 1] = b"\n"
+            cut = end + (nul < 0)
         else:
             cut = _last_line_break(buf, end, continuations)
-            if cut == 0:  # one line longer than the chunk: read on
+            if cut == 0:  # one line longer than the chunk: read on, if the format has such lines
+                _check_long_line(buf, end, path, line if count_lines else 0, offset, long_line)
                 carry = bytes(buf[PAD:end])
                 continue
         carry = bytes(buf[cut:end])
@@ -136,9 +194,22 @@ def read_chunks(fh, first_line: int = 1, continuations: bool = False, size: int 
         joined = np.zeros(0, np.int64)
         if continuations and buf.find(b"\\", PAD, cut) >= 0:
             joined = _join_continuations(array, cut - 1)
-        yield Chunk(array, line, joined)
+        yield Chunk(array, line, joined, offset)
+        if nul >= 0:
+            raise error
+        offset += cut - PAD
         if count_lines:
             line += buf.count(b"\n", PAD, cut) + len(joined)
+
+
+def _check_long_line(buf: bytearray, end: int, path, line: int, offset: int, long_line: re.Pattern | None) -> None:
+    """NotText unless the line ``buf[PAD:end]`` (no line break in it) may be read on."""
+    if end - PAD > MAX_LINE_BYTES:
+        raise NotText(path, line, offset, f"a line longer than {MAX_LINE_BYTES >> 20} MiB")
+    if end - PAD < LONG_LINE_BYTES:
+        return
+    if long_line is None or not long_line.match(buf, PAD, end):
+        raise NotText(path, line, offset, f"{end - PAD:,} bytes with no line break and no statement")
 
 
 def _last_line_break(buf: bytearray, end: int, continuations: bool) -> int:
@@ -332,10 +403,14 @@ class Rows(_Ragged):
     values: np.ndarray
 
 
+#: A row of numbers (or a comment) may run longer than a chunk: a face of many corners.
+_LONG_ROW = re.compile(rb"\s*[-+.0-9#]")
+
+
 def read_rows(fh, path, first_line: int) -> Rows:
     """Read the rest of ``fh`` as rows of whitespace-separated numbers ('#' comments allowed)."""
     numbers, counts, values = [], [], []
-    for chunk in read_chunks(fh, first_line):
+    for chunk in read_chunks(fh, path, first_line, long_line=_LONG_ROW):
         tokens = tokenize(chunk, path)
         per_line = tokens.counts
         numbers.append(tokens.number[per_line > 0])

@@ -52,6 +52,7 @@ import numpy as np
 from ..errors import MeshError, SkippedFile
 from ..mesh import Mesh
 from .formats import format_named
+from .regular import not_regular
 from .resources import Resource
 
 USD_SUFFIXES = format_named("usd").suffixes
@@ -108,6 +109,35 @@ def asset_paths(path: str) -> list[str]:
     return [absolute for _, absolute in layer_assets(path)]
 
 
+def _regular_layers(path) -> list:
+    """Every layer the stage at ``path`` composes (its sublayers, references and payloads, and
+    theirs), opened with Sdf after a look at what each is: MeshError naming a layer that is a FIFO,
+    socket or device, which pxr would read without end or wait on forever. A layer that is missing
+    or cannot be opened is left to the stage to report."""
+    from pxr import Sdf, Tf
+
+    layers, todo, seen = [], [os.fspath(path)], set()  # the root as the stage names it: opened once
+    while todo:
+        layer_path = todo.pop()
+        if layer_path in seen:
+            continue
+        seen.add(layer_path)
+        try:
+            reason = not_regular(os.stat(layer_path).st_mode)
+        except (OSError, ValueError):  # missing, or a packaged or resolver path: the stage's to say
+            continue
+        if reason is not None:
+            raise MeshError(path, 0, f"the layer {layer_path} {reason}")
+        try:
+            layer = Sdf.Layer.FindOrOpen(layer_path)
+        except Tf.ErrorException:
+            continue
+        if layer is not None:
+            layers.append(layer)
+            todo += [layer.ComputeAbsolutePath(asset) for asset in layer.GetCompositionAssetDependencies()]
+    return layers
+
+
 def load_usd(path, options: UsdOptions | None = None) -> Mesh:
     """Read every drawn mesh prim of the USD stage at ``path`` as one mesh (see the module docstring).
 
@@ -120,7 +150,9 @@ def load_usd(path, options: UsdOptions | None = None) -> Mesh:
     except ImportError:
         raise MeshError(path, 0, f"reading USD needs usd-core: {INSTALL}") from None
     try:
+        layers = _regular_layers(path)  # held open until the stage is: pxr reads each once
         stage = Usd.Stage.Open(os.fspath(path))
+        del layers
     except Tf.ErrorException as error:
         reason = pxr_reason(error)
         line = _TEXT_LINE.search(reason)  # .usda parse errors say where: "file.usda:7:9: ..."

@@ -202,11 +202,15 @@ def _render(result: MeshResult, texture: np.ndarray | None, step: StepTimer) -> 
                                texture=texture, pixel_tolerance=result.options.pixel_tolerance, **options)
         return render_mesh(result.mesh, chosen, warn)
 
+    from render.raster import OverBudget
+
     step("render hybrid", "renders")
     try:
         hybrid = draw(warn=result.warnings.append, method="hybrid")
     except (ValueError, TextureError) as err:
         result.render_error = str(err)
+        if isinstance(err, OverBudget):  # pyvista would draw the same stack of faces, for minutes
+            result.overview_note = "the mesh is over the renderer's budget (see the render's line)"
         return
     result.renders["hybrid"] = hybrid
     if not (hybrid.methods == MVC).any():
@@ -219,6 +223,8 @@ def _render(result: MeshResult, texture: np.ndarray | None, step: StepTimer) -> 
 def _overview(result: MeshResult, step: StepTimer) -> None:
     from ..view import INSTALL_HINT, overview_image, pyvista_installed
 
+    if result.overview_note:  # left out already, and why
+        return
     if not pyvista_installed():
         result.overview_note = f"pyvista is not installed (the view extra: {INSTALL_HINT})"
         return
@@ -288,6 +294,7 @@ def collect_mesh(item: MeshInput, settings: Settings, step: Callable[[str], None
 
     ``step`` is called with each step's name as it starts (the progress bar).
     """
+    from ..draw.drawing import over_render_budget
     from ..draw.texture import checker
     from ..pipeline.check import load_and_check
 
@@ -304,17 +311,21 @@ def collect_mesh(item: MeshInput, settings: Settings, step: Callable[[str], None
         result.shown = next((code for code in result.scores if code in flagged), next(iter(result.scores), None))
         result.texture = _texture_label(result.mesh, item.view, options.texture)
         has_uv = result.mesh.texcoords is not None
-        _view(result)
-        texture = options.texture or (checker(512, item.view.checks) if item.view.checks and has_uv else None)
-        _render(result, texture, timer)
-        if "hybrid" in result.renders:
-            from .stiffness import render_stability
+        result.render_error = over_render_budget(result.mesh)
+        if result.render_error:  # no pictures: framing and drawing it would take gigabytes
+            result.overview_note = "the mesh is over the renderer's budget (see the render's line)"
+        else:
+            _view(result)
+            texture = options.texture or (checker(512, item.view.checks) if item.view.checks and has_uv else None)
+            _render(result, texture, timer)
+            if "hybrid" in result.renders:
+                from .stiffness import render_stability
 
-            timer("stability")
-            result.stability = render_stability(result.renders["hybrid"])
-        _overview(result, timer)
-        if result.mesh.n_faces:
-            _closeups(result, timer)
+                timer("stability")
+                result.stability = render_stability(result.renders["hybrid"])
+            _overview(result, timer)
+            if result.mesh.n_faces:
+                _closeups(result, timer)
     import_in_background(SLOW_IMPORTS).join()  # nothing half-imported is left to the caller
     result.parts = timer.stop()
     result.seconds = time.perf_counter() - start

@@ -43,16 +43,20 @@ def no_faces(mesh, settings) -> tuple | None:
     return np.array([-1]), np.array([1]), np.array([float(len(mesh.positions))])
 
 
-def _unusable(path: str, image: bool) -> str | None:
-    """Why the resource at ``path`` cannot be used (``"not found"``, ...), or None when it can."""
+def unusable_resource(path: str, image: bool) -> str | None:
+    """Why the resource at ``path`` cannot be used (``"not found"``, ``"is a FIFO (named pipe), not a
+    regular file: not read"``, over the side-file budget: an image is read in part, others whole), or None."""
     from ..loaders import LFS_POINTER
     from ..loaders.imagesize import image_size
+    from ..loaders.regular import SIDE_FILE_BUDGET, RefusedFile, open_regular
 
     try:
-        with open(path, "rb") as fh:
+        with open_regular(path, None if image else SIDE_FILE_BUDGET) as fh:
             head = fh.read(len(LFS_POINTER))
     except FileNotFoundError:
         return "not found"
+    except RefusedFile as err:
+        return err.strerror
     except OSError as err:
         return f"cannot be read ({err.strerror or err})"
     if head == LFS_POINTER:
@@ -112,7 +116,7 @@ def missing_resources(mesh, settings) -> tuple | None:
         if role is None or role.named_in == "usd" or resource.path in seen:
             continue
         seen.add(resource.path)
-        problem = _unusable(resource.path, image=role.image)
+        problem = unusable_resource(resource.path, image=role.image)
         if not problem:
             continue
         lines.append(resource.line)
