@@ -1,12 +1,13 @@
 """Wavefront material (.mtl) files: only what the linter needs, the texture maps per material.
 
 Which statements name texture maps is the resource registry's
-(:func:`affinity.loaders.resources.roles_named_in`): ``map_Kd`` today.
+(:func:`affinity.loaders.resources.roles_named_in`): ``map_Kd``, ``norm``, ``bump`` and the scalar maps.
 """
 
 from __future__ import annotations
 
 import os
+from dataclasses import dataclass
 
 #: ``map_Kd`` options with a fixed number of arguments.
 _FIXED_ARGUMENTS = {
@@ -24,6 +25,28 @@ def material_maps(path) -> list[tuple[str, str, str, str]]:
 
     A missing or unreadable file gives an empty list: materials are optional.
     """
+    return [(statement.role, statement.material, statement.name, statement.path)
+            for statement in map_statements(path)]
+
+
+@dataclass(frozen=True)
+class MapStatement:
+    """One texture map statement of an MTL file: its resource ``role`` (the statement, ``"map_Kd"``),
+    the ``material`` it belongs to, the file ``name`` as written and its ``path`` resolved against the
+    .mtl's folder, and the ``-s`` scale and ``-o`` offset of the texture's u and v (the texture is read at
+    ``uv * scale + offset``; w is not used by a 2-D texture)."""
+
+    role: str
+    material: str
+    name: str
+    path: str
+    scale: tuple[float, float] = (1.0, 1.0)
+    offset: tuple[float, float] = (0.0, 0.0)
+
+
+def map_statements(path) -> list[MapStatement]:
+    """Every texture map statement of the MTL file ``path`` (the roles the resource registry names
+    in MTL files), in file order; a missing or unreadable file gives an empty list."""
     from .resources import roles_named_in
 
     try:
@@ -43,9 +66,12 @@ def material_maps(path) -> list[tuple[str, str, str, str]]:
         if words[0] == "newmtl":
             material = " ".join(words[1:])
         elif words[0] in statements and material is not None:
-            name = texture_file_name(words[1:])
-            maps.append((statements[words[0]], material, name,
-                         os.path.normpath(os.path.join(folder, name.replace("\\", "/")))))
+            name, options = map_arguments(words[1:])
+            scale, offset = options.get("-s", (1.0, 1.0)), options.get("-o", (0.0, 0.0))
+            maps.append(MapStatement(statements[words[0]], material, name,
+                                     os.path.normpath(os.path.join(folder, name.replace("\\", "/"))),
+                                     (scale[0], scale[1] if len(scale) > 1 else 1.0),
+                                     (offset[0], offset[1] if len(offset) > 1 else 0.0)))
     return maps
 
 
@@ -61,17 +87,29 @@ def texture_file_name(arguments: list[str]) -> str:
     >>> texture_file_name(["-s", "1", "1", "1", "-clamp", "on", "wood grain.png"])
     'wood grain.png'
     """
-    k = 0
+    return map_arguments(arguments)[0]
+
+
+def map_arguments(arguments: list[str]) -> tuple[str, dict[str, tuple[float, ...]]]:
+    """The file name of a texture map statement after its options, and its vector options
+    (``-o``, ``-s``, ``-t``) with the numbers given (one to three).
+
+    >>> map_arguments(["-s", "2", "2", "1", "-o", "0.5", "-clamp", "on", "wood grain.png"])
+    ('wood grain.png', {'-s': (2.0, 2.0, 1.0), '-o': (0.5,)})
+    """
+    k, vectors = 0, {}
     while k < len(arguments) - 1 and (arguments[k] in _FIXED_ARGUMENTS or arguments[k] in _VECTOR_OPTIONS):
         option = arguments[k]
         k += 1
         if option in _FIXED_ARGUMENTS:
             k += _FIXED_ARGUMENTS[option]
             continue
-        for _ in range(3):
-            if k < len(arguments) - 1 and _is_number(arguments[k]):
-                k += 1
-    return " ".join(arguments[k:])
+        numbers = []
+        while len(numbers) < 3 and k < len(arguments) - 1 and _is_number(arguments[k]):
+            numbers.append(float(arguments[k]))
+            k += 1
+        vectors[option] = tuple(numbers)
+    return " ".join(arguments[k:]), vectors
 
 
 def _is_number(word: str) -> bool:

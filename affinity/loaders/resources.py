@@ -28,6 +28,8 @@ class ResourceRole:
     named_in : the kind of file whose statements name it: ``"obj"``, ``"mtl"`` or ``"usd"``
     image : the file must be a readable image (PNG, JPEG, BMP, TGA) to be of use
     summary : what the file is for, one line
+    texture : for a texture map, what its texels are (design.md, "Textures by role"): ``"base colour"``,
+        ``"normal"``, ``"height"`` or ``"scalar"``; None for other files
     """
 
     name: str
@@ -35,6 +37,7 @@ class ResourceRole:
     named_in: str
     image: bool = False
     summary: str
+    texture: str | None = None
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -81,8 +84,16 @@ def unregister_role(name: str) -> None:
 
 register_role(ResourceRole(name="mtllib", statement="mtllib", named_in="obj",
                            summary="a Wavefront material library"))
-register_role(ResourceRole(name="map_Kd", statement="map_Kd", named_in="mtl", image=True,
+register_role(ResourceRole(name="map_Kd", statement="map_Kd", named_in="mtl", image=True, texture="base colour",
                            summary="the diffuse colour texture of a material (Q101's texel unit)"))
+register_role(ResourceRole(name="norm", statement="norm", named_in="mtl", image=True, texture="normal",
+                           summary="a tangent-space normal map"))
+for _statement in ("bump", "map_Bump", "map_bump"):
+    register_role(ResourceRole(name=_statement, statement=_statement, named_in="mtl", image=True, texture="height",
+                               summary="a height map (a normal map when its image is one, as Blender writes them)"))
+for _statement in ("map_Ks", "map_Ns", "map_Pr", "map_Pm", "map_Ke", "map_d", "disp"):
+    register_role(ResourceRole(name=_statement, statement=_statement, named_in="mtl", image=True, texture="scalar",
+                               summary="a scalar or secondary colour map of a material"))
 register_role(ResourceRole(name="usd-asset", statement="sublayer, reference or payload", named_in="usd",
                            summary="a layer a USD stage composes"))
 

@@ -97,6 +97,13 @@ class Finding:
     group: str
     message: str
     prim: str | None = None
+    shift: float | None = None
+    bound: str | None = None
+    texture: str | None = None
+    role: str | None = None
+
+    #: The fields of Q101's visible reading (design.md): set where C was read through a texture.
+    VISIBLE = ("shift", "bound", "texture", "role")
 
 
 def writer(name: str):
@@ -117,6 +124,7 @@ def _rows(report: FileReport, hits: RuleHits, take: np.ndarray) -> list[tuple[in
     faces, groups, lines = hits.faces[take], hits.groups[take], hits.lines[take]
     unit = hits.unit if hits.unit is not None else rule.unit
     details = [None] * len(faces) if hits.details is None else [hits.details[k] for k in np.arange(len(hits))[take]]
+    visible = _visible_fields(hits, take, report.path)
     usd = report.prim_face_start is not None
     if usd:  # no lines; faces count within their prim (the file-level face -1 stays -1)
         faces, lines = faces - report.prim_face_start[groups], np.zeros_like(lines)
@@ -129,18 +137,42 @@ def _rows(report: FileReport, hits: RuleHits, take: np.ndarray) -> list[tuple[in
             name=rule.name,
             face=int(face),
             value=float(value),
-            threshold=threshold,
-            unit=unit,
+            threshold=seen.pop("threshold", threshold),
+            unit=seen.pop("unit", unit),
             level=level,
             group=group_name(report, g),
-            message=rule.summary if detail is None else f"{rule.summary}: {detail}",
+            message=": ".join(filter(None, [rule.summary, seen.pop("remark", None), detail])),
             prim=group_name(report, g) if usd and order >= 0 else None,
+            **seen,
         ))
-        for order, face, line, value, g, detail, level in zip(
+        for order, face, line, value, g, detail, level, seen in zip(
             hits.faces[take].tolist(), faces.tolist(), lines.tolist(),
-            hits.values[take].tolist(), groups.tolist(), details, hits.levels()[take].tolist(),
+            hits.values[take].tolist(), groups.tolist(), details, hits.levels()[take].tolist(), visible,
         )
     ]
+
+
+def _visible_fields(hits: RuleHits, take: np.ndarray, path: str) -> list[dict]:
+    """Per finding at ``take``: the Finding fields Q101's visible reading sets (``threshold``, ``unit``,
+    ``shift``, ``bound``, ``texture``, ``role``) and the message's ``remark``; empty where C was not read."""
+    from ..textures.visible import BOUND_NAMES
+
+    columns = hits.visible
+    if columns is None:
+        return [{} for _ in range(len(hits.faces[take]))]
+    folder = os.path.dirname(path)
+    rows = []
+    for shift, bound, pick in zip(columns.shifts[take].tolist(), columns.bounds[take].tolist(),
+                                  columns.picks[take].tolist()):
+        if pick < 0 or shift != shift:  # no texture read (NaN shift)
+            rows.append({})
+            continue
+        texture = os.path.relpath(columns.textures[pick], folder) if folder else columns.textures[pick]
+        rows.append({"threshold": columns.limits[1], "unit": columns.units[pick], "shift": shift,
+                     "bound": BOUND_NAMES.get(bound), "texture": texture, "role": columns.roles[pick],
+                     "remark": f"the split shifts the {columns.roles[pick]} texture {texture} by "
+                               f"{format_value(shift)} texels"})
+    return rows
 
 
 def severity(f: Finding) -> tuple[int, float]:
@@ -249,8 +281,8 @@ def describe(f: Finding) -> str:
     """
     if not f.unit:
         return f.message
-    measured = (format_value(f.value) if f.threshold is None
-                else f"{format_value(f.value)} vs {format_value(f.threshold)}")
+    value = {"at least": ">=", "at most": "<="}.get(f.bound, "") + format_value(f.value)
+    measured = value if f.threshold is None else f"{value} vs {format_value(f.threshold)}"
     return f"{f.message} ({with_unit(measured, f.unit)})"
 
 

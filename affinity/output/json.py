@@ -10,7 +10,8 @@ Document layout::
                 | {"path", "error", "line"} | {"path", "skipped"}],
       "findings": [{"path", "line", "column", "code", "name", "face", "value",
                     "threshold", "unit", "level", "group", "message", Q101-Q103 only: "measure",
-                    USD only: "prim"}],
+                    USD only: "prim", Q101 read through a texture: "shift", "texture", "role",
+                    and "bound" ("at least" or "at most") where C is a bound}],
       "summary": {"files", "checked", "unreadable", "skipped", "findings",
                   "baselined", "by_rule": {"Q101": n, ...}, "by_level": {"warning": n, ...}},
       with --max-findings N: "truncated": [{"path", "code", "kept", "total"}],
@@ -62,8 +63,9 @@ def _file_entry(report: FileReport) -> dict:
 
 def _finding_entry(f: Finding, settings) -> dict:
     entry = dataclasses.asdict(f)
-    if f.prim is None:
-        del entry["prim"]
+    for name in ("prim", *Finding.VISIBLE):
+        if entry[name] is None:
+            del entry[name]
     measure = settings.measure_of(f.code)
     if measure is not None:
         entry["measure"] = measure

@@ -115,7 +115,8 @@ def _result(f: Finding, ordinal: int, location: dict, rule_index: int) -> dict:
         "partialFingerprints": {FINGERPRINT: fingerprint(f.code, location["uri"], f.group, f.value, ordinal)},
         "properties": {"name": f.name, "face": f.face, "value": f.value,
                        "threshold": f.threshold, "unit": f.unit, "level": f.level, "group": f.group,
-                       **({} if f.prim is None else {"prim": f.prim})},
+                       **({} if f.prim is None else {"prim": f.prim}),
+                       **{name: getattr(f, name) for name in Finding.VISIBLE if getattr(f, name) is not None}},
     }
 
 

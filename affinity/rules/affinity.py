@@ -71,7 +71,7 @@ def uv_disaffinity(quads) -> tuple:
     diagonal = quads.settings.diagonal
     if quads.settings.measure == "barycentric":
         return rows, barycentric_score(quads.planar.take(rows), quads.uv_planar, diagonal)
-    return rows, texels(quads.split_error(rows, uv).T, quads.texture_size)
+    return rows, texels(quads.split_error(rows, uv).T, quads.texel_size(rows))
 
 
 @rule(code="Q102", name="color-disaffine", unit="1/255", default_threshold=2.0, visible_threshold=8.0, attribute="colors", scored=True,

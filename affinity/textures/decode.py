@@ -1,0 +1,136 @@
+"""Decode a texture once per run, within a pixel budget checked against its header first.
+
+A texture whose header claims more than :data:`DECODE_BUDGET` pixels is never
+decoded (a 100,000 x 100,000 PNG header would ask for 30 GB); decoded textures
+are kept as (H, W, C) uint8, at most :data:`CACHE_BYTES` of them at a time
+(least recently used dropped first), keyed by path, size and modification time,
+so each texture is decoded once per run however many meshes or rules read it.
+Peak memory for textures: :data:`CACHE_BYTES` plus one texture being decoded
+(at most ``DECODE_BUDGET x 4`` bytes) and its min/max pyramid (2/3 of it).
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+from collections import OrderedDict
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+
+from ..loaders.imagesize import ImageHeader, ImageUnreadable, open_image_file, read_header
+
+#: Pixels (width x height) a texture may have to be decoded: 8192 x 8192.
+DECODE_BUDGET = 1 << 26
+#: Decoded texture bytes kept between meshes of one run.
+CACHE_BYTES = 1 << 29
+#: Formats Pillow decodes; an EXR's size comes from its header, its texels are not read.
+_DECODED_FORMATS = frozenset(["PNG", "JPEG", "BMP", "TGA", "TIFF", "DDS"])
+
+
+class TextureUnusable(Exception):
+    """A texture that is not decoded; the message is the reason, for a note, and ``header`` what its
+    header says (None when it cannot be read)."""
+
+    def __init__(self, reason: str, header: ImageHeader | None = None):
+        super().__init__(reason)
+        self.header = header
+
+
+@dataclass(frozen=True, eq=False)
+class DecodedTexture:
+    """A decoded texture.
+
+    Attributes
+    ----------
+    path : the file
+    header : what its header says (format and size)
+    pixels : (H, W, C) uint8, read-only; C is 1 (grey), 2 (grey, alpha), 3 (RGB) or 4 (RGBA); row 0 the top
+    """
+
+    path: str
+    header: ImageHeader
+    pixels: np.ndarray
+
+    @cached_property
+    def pyramid(self):
+        """The texture's min/max pyramid (:class:`~affinity.textures.filtering.RangePyramid`), built once."""
+        from .filtering import RangePyramid
+
+        return RangePyramid(self.pixels)
+
+    @cached_property
+    def looks_like_normal_map(self) -> bool:
+        """Three or more channels with blue dominant, as a tangent-space normal map (flat: 128, 128, 255)."""
+        if self.pixels.shape[2] < 3:
+            return False
+        step = max(1, int(np.sqrt(self.pixels.shape[0] * self.pixels.shape[1] / 65536)))
+        red, green, blue = self.pixels[::step, ::step, :3].reshape(-1, 3).mean(axis=0)
+        return blue >= 0.7 * 255 and blue > red and blue > green
+
+
+_cache: OrderedDict = OrderedDict()
+_cache_lock = threading.Lock()
+
+
+def header_or_reason(path: str) -> tuple[ImageHeader | None, str | None]:
+    """The header of the texture ``path``, or None and why not (``"missing"``, ``"a Git LFS pointer"``, ...)."""
+    try:
+        return read_header(path), None
+    except ImageUnreadable as err:
+        return None, str(err)
+
+
+def decode(path: str, budget: int = DECODE_BUDGET) -> DecodedTexture:
+    """The texture at ``path`` decoded (cached for the run, see the module's notes).
+
+    Raises :class:`TextureUnusable` naming why it is not decoded: no readable header, more pixels
+    than ``budget``, a format not decoded here, or a file that does not decode.
+    """
+    header, reason = header_or_reason(path)
+    if header is None:
+        raise TextureUnusable(reason)
+    if header.pixels > budget:
+        raise TextureUnusable(f"{header.width}x{header.height} is over the decode budget of "
+                              f"{budget:,} pixels, not decoded", header)
+    if header.format not in _DECODED_FORMATS:
+        raise TextureUnusable(f"{header.format} texels are not decoded", header)
+    try:
+        stat = os.stat(path)
+    except OSError as err:
+        raise TextureUnusable(f"not readable ({err.__class__.__name__})", header) from None
+    key = (os.path.realpath(path), stat.st_size, stat.st_mtime_ns)
+    with _cache_lock:
+        if key in _cache:
+            _cache.move_to_end(key)
+            return _cache[key]
+    texture = DecodedTexture(path, header, _decode_pixels(path, header))
+    with _cache_lock:
+        _cache[key] = texture
+        while sum(t.pixels.nbytes for t in _cache.values()) > CACHE_BYTES and len(_cache) > 1:
+            _cache.popitem(last=False)
+    return texture
+
+
+def _decode_pixels(path: str, header: ImageHeader) -> np.ndarray:
+    """(H, W, C) uint8 of an image whose header was checked against the budget."""
+    from PIL import Image, UnidentifiedImageError
+
+    try:
+        with open_image_file(path) as file, Image.open(file) as image:
+            if image.size != header.size:
+                raise TextureUnusable(f"its header and its decoder disagree on the size ({image.size})", header)
+            bands = image.getbands()
+            mode = ("RGBA" if "A" in bands else "RGB") if len(bands) >= 3 else ("LA" if "A" in bands else "L")
+            if image.mode in ("I;16", "I;16B", "I;16L", "I"):  # 16-bit grey: keep the top 8 bits
+                array = (np.asarray(image, dtype=np.uint32) >> 8).astype(np.uint8)
+            else:
+                array = np.asarray(image.convert(mode), dtype=np.uint8)
+    except TextureUnusable:
+        raise
+    except (UnidentifiedImageError, OSError, ValueError, Image.DecompressionBombError) as err:
+        raise TextureUnusable(f"does not decode ({err.__class__.__name__})", header) from None
+    array = array.reshape(*array.shape[:2], -1)
+    array.flags.writeable = False
+    return array
