@@ -82,20 +82,31 @@ def header_or_reason(path: str) -> tuple[ImageHeader | None, str | None]:
         return None, str(err)
 
 
+def why_not_decoded(path: str | None, budget: int = DECODE_BUDGET) -> str | None:
+    """Why :func:`decode` would refuse ``path``, read from its header alone (no path, no readable header,
+    over ``budget``, a format not decoded), else None. A file whose header is fine may still fail to decode."""
+    if path is None:
+        return "no texture"
+    header, reason = header_or_reason(path)
+    if header is None:
+        return reason
+    if header.pixels > budget:
+        return f"{header.width}x{header.height} is over the decode budget of {budget:,} pixels"
+    if header.format not in _DECODED_FORMATS:
+        return f"{header.format} texels are not decoded"
+    return None
+
+
 def decode(path: str, budget: int = DECODE_BUDGET) -> DecodedTexture:
     """The texture at ``path`` decoded (cached for the run, see the module's notes).
 
     Raises :class:`TextureUnusable` naming why it is not decoded: no readable header, more pixels
     than ``budget``, a format not decoded here, or a file that does not decode.
     """
-    header, reason = header_or_reason(path)
-    if header is None:
-        raise TextureUnusable(reason)
-    if header.pixels > budget:
-        raise TextureUnusable(f"{header.width}x{header.height} is over the decode budget of "
-                              f"{budget:,} pixels, not decoded", header)
-    if header.format not in _DECODED_FORMATS:
-        raise TextureUnusable(f"{header.format} texels are not decoded", header)
+    header, _ = header_or_reason(path)
+    refused = why_not_decoded(path, budget)
+    if refused is not None:
+        raise TextureUnusable(refused + (", not decoded" if header is not None else ""), header)
     try:
         stat = os.stat(path)
     except OSError as err:

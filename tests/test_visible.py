@@ -1,0 +1,144 @@
+"""Q101's visible reading (design.md, "The visible reading") against an independent dense C.
+
+The reference here shares no code with ``affinity.textures``: the mesh is read by a
+few lines of its own, the texture decoded by Pillow and filtered by SciPy's
+``map_coordinates`` (order 1, wrapping), each quad projected onto its own plane with
+NumPy, and the split's uv taken from the affine map of the triangle (solved with
+``np.linalg.solve``) that holds the point. C is the largest difference over a dense
+(s, t) grid, refined around its largest samples.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+TEXTURED = Path(__file__).resolve().parents[2] / "shared" / "meshes" / "textured"
+SPOT = TEXTURED / "spot_control_mesh_textured.obj"
+#: Reference samples per texel of a quad's uv extent, per side (at most REFERENCE_CAP per side).
+REFERENCE_PER_TEXEL, REFERENCE_CAP = 3, 320
+
+
+def read_obj(path: Path) -> tuple[np.ndarray, np.ndarray, list[list[tuple[int, int]]]]:
+    """Positions (V, 3), uv (T, 2) and faces as (v, vt) 0-based pairs, from ``v``, ``vt`` and ``f`` lines."""
+    positions, uv, faces = [], [], []
+    for line in path.read_text().splitlines():
+        words = line.split()
+        if words[:1] == ["v"]:
+            positions.append([float(x) for x in words[1:4]])
+        elif words[:1] == ["vt"]:
+            uv.append([float(x) for x in words[1:3]])
+        elif words[:1] == ["f"]:
+            faces.append([tuple(int(i) - 1 for i in corner.split("/")[:2]) for corner in words[1:]])
+    return np.array(positions), np.array(uv), faces
+
+
+def in_plane(p: np.ndarray) -> np.ndarray:
+    """(4, 2) corners in the quad's plane: normal from the diagonals' cross product, through the centroid."""
+    normal = np.cross(p[2] - p[0], p[3] - p[1])
+    normal /= np.linalg.norm(normal)
+    e1 = (p[1] - p[0]) - np.dot(p[1] - p[0], normal) * normal
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(normal, e1)
+    centred = p - p.mean(axis=0)
+    return np.stack([centred @ e1, centred @ e2], axis=1)
+
+
+def filtered(image: np.ndarray, uv: np.ndarray) -> np.ndarray:
+    """(N, C) bilinear samples of ``image`` (H, W, C) float64 at OpenGL uv (N, 2), repeating."""
+    from scipy.ndimage import map_coordinates
+
+    height, width = image.shape[:2]
+    rows, columns = (1 - uv[:, 1]) * height - 0.5, uv[:, 0] * width - 0.5
+    return np.stack([map_coordinates(image[:, :, c], [rows, columns], order=1, mode="grid-wrap")
+                     for c in range(image.shape[2])], axis=1)
+
+
+def split_uv(q: np.ndarray, uv: np.ndarray, points: np.ndarray, triangles) -> np.ndarray:
+    """The split's uv at ``points`` (N, 2): each point in the triangle of ``triangles`` holding it most."""
+    weights = []
+    for triangle in triangles:
+        corners = np.c_[q[list(triangle)], np.ones(3)].T  # (3, 3): columns (x, y, 1) of the corners
+        weights.append(np.linalg.solve(corners, np.c_[points, np.ones(len(points))].T).T)  # (N, 3)
+    deeper = weights[0].min(axis=1) >= weights[1].min(axis=1)
+    return np.where(deeper[:, None], weights[0] @ uv[list(triangles[0])], weights[1] @ uv[list(triangles[1])])
+
+
+def crease(image, q, uv, s, t) -> np.ndarray:
+    """(N,) largest channel difference (0-255) between the two splits' uv and the bilinear uv at (s, t)."""
+    w = np.stack([(1 - s) * (1 - t), s * (1 - t), s * t, (1 - s) * t], axis=1)
+    points, exact = w @ q, w @ uv
+    reference = filtered(image, exact)
+    return np.max([np.abs(filtered(image, split_uv(q, uv, points, triangles)) - reference).max(axis=1)
+                   for triangles in (((0, 1, 2), (0, 2, 3)), ((1, 2, 3), (1, 3, 0)))], axis=0)
+
+
+def dense_c(image: np.ndarray, p: np.ndarray, uv: np.ndarray) -> float:
+    """C of one quad (both diagonals, the worse), dense: a grid of REFERENCE_PER_TEXEL samples per texel
+    of the uv extent, then a 33 x 33 grid over the two cells around each of the 8 largest samples."""
+    q = in_plane(p)
+    height, width = image.shape[:2]
+    extent = max(np.ptp(uv[:, 0]) * width, np.ptp(uv[:, 1]) * height)
+    n = int(min(REFERENCE_CAP, max(64, np.ceil(REFERENCE_PER_TEXEL * extent))))
+    s, t = (a.ravel() for a in np.meshgrid(np.linspace(0, 1, n + 1), np.linspace(0, 1, n + 1)))
+    values = crease(image, q, uv, s, t)
+    best = np.argsort(values)[-8:]
+    offsets = np.linspace(-1.0 / n, 1.0 / n, 33)
+    ds, dt = (a.ravel() for a in np.meshgrid(offsets, offsets))
+    local_s = np.clip(s[best][:, None] + ds, 0, 1).ravel()
+    local_t = np.clip(t[best][:, None] + dt, 0, 1).ravel()
+    return float(max(values.max(), crease(image, q, uv, local_s, local_t).max()))
+
+
+def check_json(*args) -> dict:
+    result = subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--format", "json", "--no-cache", *args],
+                            capture_output=True, text=True)
+    assert result.returncode in (0, 1), result.stderr
+    return json.loads(result.stdout)
+
+
+@pytest.mark.skipif(not SPOT.exists(), reason="../shared/meshes/textured is not in this checkout")
+def test_spot_c_matches_a_dense_independent_reading():
+    """Every Q101 finding on Spot with its own texture: C within 1/255 of the dense reading, or a correct
+    bound; every error visible (C >= 8/255); no visible quad (C >= 8/255) without a warning or error."""
+    from PIL import Image
+
+    image = np.asarray(Image.open(TEXTURED / "spot_texture.png").convert("RGB"), dtype=np.float64)
+    positions, uv, faces = read_obj(SPOT)
+    findings = check_json("--select", "Q101", str(SPOT))["findings"]
+    assert all(f["unit"] == "1/255" and f["role"] == "base colour" and f["texture"] == "spot_texture.png"
+               and f["shift"] >= 0.5 for f in findings)
+    wrong, levels = [], {"error": 0, "warning": 0, "info": 0}
+    for f in findings:
+        corners = faces[f["face"]]
+        reference = dense_c(image, positions[[v for v, _ in corners]], uv[[t for _, t in corners]])
+        bound = f.get("bound")
+        if bound == "at least":
+            right = f["value"] >= 8 and reference >= f["value"] - 1
+        elif bound == "at most":
+            right = reference <= f["value"] + 1e-6 and f["value"] - reference <= 1
+        else:
+            right = abs(f["value"] - reference) <= 1
+        if not right:
+            wrong.append((f["face"], f["value"], bound, reference))
+        if f["level"] == "error":
+            assert reference >= 8, (f["face"], reference)
+        if reference >= 8:
+            assert f["level"] in ("error", "warning"), (f["face"], reference)
+        levels[f["level"]] += 1
+    assert not wrong, wrong
+    assert levels["error"] > 50 and levels["info"] > 20  # the texture hides many shifts, shows many more
+
+
+@pytest.mark.skipif(not SPOT.exists(), reason="../shared/meshes/textured is not in this checkout")
+def test_spot_text_output_names_the_texture_and_marks_bounds():
+    result = subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--no-cache", "--select", "Q101",
+                             "--verbose", str(SPOT)], capture_output=True, text=True)
+    lines = [line for line in result.stdout.splitlines() if " Q101 " in line]
+    assert lines and all("base colour texture spot_texture.png" in line for line in lines)
+    assert any("(>=" in line and "vs 2/255)" in line for line in lines)
