@@ -146,7 +146,30 @@ def load_usd(path, options: UsdOptions | None = None) -> Mesh:
     mesh.notes = notes
     mesh.resources = [Resource(role="usd-asset", name=asset, path=os.path.normpath(absolute))
                       for asset, absolute in layer_assets(path)]
+    _bind_materials(mesh, prims, options.uv_primvar)
     return mesh
+
+
+def _bind_materials(mesh: Mesh, prims: list, uv_primvar: str | None) -> None:
+    """Each prim's bound material (``material_names``, ``face_material`` per prim) and the textures it reads
+    through the uv primvar (``material_maps``, :mod:`affinity.loaders.usdmaterials`)."""
+    from pxr import Tf
+
+    from .usdmaterials import prim_material_maps
+
+    names, per_prim = [], []
+    for prim in prims:
+        try:
+            material, maps = prim_material_maps(prim, uv_primvar)
+        except Tf.ErrorException:
+            material, maps = None, []
+        if material is not None and material not in names:
+            names.append(material)
+            mesh.material_maps[material] = maps
+        per_prim.append(names.index(material) if material is not None else -1)
+    mesh.material_names = names
+    sizes = np.diff(mesh.prim_face_start)
+    mesh.face_material = np.repeat(np.asarray(per_prim, dtype=np.int32), sizes)
 
 
 def _stage_metadata(stage, name: str, read, notes: list[str]):

@@ -160,14 +160,14 @@ def _visible_fields(hits: RuleHits, take: np.ndarray, path: str) -> list[dict]:
     columns = hits.visible
     if columns is None:
         return [{} for _ in range(len(hits.faces[take]))]
-    folder = os.path.dirname(path)
+    folder = os.path.dirname(os.path.abspath(path))
     rows = []
     for shift, bound, pick in zip(columns.shifts[take].tolist(), columns.bounds[take].tolist(),
                                   columns.picks[take].tolist()):
         if pick < 0 or shift != shift:  # no texture read (NaN shift)
             rows.append({})
             continue
-        texture = os.path.relpath(columns.textures[pick], folder) if folder else columns.textures[pick]
+        texture = os.path.relpath(os.path.abspath(columns.textures[pick]), folder)
         rows.append({"threshold": columns.limits[1], "unit": columns.units[pick], "shift": shift,
                      "bound": BOUND_NAMES.get(bound), "texture": texture, "role": columns.roles[pick],
                      "remark": f"the split shifts the {columns.roles[pick]} texture {texture} by "
