@@ -21,6 +21,23 @@ def test_sampling_between_texels_averages_and_wraps():
     np.testing.assert_allclose(sample_bilinear(image, np.array([[0.5, 0.75]])), 0.5)
 
 
+@pytest.mark.parametrize("channels", [1, 3, 4])
+def test_packed_sampling_is_bilinear_filtering_of_the_texels(channels):
+    """The lint's packed sampler: texel centres give the texels, midpoints the mean of their neighbours,
+    repeating past the edges (closed forms on random uint8 texels)."""
+    from affinity.textures.filtering import PackedTexture
+
+    pixels = np.random.default_rng(2).integers(0, 256, (5, 7, channels), dtype=np.uint8)
+    packed = PackedTexture(pixels)
+    rows, cols = np.meshgrid(np.arange(5), np.arange(7), indexing="ij")
+    centres = np.stack([(cols + 0.5) / 7, 1 - (rows + 0.5) / 5], axis=-1).reshape(-1, 2)
+    np.testing.assert_allclose(packed.sample(centres), pixels.reshape(-1, channels), atol=1e-4)
+    np.testing.assert_allclose(packed.sample(centres + [1.0, -2.0]), pixels.reshape(-1, channels), atol=1e-4)
+    between = np.array([[1.0 / 7, 1 - 0.5 / 5]])  # between the first two texels of the top row
+    np.testing.assert_allclose(packed.sample(between), (pixels[0, :1].astype(float) + pixels[0, 1:2]) / 2,
+                               atol=1e-4)
+
+
 def test_checker_alternates():
     image = checker(64, checks=4)
     assert image.shape == (64, 64, 3)

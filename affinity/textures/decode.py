@@ -61,6 +61,25 @@ class DecodedTexture:
         return RangePyramid(self.pixels)
 
     @cached_property
+    def slopes(self):
+        """The pyramid of the texture's steps (:class:`~affinity.textures.filtering.RangePyramid` of (H, W, 2)
+        uint8): the largest channel difference from each texel to the next column and to the next row,
+        wrapping; bilinear filtering changes by at most their sum per texel moved."""
+        from .filtering import RangePyramid
+
+        pixels = self.pixels.astype(np.int16)
+        across = np.abs(np.roll(pixels, -1, axis=1) - pixels).max(axis=2)
+        down = np.abs(np.roll(pixels, -1, axis=0) - pixels).max(axis=2)
+        return RangePyramid(np.stack([across, down], axis=-1).astype(np.uint8))
+
+    @cached_property
+    def packed(self):
+        """The texels packed for sampling (:class:`~affinity.textures.filtering.PackedTexture`), built once."""
+        from .filtering import PackedTexture
+
+        return PackedTexture(self.pixels)
+
+    @cached_property
     def looks_like_normal_map(self) -> bool:
         """Three or more channels with blue dominant, as a tangent-space normal map (flat: 128, 128, 255)."""
         if self.pixels.shape[2] < 3:

@@ -61,8 +61,8 @@ def visible_reading(mesh, settings, faces: np.ndarray, shifts: np.ndarray) -> tu
             notes.setdefault(int(rows[0]), f"{bound.label}: {err}{size}")
             continue
         normal_map = bound.map.role == "normal" or (bound.map.role == "height" and texture.looks_like_normal_map)
-        values, bounds = visible_values(texture.pixels, xy[rows], bound.tile_uv(uv[rows]), diagonals[rows],
-                                        normal_map, limits, texture.pyramid)
+        values, bounds = visible_values(texture, xy[rows], bound.tile_uv(uv[rows]), diagonals[rows], normal_map,
+                                        limits)
         levels = limits.levels(values, shifts[rows])
         severity = (len(LEVELS) - np.select([levels == level for level in LEVELS], range(len(LEVELS)))
                     + np.minimum(values / max(limits.error, 1e-12), 0.999))
