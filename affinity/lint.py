@@ -202,14 +202,16 @@ def assumed_texture_note(size: int) -> str:
             "(give the size with --texture-size or the texture-size setting)")
 
 
-def _map_quad_batches(mesh: Mesh, settings: Settings, measure, attributes=()) -> list:
+def _map_quad_batches(mesh: Mesh, settings: Settings, measure, attributes=(), grid=None) -> list:
     """Run ``measure(batch: QuadBatch)`` on every batch of the mesh's quads, in
     parallel threads (NumPy releases the GIL in its loops); results in file order.
-    ``attributes`` names the tables the measure reads besides the positions."""
+    ``attributes`` names the tables the measure reads besides the positions; ``grid`` is the texel grid
+    of the uv (:func:`texture_grid`, computed here when None)."""
     tables = CornerTables(mesh)
     names = ("positions", *attributes)
     quads = np.flatnonzero(mesh.face_sizes == 4)
-    grid = texture_grid(mesh, settings, quads) if "texcoords" in attributes else None
+    if grid is None and "texcoords" in attributes:
+        grid = texture_grid(mesh, settings, quads)
 
     def run(start: int):
         faces = quads[start : start + BATCH_SIZE]
@@ -243,6 +245,9 @@ def lint_mesh(mesh: Mesh, settings: Settings, visible: bool = True) -> list[Rule
     faces in file order within each.
     """
     enabled = [RULES[code] for code in resolve_codes(settings.select, settings.ignore)]
+    reads_textures = (visible and RULES["Q101"] in enabled and RULES["Q101"].unit_for(settings.measure) == "texels"
+                      and mesh.texcoords is not None and (mesh.material_maps or mesh.material_textures))
+    preparing = _prepare_textures(mesh) if reads_textures else None
     hits = []
     for rule in enabled:
         found = rule.check(mesh, settings) if rule.scope == "mesh" else None
@@ -267,7 +272,8 @@ def lint_mesh(mesh: Mesh, settings: Settings, visible: bool = True) -> list[Rule
         return found
 
     attributes = sorted({rule.attribute for rule in quad_rules if rule.attribute})
-    batches = _map_quad_batches(mesh, settings, flag, attributes) if quad_rules else []
+    grid = texture_grid(mesh, settings) if "texcoords" in attributes else None
+    batches = _map_quad_batches(mesh, settings, flag, attributes, grid) if quad_rules else []
     for rule in quad_rules:
         faces = np.concatenate([found[rule.code][0] for found in batches] or [np.zeros(0, dtype=np.int64)])
         if len(faces):
@@ -275,25 +281,37 @@ def lint_mesh(mesh: Mesh, settings: Settings, visible: bool = True) -> list[Rule
             threshold = thresholds[rule.code]
             found = RuleHits(rule.code, faces, mesh.face_line[faces], values,
                              0.0 if threshold is None else float(threshold), mesh.face_group[faces],
-                             details=_texel_details(mesh, settings, rule, faces))
-            if visible and rule.code == "Q101" and rule.unit_for(settings.measure) == "texels":
+                             details=_texel_details(settings, rule, faces, grid))
+            if reads_textures and rule.code == "Q101":
+                if preparing is not None:
+                    preparing.join()
                 _read_visible(mesh, settings, found)
             hits.append(found)
+    if preparing is not None:  # no Q101 finding read it: the decode is not left running into the next file
+        preparing.join()
     order = {code: i for i, code in enumerate(RULES)}
     return sorted(hits, key=lambda h: order[h.code])
 
 
-def _texel_details(mesh: Mesh, settings: Settings, rule, faces: np.ndarray) -> list | None:
+def _texel_details(settings: Settings, rule, faces: np.ndarray, grid) -> list | None:
     """For a rule read in texels: the note on the first finding (``faces`` (n,) in file order) of a quad
-    whose texture size was assumed, None elsewhere; None altogether when every size is known."""
-    if rule.unit_for(settings.measure) != "texels":
+    whose texture size was assumed (``grid``, :func:`texture_grid`), None elsewhere; None altogether when
+    every size is known."""
+    if rule.unit_for(settings.measure) != "texels" or grid is None:
         return None
-    assumed = np.flatnonzero(texture_grid(mesh, settings, faces).assumed[faces])
+    assumed = np.flatnonzero(grid.assumed[faces])
     if not len(assumed):
         return None
     details = [None] * len(faces)
     details[assumed[0]] = assumed_texture_note(settings.texture_size)
     return details
+
+
+def _prepare_textures(mesh: Mesh):
+    """The background thread decoding the mesh's textures while the lint runs (None: nothing to decode)."""
+    from .textures.reading import prepare_textures
+
+    return prepare_textures(mesh)
 
 
 def _read_visible(mesh: Mesh, settings: Settings, hits: RuleHits) -> None:

@@ -38,6 +38,26 @@ def test_packed_sampling_is_bilinear_filtering_of_the_texels(channels):
                                atol=1e-4)
 
 
+def test_the_range_pyramid_holds_every_box_and_is_exact_on_its_blocks():
+    """Brute force over random boxes of an odd-sized image: the bounds hold the box's true extremes, and
+    equal them on a box that is one of the pyramid's blocks."""
+    from affinity.textures.filtering import RangePyramid
+
+    rng = np.random.default_rng(3)
+    image = rng.integers(0, 256, (37, 53, 3), dtype=np.uint8)
+    pyramid = RangePyramid(image)
+    x0, y0 = rng.integers(0, 53, 200), rng.integers(0, 37, 200)
+    x1, y1 = np.minimum(x0 + rng.integers(0, 40, 200), 52), np.minimum(y0 + rng.integers(0, 30, 200), 36)
+    low, high = pyramid.channel_bounds(x0, x1, y0, y1)
+    for k in range(200):
+        box = image[y0[k]:y1[k] + 1, x0[k]:x1[k] + 1].reshape(-1, 3)
+        assert (low[k] <= box.min(axis=0)).all() and (high[k] >= box.max(axis=0)).all()
+    low, high = pyramid.channel_bounds(np.array([8]), np.array([15]), np.array([16]), np.array([23]))
+    block = image[16:24, 8:16].reshape(-1, 3)
+    np.testing.assert_array_equal(low[0], block.min(axis=0))
+    np.testing.assert_array_equal(high[0], block.max(axis=0))
+
+
 def test_checker_alternates():
     image = checker(64, checks=4)
     assert image.shape == (64, 64, 3)

@@ -153,5 +153,6 @@ def texel_grid(mesh, texture_size: int, faces: np.ndarray | None = None) -> Texe
         if headers[bound.path] is not None:
             sizes[bound.faces] = headers[bound.path].size
             assumed[bound.faces] = False
-    unique = np.unique(sizes[faces], axis=0) if len(faces) else assumed_size[None]
-    return TexelGrid(unique[0] if len(unique) == 1 else sizes, assumed)
+    first = sizes[faces[0]] if len(faces) else assumed_size
+    one_size = not len(faces) or bool((sizes[faces] == first).all())
+    return TexelGrid(first.copy() if one_size else sizes, assumed)

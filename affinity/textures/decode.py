@@ -26,7 +26,6 @@ DECODE_BUDGET = 1 << 26
 #: Decoded texture bytes kept between meshes of one run.
 CACHE_BYTES = 1 << 29
 #: Formats Pillow decodes; an EXR's size comes from its header, its texels are not read.
-_DECODED_FORMATS = frozenset(["PNG", "JPEG", "BMP", "TGA", "TIFF", "DDS"])
 
 
 class TextureUnusable(Exception):
@@ -67,10 +66,22 @@ class DecodedTexture:
         wrapping; bilinear filtering changes by at most their sum per texel moved."""
         from .filtering import RangePyramid
 
-        pixels = self.pixels.astype(np.int16)
-        across = np.abs(np.roll(pixels, -1, axis=1) - pixels).max(axis=2)
-        down = np.abs(np.roll(pixels, -1, axis=0) - pixels).max(axis=2)
-        return RangePyramid(np.stack([across, down], axis=-1).astype(np.uint8))
+        pixels = self.pixels
+        steps = np.empty((*pixels.shape[:2], 2), dtype=np.uint8)
+
+        def largest_step(a: np.ndarray, b: np.ndarray, out: np.ndarray) -> None:
+            step = np.maximum(a, b)
+            step -= np.minimum(a, b)  # |a - b| in uint8
+            largest = step[..., 0].copy()
+            for channel in range(1, step.shape[2]):  # elementwise: faster than a reduction over a short axis
+                np.maximum(largest, step[..., channel], out=largest)
+            out[...] = largest
+
+        largest_step(pixels[:, :-1], pixels[:, 1:], steps[:, :-1, 0])
+        largest_step(pixels[:, -1:], pixels[:, :1], steps[:, -1:, 0])  # the last column wraps to the first
+        largest_step(pixels[:-1], pixels[1:], steps[:-1, :, 1])
+        largest_step(pixels[-1:], pixels[:1], steps[-1:, :, 1])
+        return RangePyramid(steps, minima=False)
 
     @cached_property
     def packed(self):
@@ -111,7 +122,7 @@ def why_not_decoded(path: str | None, budget: int = DECODE_BUDGET) -> str | None
         return reason
     if header.pixels > budget:
         return f"{header.width}x{header.height} is over the decode budget of {budget:,} pixels"
-    if header.format not in _DECODED_FORMATS:
+    if header.format not in _PLUGINS:
         return f"{header.format} texels are not decoded"
     return None
 
@@ -143,12 +154,27 @@ def decode(path: str, budget: int = DECODE_BUDGET) -> DecodedTexture:
     return texture
 
 
+#: Pillow's image class per header format, opened directly: ``Image.open`` would first import every common
+#: plug-in (JPEG's imports subprocess), a tenth of a second of a small check.
+_PLUGINS = {"PNG": ("PngImagePlugin", "PngImageFile"), "JPEG": ("JpegImagePlugin", "JpegImageFile"),
+            "BMP": ("BmpImagePlugin", "BmpImageFile"), "TGA": ("TgaImagePlugin", "TgaImageFile"),
+            "TIFF": ("TiffImagePlugin", "TiffImageFile"), "DDS": ("DdsImagePlugin", "DdsImageFile")}
+
+
+def _opened(file, header: ImageHeader):
+    """The Pillow image of an open texture file, by the class of its header's format."""
+    import importlib
+
+    module, name = _PLUGINS[header.format]
+    return getattr(importlib.import_module(f"PIL.{module}"), name)(file)
+
+
 def _decode_pixels(path: str, header: ImageHeader) -> np.ndarray:
     """(H, W, C) uint8 of an image whose header was checked against the budget."""
     from PIL import Image, UnidentifiedImageError
 
     try:
-        with open_image_file(path) as file, Image.open(file) as image:
+        with open_image_file(path) as file, _opened(file, header) as image:
             if image.size != header.size:
                 raise TextureUnusable(f"its header and its decoder disagree on the size ({image.size})", header)
             bands = image.getbands()
@@ -156,10 +182,10 @@ def _decode_pixels(path: str, header: ImageHeader) -> np.ndarray:
             if image.mode in ("I;16", "I;16B", "I;16L", "I"):  # 16-bit grey: keep the top 8 bits
                 array = (np.asarray(image, dtype=np.uint32) >> 8).astype(np.uint8)
             else:
-                array = np.asarray(image.convert(mode), dtype=np.uint8)
+                array = np.asarray(image if image.mode == mode else image.convert(mode), dtype=np.uint8)
     except TextureUnusable:
         raise
-    except (UnidentifiedImageError, OSError, ValueError, Image.DecompressionBombError) as err:
+    except (UnidentifiedImageError, OSError, ValueError, SyntaxError, Image.DecompressionBombError) as err:
         raise TextureUnusable(f"does not decode ({err.__class__.__name__})", header) from None
     array = array.reshape(*array.shape[:2], -1)
     array.flags.writeable = False

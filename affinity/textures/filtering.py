@@ -84,15 +84,17 @@ class RangePyramid:
 
     A box of texels is covered by at most 2 x 2 blocks of the first level whose block is
     at least as wide as the box, so :meth:`channel_bounds` answers any box in four lookups.
-    Memory: two pyramids of about 1/3 of the image each (uint8 like the image).
+    Memory: two pyramids of about 1/3 of the image each (uint8 like the image); with
+    ``minima=False`` the maxima only (the minima :meth:`channel_bounds` gives are then 0).
     """
 
-    def __init__(self, image: np.ndarray):
-        self.shape = image.shape
-        self.levels = [(image, image)]
+    def __init__(self, image: np.ndarray, minima: bool = True):
+        self.shape, self.minima = image.shape, minima
+        self.levels = [(image if minima else np.zeros_like(image[:1, :1]), image)]
         low, high = image, image
-        while max(low.shape[:2]) > 1:
-            low, high = _reduced(low, np.minimum), _reduced(high, np.maximum)
+        while max(high.shape[:2]) > 1:
+            high = _reduced(high, np.maximum)
+            low = _reduced(low, np.minimum) if minima else np.zeros_like(high[:1, :1])
             self.levels.append((low, high))
 
     def channel_bounds(self, x0: np.ndarray, x1: np.ndarray, y0: np.ndarray,
@@ -106,15 +108,22 @@ class RangePyramid:
             rows = np.flatnonzero(level == k)
             low, high = self.levels[k]
             bx0, bx1, by0, by1 = x0[rows] >> k, x1[rows] >> k, y0[rows] >> k, y1[rows] >> k
-            lows[rows] = np.stack([low[by, bx] for by in (by0, by1) for bx in (bx0, bx1)]).min(axis=0)
+            if not self.minima:
+                lows[rows] = 0
+            else:
+                lows[rows] = np.stack([low[by, bx] for by in (by0, by1) for bx in (bx0, bx1)]).min(axis=0)
             highs[rows] = np.stack([high[by, bx] for by in (by0, by1) for bx in (bx0, bx1)]).max(axis=0)
         return lows, highs
 
 
 def _reduced(image: np.ndarray, reduce) -> np.ndarray:
     """One pyramid level: ``reduce`` (np.minimum or np.maximum) over 2 x 2 blocks, an odd last row or column
-    kept as its own block (elementwise on the four quarter-images: faster than a reduction over tiny axes)."""
+    kept as its own block (elementwise over row pairs, then column pairs: faster than a reduction over tiny
+    axes)."""
     height, width = image.shape[:2]
     if height % 2 or width % 2:
         image = np.pad(image, ((0, height % 2), (0, width % 2), (0, 0)), mode="edge")
-    return reduce(reduce(image[0::2, 0::2], image[0::2, 1::2]), reduce(image[1::2, 0::2], image[1::2, 1::2]))
+    rows = reduce(image[0::2], image[1::2])  # pairs of rows: contiguous runs
+    half, width, channels = rows.shape
+    pairs = rows.reshape(half, width // 2, 2 * channels)  # each column pair's channels side by side
+    return reduce(pairs[..., :channels], pairs[..., channels:])

@@ -10,13 +10,15 @@ that cannot be decoded leaves its quads on the texel reading, with a note.
 
 from __future__ import annotations
 
+import threading
+
 import numpy as np
 
 from ..findings import VisibleColumns
 from ..geometry import plane_coordinates
 from ..rules import LEVELS
 from .binding import bound_textures, quad_uv
-from .decode import TextureUnusable, decode
+from .decode import TextureUnusable, decode, why_not_decoded
 from .visible import BOTH_DIAGONALS, DIAGONAL_02, DIAGONAL_13, EXACT, visible_values
 
 #: The unit of C by what the texture holds.
@@ -32,6 +34,29 @@ def split_diagonals(mesh, faces: np.ndarray, diagonal: str) -> np.ndarray:
     p = mesh.positions[mesh.corner_vertex[mesh.face_start[faces][:, None] + np.arange(4)]]
     d02, d13 = np.linalg.norm(p[:, 2] - p[:, 0], axis=1), np.linalg.norm(p[:, 3] - p[:, 1], axis=1)
     return np.where(d02 <= d13, DIAGONAL_02, DIAGONAL_13).astype(np.int8)
+
+
+def prepare_textures(mesh) -> threading.Thread | None:
+    """Start decoding, in a background thread, every texture the mesh's quads read that the budget lets
+    decode, with its pyramids and packed texels (:class:`~affinity.textures.decode.DecodedTexture`), so that
+    the work overlaps the lint's; join the thread before reading C. None when there is nothing to decode."""
+    quads = np.flatnonzero(mesh.face_sizes == 4)
+    paths = list(dict.fromkeys(bound.path for bound in bound_textures(mesh, quads)))
+    paths = [path for path in paths if why_not_decoded(path) is None]
+    if not paths:
+        return None
+
+    def warm() -> None:
+        for path in paths:
+            try:
+                texture = decode(path)
+            except TextureUnusable:
+                continue  # the reading says why
+            texture.pyramid, texture.slopes, texture.packed  # noqa: B018 (built once, here)
+
+    thread = threading.Thread(target=warm, name="affinity-textures", daemon=True)
+    thread.start()
+    return thread
 
 
 def visible_reading(mesh, settings, faces: np.ndarray, shifts: np.ndarray) -> tuple[VisibleColumns, dict] | None:

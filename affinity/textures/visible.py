@@ -47,7 +47,7 @@ DIAGONAL_02, DIAGONAL_13, BOTH_DIAGONALS = 0, 1, 2
 #: Cells of a quad's (s, t) square are about this many texels of its uv extent wide, at most MAX_CELLS a side.
 CELL_TEXELS, MAX_CELLS = 4.0, 16
 #: Samples per texel of a cell's uv extent, per side (2 to MAX_CELL_SAMPLES a side).
-SAMPLES_PER_TEXEL = 2.0
+SAMPLES_PER_TEXEL = 1.0
 MAX_CELL_SAMPLES = 32
 #: A cell whose bound exceeds the quad's best so far by no more than this (1/255 steps or degrees) is left
 #: out: C is then known to within it (the values are meant to be right to one step).
