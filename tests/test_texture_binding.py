@@ -212,3 +212,33 @@ def test_a_normal_map_reads_in_degrees_and_the_worst_role_decides(tmp_path):
     angle = np.degrees(np.arccos(np.dot(*decoded) / np.linalg.norm(decoded[0]) / np.linalg.norm(decoded[1])))
     assert finding["unit"] == "degrees" and finding["role"] == "normal (bump)" and finding["texture"] == "bumps.png"
     assert finding["value"] == pytest.approx(angle, abs=0.05) and finding["level"] == "error"
+
+
+def test_the_result_cache_follows_usd_and_materialx_textures(tmp_path):
+    """A texture changed behind a cached report gives the new C (the cache hashes what the stage, its
+    UsdUVTexture files, its MaterialX documents and their images, and UDIM tiles name)."""
+    pytest.importorskip("pxr")
+    from PIL import Image
+
+    from affinity.loaders.resources import named_files
+
+    udim_tiles(tmp_path)
+    (tmp_path / "maps" / "normals").mkdir(parents=True)
+    picture(tmp_path / "maps" / "wood_base.png", (300, 200))
+    (tmp_path / "look.mtlx").write_text(MTLX)
+    stage = tmp_path / "scene.usda"
+    stage.write_text(usd_quads(["Paint"]) + looks(preview_material("Paint", {"diffuseColor": "paint.<UDIM>.png"})))
+    assert [Path(p).name for p in named_files(str(stage))] == ["paint.1001.png", "paint.1002.png"]
+    assert [Path(p).name for p in named_files(str(tmp_path / "look.mtlx"))] == ["wood_base.png",
+                                                                                  "wood_normal.png"]
+    env = {**__import__("os").environ, "AFFINITY_CACHE_DIR": str(tmp_path / "cache")}
+
+    def value() -> float:
+        result = subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--format", "json", "--select",
+                                 "Q101", str(stage)], capture_output=True, text=True, env=env)
+        return json.loads(result.stdout)["findings"][0]["value"]
+
+    assert value() == pytest.approx(0.0, abs=0.01)  # a flat tile hides the crease
+    checker = (np.indices((64, 64)).sum(axis=0) // 4 % 2 * 255).astype(np.uint8)
+    Image.fromarray(np.repeat(checker[..., None], 3, axis=2)).save(tmp_path / "paint.1001.png")
+    assert value() > 8  # the same stage, a new texture: checked again, not served from the cache

@@ -142,3 +142,22 @@ def test_spot_text_output_names_the_texture_and_marks_bounds():
     lines = [line for line in result.stdout.splitlines() if " Q101 " in line]
     assert lines and all("base colour texture spot_texture.png" in line for line in lines)
     assert any("(>=" in line and "vs 2/255)" in line for line in lines)
+
+
+@pytest.mark.parametrize("textured", [False, True])
+def test_pillow_is_imported_only_for_a_mesh_that_binds_a_readable_texture(tmp_path, textured):
+    """design.md: `affinity check` on an untextured mesh never imports Pillow; one whose material binds a
+    readable texture does (it decodes it)."""
+    from PIL import Image
+
+    Image.new("RGB", (16, 16), "white").save(tmp_path / "wood.png")
+    (tmp_path / "look.mtl").write_text("newmtl m\nmap_Kd wood.png\n")
+    head = "mtllib look.mtl\nusemtl m\n" if textured else ""
+    (tmp_path / "mesh.obj").write_text(head + "v -1 0 0\nv 1 0 0\nv 0.5 1 0\nv -0.5 1 0\n"
+                                       "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n")
+    code = ("import runpy, sys; sys.argv = ['affinity', 'check', '--no-cache', sys.argv[1]]\n"
+            "try:\n    runpy.run_module('affinity.cli', run_name='__main__')\n"
+            "except SystemExit:\n    pass\n"
+            "sys.stderr.write('PIL' + str('PIL' in sys.modules))\n")
+    result = subprocess.run([sys.executable, "-c", code, str(tmp_path / "mesh.obj")], capture_output=True, text=True)
+    assert f"PIL{textured}" in result.stderr, result.stderr

@@ -169,7 +169,9 @@ def named_files(path: str, data=None) -> list[str]:
     """The files the file at ``path`` names itself (one level down, each once, in order):
     an OBJ's material libraries (from its bytes ``data``; read when None), an MTL file's
     texture maps of every role named in MTL files, a USD layer's sublayers, references and
-    payloads (none without ``pxr``). Other files name none. Paths are normalised, not made absolute."""
+    payloads and the files of its asset-valued attributes (textures; none without ``pxr``), a
+    MaterialX document's image files. A UDIM texture names its tiles on disk. Other files name
+    none. Paths are normalised, not made absolute."""
     suffix = os.path.splitext(path)[1].lower()
     if suffix == ".obj":
         if data is None:
@@ -178,10 +180,16 @@ def named_files(path: str, data=None) -> list[str]:
         folder = os.path.dirname(path)
         return list(dict.fromkeys(os.path.normpath(os.path.join(folder, name))
                                   for _, name in mtllib_statements(data)))
+    from .texturemaps import tile_files
+
     if suffix == ".mtl":
         from .mtl import material_maps
 
-        return list(dict.fromkeys(texture for *_, texture in material_maps(path)))
-    from .usd import USD_SUFFIXES, asset_paths
+        return tile_files(texture for *_, texture in material_maps(path))
+    if suffix == ".mtlx":
+        from .usdmaterials import mtlx_document_maps
 
-    return asset_paths(path) if suffix in USD_SUFFIXES else []
+        return tile_files(texture_map.path for texture_map in mtlx_document_maps(path, every=True))
+    from .usd import USD_SUFFIXES, asset_paths, texture_asset_paths
+
+    return [*asset_paths(path), *tile_files(texture_asset_paths(path))] if suffix in USD_SUFFIXES else []

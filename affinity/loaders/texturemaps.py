@@ -69,6 +69,15 @@ def udim_tiles(path: str) -> dict[int, str]:
     return {}
 
 
+def tile_files(paths) -> list[str]:
+    """``paths`` each once, in order, a UDIM path replaced by its tiles on disk (:func:`udim_tiles`)."""
+    files = []
+    for path in paths:
+        has_token = any(token in path for token in _UDIM_TOKENS)
+        files += list(udim_tiles(path).values()) if has_token else [path]
+    return list(dict.fromkeys(files))
+
+
 def udim_tile_of(uv: np.ndarray) -> np.ndarray:
     """(Q,) int64 UDIM tile of quads whose corner uv are ``uv`` (Q, 4, 2): ``1001 + u + 10 v`` at
     the quad's uv centre (a quad belongs to one tile; the tile's uv is its fractional part).

@@ -99,6 +99,34 @@ def layer_assets(path: str) -> list[tuple[str, str]]:
     return [(asset, layer.ComputeAbsolutePath(asset)) for asset in sorted(layer.GetCompositionAssetDependencies())]
 
 
+def texture_asset_paths(path: str) -> list[str]:
+    """The files the asset-valued attributes of the USD layer ``path`` name (a ``UsdUVTexture``'s
+    ``inputs:file``), resolved against the layer's folder, in path order; none without ``pxr`` or when the
+    layer cannot be opened. The result cache follows them (a changed texture changes C)."""
+    try:
+        from pxr import Sdf, Tf
+    except ImportError:
+        return []
+    try:
+        layer = Sdf.Layer.FindOrOpen(os.fspath(path))
+    except Tf.ErrorException:
+        return []
+    if layer is None:
+        return []
+    found = []
+
+    def visit(spec_path) -> None:
+        if not spec_path.IsPropertyPath():
+            return
+        spec = layer.GetAttributeAtPath(spec_path)
+        value = spec.default if spec is not None and spec.typeName == Sdf.ValueTypeNames.Asset else None
+        if isinstance(value, Sdf.AssetPath) and value.path:
+            found.append(os.path.normpath(os.path.join(os.path.dirname(os.fspath(path)), value.path)))
+
+    layer.Traverse(Sdf.Path.absoluteRootPath, visit)
+    return sorted(set(found))
+
+
 def asset_paths(path: str) -> list[str]:
     """The absolute paths of :func:`layer_assets`."""
     return [absolute for _, absolute in layer_assets(path)]

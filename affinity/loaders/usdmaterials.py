@@ -117,23 +117,20 @@ def materialx_maps(material_prim) -> list[TextureMap]:
     return []
 
 
-def mtlx_document_maps(path: str, material: str | None = None) -> list[TextureMap]:
+def mtlx_document_maps(path: str, material: str | None = None, every: bool = False) -> list[TextureMap]:
     """The image files feeding the surface shader of ``material`` (a ``surfacematerial`` name; None: the
-    first) in the MaterialX document ``path``; empty when it cannot be read."""
+    first; with ``every``, of every material) in the MaterialX document ``path``; empty when it cannot be
+    read."""
     try:
         root = ElementTree.parse(path).getroot()
     except (OSError, ElementTree.ParseError):
         return []
     nodes = _named_nodes(root)
     materials = [n for n in root.iter("surfacematerial") if material in (None, n.get("name"))]
-    if not materials:
-        return []
-    shader = _upstream(nodes, materials[0].find("input[@name='surfaceshader']"))
-    if shader is None:
-        return []
+    shaders = [_upstream(nodes, m.find("input[@name='surfaceshader']")) for m in materials[: None if every else 1]]
     folder = os.path.dirname(os.path.abspath(path))
     maps = []
-    for shader_input in shader.findall("input"):
+    for shader_input in (i for shader in shaders if shader is not None for i in shader.findall("input")):
         role = ROLE_OF_INPUT.get(shader_input.get("name"), "scalar")
         for image in _images_upstream(nodes, shader_input):
             file_input = image.find("input[@name='file']")
