@@ -161,3 +161,21 @@ def test_pillow_is_imported_only_for_a_mesh_that_binds_a_readable_texture(tmp_pa
             "sys.stderr.write('PIL' + str('PIL' in sys.modules))\n")
     result = subprocess.run([sys.executable, "-c", code, str(tmp_path / "mesh.obj")], capture_output=True, text=True)
     assert f"PIL{textured}" in result.stderr, result.stderr
+
+
+def test_the_readme_visible_table_is_what_the_default_gate_does():
+    """Each row of the generated visible-reading table (reports/bench/calibration_visible.json): the gate
+    fails exactly where the visible reading found an error; a flat texture hides every crease; on Spot the
+    row is what a check run now gives (a snapshot of the levels, re-run here)."""
+    root = Path(__file__).resolve().parents[1]
+    rows = json.loads((root / "reports" / "bench" / "calibration_visible.json").read_text())
+    assert {row["texture"].split(" ")[0] for row in rows} >= {"flat.png", "checker.png", "text.png"}
+    for row in rows:
+        assert row["exit"] == int(row["visible"][2] > 0), row
+        assert sum(row["visible"]) == sum(row["texel"]) == row["findings"], row
+    flat = next(row for row in rows if row["texture"].startswith("flat.png"))
+    assert flat["visible"] == [flat["findings"], 0, 0] and flat["texel"][1] > 0
+    spot = [row for row in rows if row["mesh"] == SPOT.name]
+    if spot and SPOT.exists():
+        levels = [f["level"] for f in check_json("--select", "Q101", str(SPOT))["findings"]]
+        assert [levels.count(level) for level in ("info", "warning", "error")] == spot[0]["visible"]
