@@ -7,7 +7,10 @@ Which statements name texture maps is the resource registry's
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from .texturemaps import TextureMap
 
 #: ``map_Kd`` options with a fixed number of arguments.
 _FIXED_ARGUMENTS = {
@@ -25,29 +28,18 @@ def material_maps(path) -> list[tuple[str, str, str, str]]:
 
     A missing or unreadable file gives an empty list: materials are optional.
     """
-    return [(statement.role, statement.material, statement.name, statement.path)
-            for statement in map_statements(path)]
+    return [(role, material, texture.name, texture.path) for role, material, texture in map_statements(path)]
 
 
-@dataclass(frozen=True)
-class MapStatement:
-    """One texture map statement of an MTL file: its resource ``role`` (the statement, ``"map_Kd"``),
-    the ``material`` it belongs to, the file ``name`` as written and its ``path`` resolved against the
-    .mtl's folder, and the ``-s`` scale and ``-o`` offset of the texture's u and v (the texture is read at
-    ``uv * scale + offset``; w is not used by a 2-D texture)."""
-
-    role: str
-    material: str
-    name: str
-    path: str
-    scale: tuple[float, float] = (1.0, 1.0)
-    offset: tuple[float, float] = (0.0, 0.0)
-
-
-def map_statements(path) -> list[MapStatement]:
-    """Every texture map statement of the MTL file ``path`` (the roles the resource registry names
-    in MTL files), in file order; a missing or unreadable file gives an empty list."""
-    from .resources import roles_named_in
+def map_statements(path) -> list[tuple[str, str, TextureMap]]:
+    """``(resource role, material, texture)`` of every texture map statement of the MTL file ``path``
+    (the roles the resource registry names in MTL files), in file order: the texture as a
+    :class:`~affinity.loaders.texturemaps.TextureMap` whose role is the resource role's kind of texels
+    (None for a role that names none), its file resolved against the .mtl's folder, and the statement's
+    ``-s`` scale and ``-o`` offset of u and v (w is not used by a 2-D texture). A missing or unreadable
+    file gives an empty list."""
+    from .resources import ROLES, roles_named_in
+    from .texturemaps import TextureMap
 
     try:
         with open(path, "rb") as fh:
@@ -68,10 +60,12 @@ def map_statements(path) -> list[MapStatement]:
         elif words[0] in statements and material is not None:
             name, options = map_arguments(words[1:])
             scale, offset = options.get("-s", (1.0, 1.0)), options.get("-o", (0.0, 0.0))
-            maps.append(MapStatement(statements[words[0]], material, name,
-                                     os.path.normpath(os.path.join(folder, name.replace("\\", "/"))),
-                                     (scale[0], scale[1] if len(scale) > 1 else 1.0),
-                                     (offset[0], offset[1] if len(offset) > 1 else 0.0)))
+            role = statements[words[0]]
+            maps.append((role, material, TextureMap(
+                role=ROLES[role].texture, name=name, source=words[0],
+                path=os.path.normpath(os.path.join(folder, name.replace("\\", "/"))),
+                scale=(scale[0], scale[1] if len(scale) > 1 else 1.0),
+                offset=(offset[0], offset[1] if len(offset) > 1 else 0.0))))
     return maps
 
 

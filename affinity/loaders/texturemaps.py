@@ -28,14 +28,15 @@ class TextureMap:
 
     Attributes
     ----------
-    role : ``"base colour"``, ``"normal"``, ``"height"`` or ``"scalar"``
+    role : ``"base colour"``, ``"normal"``, ``"height"`` or ``"scalar"`` (None: a map whose texels no
+        reading knows, named by a role registered without a kind)
     path : the file, resolved (it may hold a UDIM token)
     name : the file as the material spells it
     source : what names it, for messages: ``"map_Kd"``, ``"UsdUVTexture /Looks/Wood/Tex"``
     scale, offset : the texture is read at ``uv * scale + offset`` (MTL ``-s``/``-o``)
     """
 
-    role: str
+    role: str | None
     path: str
     name: str
     source: str
@@ -95,17 +96,13 @@ def obj_material_maps(resources: list) -> dict[str, list[TextureMap]]:
     library defining a material wins, within a library its last statement of each role (as a renderer
     reads them)."""
     from .mtl import map_statements
-    from .resources import ROLES as RESOURCE_ROLES
 
     maps: dict[str, list[TextureMap]] = {}
     for library in (r for r in resources if r.role == "mtllib"):
         own: dict[str, dict[str, TextureMap]] = {}
-        for statement in map_statements(library.path):
-            role = RESOURCE_ROLES[statement.role].texture
-            if role is not None:
-                own.setdefault(statement.material, {})[statement.role] = TextureMap(
-                    role=role, path=statement.path, name=statement.name, source=statement.role,
-                    scale=statement.scale, offset=statement.offset)
+        for role, material, texture in map_statements(library.path):
+            if texture.role is not None:
+                own.setdefault(material, {})[role] = texture
         for material, by_statement in own.items():
             maps.setdefault(material, list(by_statement.values()))
     return maps

@@ -82,18 +82,23 @@ class _Primvar:
     indices: np.ndarray | None = None
 
 
+def _layer(path: str):
+    """The Sdf layer at ``path``, None without ``pxr`` or when it cannot be opened."""
+    try:
+        from pxr import Sdf, Tf
+    except ImportError:
+        return None
+    try:
+        return Sdf.Layer.FindOrOpen(os.fspath(path))
+    except Tf.ErrorException:
+        return None
+
+
 def layer_assets(path: str) -> list[tuple[str, str]]:
     """``(asset, absolute path)`` of the sublayers, references and payloads the USD layer ``path``
     names, sorted by asset path (the resource role ``usd-asset``); none without ``pxr`` or when the
     layer cannot be opened."""
-    try:
-        from pxr import Sdf, Tf
-    except ImportError:
-        return []
-    try:
-        layer = Sdf.Layer.FindOrOpen(os.fspath(path))
-    except Tf.ErrorException:
-        return []
+    layer = _layer(path)
     if layer is None:
         return []
     return [(asset, layer.ComputeAbsolutePath(asset)) for asset in sorted(layer.GetCompositionAssetDependencies())]
@@ -103,16 +108,11 @@ def texture_asset_paths(path: str) -> list[str]:
     """The files the asset-valued attributes of the USD layer ``path`` name (a ``UsdUVTexture``'s
     ``inputs:file``), resolved against the layer's folder, in path order; none without ``pxr`` or when the
     layer cannot be opened. The result cache follows them (a changed texture changes C)."""
-    try:
-        from pxr import Sdf, Tf
-    except ImportError:
-        return []
-    try:
-        layer = Sdf.Layer.FindOrOpen(os.fspath(path))
-    except Tf.ErrorException:
-        return []
+    layer = _layer(path)
     if layer is None:
         return []
+    from pxr import Sdf
+
     found = []
 
     def visit(spec_path) -> None:
