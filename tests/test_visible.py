@@ -179,3 +179,24 @@ def test_the_readme_visible_table_is_what_the_default_gate_does():
     if spot and SPOT.exists():
         levels = [f["level"] for f in check_json("--select", "Q101", str(SPOT))["findings"]]
         assert [levels.count(level) for level in ("info", "warning", "error")] == spot[0]["visible"]
+
+
+@pytest.mark.skipif(not SPOT.exists(), reason="../shared/meshes/textured is not in this checkout")
+def test_the_visible_reading_survives_the_cache_and_reaches_sarif(tmp_path):
+    """A report with the visible reading stored and read back (the result cache's blob) gives the same
+    findings; SARIF results carry the texture, role, shift and bound as properties."""
+    from affinity.findings import report_from_bytes, report_to_bytes
+    from affinity.output import file_findings
+    from affinity.pipeline.check import check_file
+    from affinity.settings import Settings
+
+    report = check_file(str(SPOT), Settings(select=["Q101"]))
+    again = report_from_bytes(report_to_bytes(report))
+    assert file_findings(again)[0] == file_findings(report)[0]
+    assert again.hits[0].visible.roles == ["base colour"]
+    result = subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--no-cache", "--format", "sarif",
+                             "--select", "Q101", str(SPOT)], capture_output=True, text=True)
+    properties = [r["properties"] for r in json.loads(result.stdout)["runs"][0]["results"]]
+    assert all(p["texture"] == "spot_texture.png" and p["role"] == "base colour" and p["shift"] >= 0.5
+               for p in properties)
+    assert {p.get("bound") for p in properties} >= {"at least", None}
