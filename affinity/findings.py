@@ -116,6 +116,14 @@ class RuleHits:
             levels = np.where(visible != "", visible, levels.astype(object)).astype(str)
         return levels
 
+    def reading(self, row: int, unit: str) -> tuple[str, str]:
+        """How finding ``row``'s value reads: its bound mark (``">="``, ``"<="`` or ``""``) and its unit (the
+        visible reading's where C was read, else ``unit``, the rule's under the file's reading)."""
+        columns = self.visible
+        if columns is None or not np.isfinite(columns.shifts[row]) or columns.picks[row] < 0:
+            return "", unit
+        return {1: ">=", 2: "<="}.get(int(columns.bounds[row]), ""), columns.units[columns.picks[row]]
+
     def subset(self, rows: np.ndarray) -> RuleHits:
         """The findings at ``rows`` (an index array or a boolean mask), level and unit kept."""
         details = None if self.details is None else np.asarray(self.details, dtype=object)[rows].tolist()

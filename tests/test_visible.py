@@ -200,3 +200,21 @@ def test_the_visible_reading_survives_the_cache_and_reaches_sarif(tmp_path):
     assert all(p["texture"] == "spot_texture.png" and p["role"] == "base colour" and p["shift"] >= 0.5
                for p in properties)
     assert {p.get("bound") for p in properties} >= {"at least", None}
+
+
+@pytest.mark.skipif(not SPOT.exists(), reason="../shared/meshes/textured is not in this checkout")
+def test_the_report_writes_c_in_its_own_unit_and_bound():
+    """The HTML report's findings and close-ups name C as the check does (``>=244/255``), not in texels."""
+    from affinity.output import file_findings
+    from affinity.pipeline.check import check_file
+    from affinity.report.sections import _value_text
+    from affinity.settings import Settings
+
+    report = check_file(str(SPOT), Settings(select=["Q101"]))
+    [hits] = report.hits
+    by_face = {f.face: f for f in file_findings(report)[0]}
+    for row in range(len(hits)):
+        finding = by_face[int(hits.faces[row])]
+        mark = {"at least": ">=", "at most": "<="}.get(finding.bound, "")
+        assert _value_text(hits, row, "texels").startswith(mark) and finding.unit == "1/255"
+        assert _value_text(hits, row, "texels").endswith("/255")
