@@ -402,4 +402,4 @@ def visible_values(texture, xy: np.ndarray, uv: np.ndarray, diagonals: np.ndarra
         st = np.clip(best_st[rows][:, None, :] + LOCAL[None] * spacing[rows, None, None], 0.0, 1.0)
         values[rows] = np.maximum(values[rows], crease_difference(pixels, tables, rows, st, normal_map).max(axis=1))
     bounds[(bounds == EXACT) & (values >= limits.error)] = AT_LEAST
-    return values, bounds
+    return np.round(values, 3), bounds  # thousandths of a step: float32 filtering leaves noise below them
