@@ -13,19 +13,22 @@ import sys
 from .commands import EXIT_CLEAN, EXIT_ERROR
 from .commands import bench as bench_command
 from .commands import check as check_command
+from .commands import fix as fix_command
+from .commands import merge as merge_command
 from .commands import render as render_command
 from .commands import report as report_command
 from .commands import rules as rules_command
 from .commands import stability as stability_command
+from .commands import usd_plugin as usd_plugin_command
 from .commands import view as view_command
 from .errors import UsageError
 
-SUBCOMMANDS = [check_command, render_command, rules_command, report_command, view_command, stability_command,
-               bench_command]
+SUBCOMMANDS = [check_command, fix_command, merge_command, render_command, rules_command, report_command,
+               view_command, stability_command, bench_command, usd_plugin_command]
 # The subcommand names each module adds; all of them are set up only when the arguments name none.
-COMMAND_NAMES = {"check": check_command, "render": render_command, "rules": rules_command, "rule": rules_command,
-                 "report": report_command, "view": view_command, "stability": stability_command,
-                 "bench": bench_command}
+COMMAND_NAMES = {"check": check_command, "fix": fix_command, "merge": merge_command, "render": render_command,
+                 "rules": rules_command, "rule": rules_command, "report": report_command, "view": view_command,
+                 "stability": stability_command, "bench": bench_command, "usd-plugin": usd_plugin_command}
 
 
 def build_parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
@@ -83,9 +86,22 @@ def console_main() -> int:
     """
     import gc
 
+    _unwind_on_sigterm()
     code = main()
     gc.freeze()
     return code
+
+
+def _unwind_on_sigterm() -> None:
+    """SIGTERM ends the program as an exception does: ``finally`` blocks run, so a half-written output's
+    temporary file is removed and the ``--jobs`` workers are stopped; a second SIGTERM ends it at once."""
+    import signal
+
+    def terminated(signum, frame):
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        raise SystemExit(128 + signum)
+
+    signal.signal(signal.SIGTERM, terminated)
 
 
 if __name__ == "__main__":

@@ -148,6 +148,14 @@ class FileReport:
     error that says something about this run rather than about the file (an
     internal error, a Dask worker that cannot see the path): such a report is
     never cached.
+
+    ``shared`` (USD) has one entry per mesh whose points and topology several prims
+    take from one layer (:func:`share_authored_geometry`): ``prim`` (the first of
+    them, whose group holds the findings), ``layer`` and ``layer_prim`` (where the
+    geometry is authored), ``prims`` (every prim that references it) and
+    ``values``: per rule code, ``[face within the prim, [value per prim, None where
+    that prim has no finding]]`` for the findings whose prims disagree (different
+    textures bound).
     """
 
     path: str
@@ -162,6 +170,7 @@ class FileReport:
     meters_per_unit: float | None = None
     notes: list[str] = field(default_factory=list)
     transient: bool = False
+    shared: list[dict] = field(default_factory=list)
 
     @property
     def n_findings(self) -> int:
@@ -207,6 +216,87 @@ def settle(hits: list[RuleHits], settings, group_names: list[str], inline=()) ->
     return settled
 
 
+def mesh_report(path: str, mesh, settings, inline=()) -> FileReport:
+    """The report of the file at ``path`` whose mesh is ``mesh``: its findings (lint, then :func:`settle`
+    with ``settings`` and the ``inline`` ignores, then :func:`share_authored_geometry`), counts, groups,
+    and for a USD stage its prims, metadata and the loader's notes."""
+    from .lint import lint_mesh
+
+    hits, shared = share_authored_geometry(settle(lint_mesh(mesh, settings), settings, list(mesh.group_names), inline),
+                                           mesh)
+    return FileReport(path, counts=mesh.counts(), hits=hits, shared=shared, group_names=list(mesh.group_names),
+                      prim_face_start=mesh.prim_face_start, up_axis=mesh.up_axis,
+                      meters_per_unit=mesh.meters_per_unit, notes=list(mesh.notes))
+
+
+def share_authored_geometry(hits: list[RuleHits], mesh) -> tuple[list[RuleHits], list[dict]]:
+    """Findings of a USD stage reported once where the geometry is authored.
+
+    Mesh prims whose points and topology come from one layer (the same
+    ``mesh.prim_sources`` entry, the same number of faces) are one mesh: their
+    findings move to the first of them (faces renumbered into its faces), each
+    (rule, face) keeping its worst value over the prims (:attr:`Rule.worst`).
+    Returns the hits and the :attr:`FileReport.shared` entries; a mesh of other
+    formats, or a stage without shared geometry, comes back as it was.
+
+    Vectorized per rule: ``owner`` (P,) maps each prim to the first prim of its
+    source, ``shift`` (P,) moves its faces onto that prim's.
+    """
+    from .rules import RULES
+
+    sources = mesh.prim_sources
+    if not sources or len(sources) < 2:
+        return hits, []
+    starts = mesh.prim_face_start
+    sizes = np.diff(starts)
+    first: dict = {}
+    owner = np.array([first.setdefault((source, int(n)), p) if source is not None else p
+                      for p, (source, n) in enumerate(zip(sources, sizes))])
+    if (owner == np.arange(len(owner))).all():
+        return hits, []
+    shift = starts[owner] - starts[:-1]
+    by_owner = np.argsort(owner, kind="stable")
+    same_source = np.split(by_owner, np.flatnonzero(np.diff(owner[by_owner])) + 1)
+    members = {int(owner[g[0]]): g.tolist() for g in same_source if len(g) > 1}  # first prim -> its prims, rising
+    shared = [{"prim": mesh.group_names[o], "layer": sources[o][0], "layer_prim": sources[o][1],
+               "prims": [mesh.group_names[p] for p in prims], "values": {}} for o, prims in members.items()]
+    entry_of = {o: entry for o, entry in zip(members, shared)}
+    merged = []
+    for h in hits:
+        on_face = h.faces >= 0  # file-level findings (face -1) stay as they are
+        prim = h.groups.astype(np.int64)
+        faces = np.where(on_face, h.faces + shift[prim], h.faces)
+        groups = np.where(on_face, owner[prim], prim).astype(h.groups.dtype)
+        worst = -h.values if RULES[h.code].worst == "highest" else h.values
+        order = np.lexsort((worst, faces, ~on_face))
+        keep = order[np.concatenate(([True], (faces[order][1:] != faces[order][:-1]) | ~on_face[order][1:]))]
+        keep.sort()
+        out = h.subset(keep)
+        out.faces, out.groups = faces[keep], groups[keep]
+        _record_prim_values(h, faces, prim, owner, starts, members, entry_of)
+        merged.append(out)
+    return merged, shared
+
+
+def _record_prim_values(h: RuleHits, faces, prim, owner, starts, members, entry_of) -> None:
+    """Into each shared entry's ``values``: the faces of rule ``h`` whose prims measured differently.
+
+    One (faces of the mesh, its prims) table per shared mesh with findings, NaN where a prim has none.
+    """
+    rows = np.flatnonzero(np.isin(owner[prim], list(members)) & (h.faces >= 0))
+    rows = rows[np.argsort(owner[prim[rows]], kind="stable")]
+    for chunk in np.split(rows, np.flatnonzero(np.diff(owner[prim[rows]])) + 1) if len(rows) else []:
+        o = int(owner[prim[chunk[0]]])
+        prims = members[o]
+        table = np.full((starts[o + 1] - starts[o], len(prims)), np.nan)
+        table[faces[chunk] - starts[o], np.searchsorted(prims, prim[chunk])] = h.values[chunk]
+        agree = np.isclose(table, table[:, :1], rtol=1e-6, atol=0, equal_nan=True).all(axis=1)
+        differ = np.flatnonzero(~np.isnan(table).all(axis=1) & ~agree)
+        if len(differ):
+            entry_of[o]["values"][h.code] = [
+                [int(face), [None if np.isnan(v) else float(v) for v in table[face]]] for face in differ]
+
+
 def report_to_bytes(report: FileReport) -> bytes:
     """``report`` as a compact blob: a JSON header (fields, then each array's dtype and shape) and the
     arrays' raw bytes, zlib-compressed.
@@ -233,13 +323,14 @@ def report_to_bytes(report: FileReport) -> bytes:
 
 
 def report_from_bytes(data: bytes) -> FileReport:
-    """The report :func:`report_to_bytes` stored; a damaged blob raises ValueError."""
+    """The report :func:`report_to_bytes` stored; anything else (a damaged blob, a value that is not
+    bytes) raises ValueError."""
     import json
     import math
     import zlib
 
     try:
-        if not data.startswith(_BLOB_MAGIC):
+        if not isinstance(data, bytes) or not data.startswith(_BLOB_MAGIC):
             raise ValueError("no report header")
         body = bytearray(zlib.decompress(data[len(_BLOB_MAGIC):]))  # writable, so the arrays are
         size = int.from_bytes(body[:4], "little")
@@ -264,7 +355,7 @@ def report_from_bytes(data: bytes) -> FileReport:
             hits.append(RuleHits(**h, **own, visible=visible))
         prim_face_start = arrays[taken] if len(arrays) > taken else None
         return FileReport(**meta, hits=hits, prim_face_start=prim_face_start)
-    except (zlib.error, KeyError, TypeError, IndexError, UnicodeDecodeError) as err:
+    except (zlib.error, KeyError, TypeError, IndexError, AttributeError) as err:
         raise ValueError(f"not a stored report: {type(err).__name__}: {err}") from None
 
 

@@ -59,6 +59,10 @@ class Mesh:
     prim_face_start : (P + 1,) int64 or None
         USD only: the faces of mesh prim ``p`` (group ``p``) are
         ``prim_face_start[p]:prim_face_start[p + 1]``. None for other formats.
+    prim_sources : list of (str, str) or None, one per prim
+        USD only: the layer and the prim path in it where each mesh prim's points and
+        topology are authored (None for a prim whose three come from different places):
+        prims that reference one geometry layer share a source.
     up_axis : str or None
         USD only: the stage's ``upAxis`` (``"Y"`` or ``"Z"``).
     meters_per_unit : float or None
@@ -86,6 +90,7 @@ class Mesh:
     material_maps: dict[str, list] = field(default_factory=dict)
     resources: list = field(default_factory=list)
     prim_face_start: np.ndarray | None = None
+    prim_sources: list | None = None
     up_axis: str | None = None
     meters_per_unit: float | None = None
     notes: list[str] = field(default_factory=list)

@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import platform
 import statistics
 import subprocess
 import sys
@@ -29,7 +28,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from common import parse_with_output, write_table
+from common import parse_with_output, run_conditions, write_table
 
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "meshes"
 CAR = SHARED / "osd_catmark_car.obj"
@@ -83,8 +82,9 @@ def write_car(path: str, levels: int) -> tuple[str, int]:
     return f"{origin}, subdivided {levels}x", len(quads)
 
 
-def timed_process(command: list[str]) -> tuple[float, float, str]:
-    """Run ``command`` (whose output is a few lines); its wall time (s), peak resident memory (MiB), stdout."""
+def timed_process(command: list[str], ok: tuple[int, ...] = (0,)) -> tuple[float, float, str]:
+    """Run ``command`` (whose output is a few lines); its wall time (s), peak resident memory (MiB), stdout.
+    An exit code outside ``ok`` stops the benchmark."""
     start = time.perf_counter()
     child = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     _, status, usage = os.wait4(child.pid, 0)
@@ -92,7 +92,7 @@ def timed_process(command: list[str]) -> tuple[float, float, str]:
     child.returncode = os.waitstatus_to_exitcode(status)
     out, err = child.stdout.read(), child.stderr.read()
     child.stdout.close(), child.stderr.close()
-    if child.returncode:
+    if child.returncode not in ok:
         sys.exit(f"{' '.join(command)} failed:\n{err}")
     return wall, usage.ru_maxrss / 1024, out
 
@@ -119,8 +119,7 @@ def main(argv=None) -> None:
                     "| mesh | wall (s) | peak memory (MiB) |", "|---|---:|---:|",
                     *(f"| {name} | {seconds:.2f} | {peak:.0f} |" for name, seconds, peak in shared)] if shared else []
     write_table([
-        f"{quads:,} quads ({source}, per-face unit uv), {platform.processor() or platform.machine()}, "
-        f"{os.cpu_count()} CPUs, load {load:.2f} before, median of {rounds} round{'s' * (rounds > 1)}:",
+        f"{quads:,} quads ({source}, per-face unit uv), {run_conditions(load, rounds)}:",
         "",
         "| `affinity report -q` | wall (s) | peak memory (MiB) | UV layout (s) | UV layout share |",
         "|---|---:|---:|---:|---:|",

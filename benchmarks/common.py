@@ -4,6 +4,8 @@
 from __future__ import annotations
 
 import argparse
+import os
+import platform
 import re
 from pathlib import Path
 
@@ -20,6 +22,13 @@ def parse_with_output(parser: argparse.ArgumentParser, small: str, out: str, arg
     parser.add_argument("--small", action="store_true", help=small)
     parser.add_argument("--out", type=Path, default=OUT, help=out)
     return parser.parse_args(argv)
+
+
+def run_conditions(load: float, rounds: int) -> str:
+    """Where and how a benchmark ran, for its table's first line: processor, CPUs, the load average before,
+    and how many rounds the medians are of."""
+    return (f"{platform.processor() or platform.machine()}, {os.cpu_count()} CPUs, load {load:.2f} before, "
+            f"median of {rounds} round{'s' * (rounds > 1)}")
 
 
 def write_table(lines: list[str], folder: Path, name: str) -> str:

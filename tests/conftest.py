@@ -1,5 +1,6 @@
 """What the whole suite shares as fixtures: the real meshes of ../shared/meshes (``helpers.corpus``), and a
-temporary result cache. Shared functions and constants live in ``tests/helpers/``.
+temporary result cache, a cache run an hour after the test wrote its files, a count of the files
+really checked. Shared functions and constants live in ``tests/helpers/``.
 
 Tests take the ``shared_meshes`` fixture (the folder) or a ``manifest_entry``
 argument (parametrized over MANIFEST.json). Without the folder those tests skip,
@@ -8,7 +9,10 @@ and the summary says so once.
 
 from __future__ import annotations
 
+import os
+import time
 from pathlib import Path
+from types import SimpleNamespace
 
 import pytest
 from helpers.corpus import ABSENT, MANIFEST, SHARED_MESHES, manifest_entries
@@ -41,3 +45,37 @@ def result_cache_folder(tmp_path_factory):
     with pytest.MonkeyPatch.context() as patch:
         patch.setenv("AFFINITY_CACHE_DIR", str(tmp_path_factory.mktemp("result-cache")))
         yield
+
+
+@pytest.fixture
+def an_hour_later():
+    """The result cache runs an hour after the test wrote its files, so none is in its racy window
+    (which reads a file's ctime: that, unlike the mtime, cannot be dated back)."""
+    from affinity.pipeline import cache as cache_module
+
+    clock = time.time
+    with pytest.MonkeyPatch.context() as patch:  # its own: a test's monkeypatch.undo() leaves it
+        patch.setattr(cache_module, "time", SimpleNamespace(time=lambda: clock() + 3600))
+        yield
+
+
+class Counting:
+    """``check_file`` that counts the files it really checks."""
+
+    def __init__(self, check_file):
+        self.paths: list[str] = []
+        self.check_file = check_file
+
+    def __call__(self, path, settings, usd=None, source=None):
+        self.paths.append(os.path.basename(path))
+        return self.check_file(path, settings, usd, source)
+
+
+@pytest.fixture
+def counting(monkeypatch) -> Counting:
+    """The files checked in this process (not the cache's hits), by base name."""
+    from affinity.pipeline import check as check_module
+
+    counter = Counting(check_module.check_file)
+    monkeypatch.setattr(check_module, "check_file", counter)
+    return counter

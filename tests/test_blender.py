@@ -377,3 +377,55 @@ print("bpy installed:", importlib.util.find_spec("bpy") is not None)
     assert result.returncode == 0, result.stderr
     assert "bpy loaded: False" in result.stdout
     assert "bpy installed: True" in result.stdout
+
+
+def trapezoid_strip():
+    """Three quads in a row; the middle one a trapezoid carrying a rectangle of uv (Q101), its neighbours affine."""
+    positions = [(0, 0, 0), (1, 0, 0), (2, 0, 0), (3, 0, 0), (0, 1, 0), (1.05, 1, 0), (1.95, 1, 0), (3, 1, 0)]
+    faces = [(0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6)]
+    mesh = bpy.data.meshes.new("strip")
+    mesh.from_pydata(positions, [], faces)
+    mesh.update()
+    layer = mesh.uv_layers.new(name="UVMap")
+    uv = [(x / 3, y) for face in faces for x, y, _ in (positions[v] for v in face)]
+    uv[4:8] = [(1 / 3, 0), (2 / 3, 0), (2 / 3, 1), (1 / 3, 1)]  # the middle quad's own rectangle: a uv seam
+    layer.data.foreach_set("uv", np.array(uv, dtype=np.float32).ravel())
+    obj = bpy.data.objects.new("strip", mesh)
+    bpy.context.scene.collection.objects.link(obj)
+    bpy.context.view_layer.objects.active = obj
+    obj.select_set(True)
+    return obj
+
+
+def boundary_length(obj) -> float:
+    """Total length of the edges used by one face: a T-junction would add the split edge twice over."""
+    mesh = obj.data
+    edge_of_loop = np.zeros(len(mesh.loops), dtype=np.int32)
+    mesh.loops.foreach_get("edge_index", edge_of_loop)
+    users = np.bincount(edge_of_loop, minlength=len(mesh.edges))
+    co = np.zeros(3 * len(mesh.vertices))
+    mesh.vertices.foreach_get("co", co)
+    co = co.reshape(-1, 3)
+    ends = np.zeros(2 * len(mesh.edges), dtype=np.int32)
+    mesh.edges.foreach_get("vertices", ends)
+    ends = ends.reshape(-1, 2)
+    return float(np.linalg.norm(co[ends[:, 0]] - co[ends[:, 1]], axis=1)[users == 1].sum())
+
+
+def test_fix_refines_the_selected_flagged_face_and_check_then_finds_it_clean():
+    strip = trapezoid_strip()
+    assert [(r["code"], r["face"]) for r in findings(strip)] == [("Q101", 1)]
+    bpy.ops.object.mode_set(mode="EDIT")
+    bpy.ops.mesh.select_all(action="DESELECT")
+    bpy.ops.object.mode_set(mode="OBJECT")
+    strip.data.polygons[1].select = True
+    bpy.ops.object.mode_set(mode="EDIT")
+    before = boundary_length(strip)
+    assert bpy.ops.affinity.fix() == {"FINISHED"}
+    assert bpy.context.mode == "EDIT_MESH"
+    bpy.ops.object.mode_set(mode="OBJECT")
+    assert len(strip.data.polygons) > 3 + 16
+    assert boundary_length(strip) == pytest.approx(before)
+    assert bpy.ops.affinity.check() == {"FINISHED"}
+    assert [(r.code, r.count) for r in bpy.context.scene.affinity.results] == []
+    assert findings(strip) == []

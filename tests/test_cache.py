@@ -21,10 +21,8 @@ from affinity.findings import FileReport, RuleHits, report_from_bytes, report_to
 from affinity.pipeline import cache as cache_module
 from affinity.pipeline import check as check_module
 from affinity.pipeline.cache import DB_NAME, ResultCache, tool_fingerprint
-from affinity.pipeline.check import check_file, check_files
+from affinity.pipeline.check import check_files
 from affinity.settings import Settings
-
-AN_HOUR_AGO = 3600
 
 
 def png_header(width: int, height: int) -> bytes:
@@ -32,14 +30,8 @@ def png_header(width: int, height: int) -> bytes:
     return b"\x89PNG\r\n\x1a\n" + struct.pack(">I4sII", 13, b"IHDR", width, height) + b"\x08\x02\x00\x00\x00"
 
 
-def age(*paths: Path) -> None:
-    """Date files an hour back: a file changed within the racy window gets no pre-key."""
-    for path in paths:
-        os.utime(path, (path.stat().st_atime - AN_HOUR_AGO, path.stat().st_mtime - AN_HOUR_AGO))
-
-
 @pytest.fixture
-def assets(tmp_path: Path) -> Path:
+def assets(tmp_path: Path, an_hour_later) -> Path:
     """``textured.obj`` (mtllib -> map_Kd tex.png, 64 px) with two disaffine quads, ``plain.obj`` with one."""
     (tmp_path / "tex.png").write_bytes(png_header(64, 64))
     (tmp_path / "look.mtl").write_text("newmtl wood\nmap_Kd tex.png\n")
@@ -47,7 +39,6 @@ def assets(tmp_path: Path) -> Path:
     (tmp_path / "textured.obj").write_text(quad_obj([(trapezoid(), UNIT_UV), (trapezoid(0.5, 3), UNIT_UV)],
                                                     header=header))
     (tmp_path / "plain.obj").write_text(quad_obj([(trapezoid(0.25), UNIT_UV), (SQUARE, UNIT_UV)]))
-    age(*tmp_path.iterdir())
     return tmp_path
 
 
@@ -68,24 +59,6 @@ def same_report(a: FileReport, b: FileReport) -> bool:
             and all(arrays_equal(getattr(h, f), getattr(k, f)) for f in ("faces", "lines", "values", "groups"))
             for h, k in zip(a.hits, b.hits))
     )
-
-
-class Counting:
-    """``check_file`` that counts the files it really checks."""
-
-    def __init__(self):
-        self.paths: list[str] = []
-
-    def __call__(self, path, settings, usd=None, source=None):
-        self.paths.append(os.path.basename(path))
-        return check_file(path, settings, usd, source)
-
-
-@pytest.fixture
-def counting(monkeypatch) -> Counting:
-    counter = Counting()
-    monkeypatch.setattr(check_module, "check_file", counter)
-    return counter
 
 
 def cached_run(folder: Path, tasks, tool: str = "tool-1") -> list[FileReport]:
@@ -142,14 +115,12 @@ def test_each_input_invalidates_exactly_its_results(assets, tmp_path_factory, co
     counting.paths.clear()
 
     (assets / "plain.obj").write_text(quad_obj([(trapezoid(0.25), UNIT_UV), (trapezoid(0.5), UNIT_UV)]))
-    age(assets / "plain.obj")
     changed = cached_run(folder, tasks_of(assets))
     assert counting.paths == ["plain.obj"] and changed[0].n_findings == 2
     counting.paths.clear()
 
     # The texture's size is the texel unit: twice the size, twice the misplacement in texels.
     (assets / "tex.png").write_bytes(png_header(128, 128))
-    age(assets / "tex.png")
     retextured = cached_run(folder, tasks_of(assets))
     assert counting.paths == ["textured.obj"]
     np.testing.assert_allclose(retextured[1].hits[0].values, 2 * first[1].hits[0].values)
@@ -203,7 +174,7 @@ def test_old_and_excess_entries_are_pruned(assets, tmp_path_factory, monkeypatch
     folder = tmp_path_factory.mktemp("cache")
     cached_run(folder, tasks_of(assets))
     db = sqlite3.connect(folder / DB_NAME)
-    db.execute("INSERT INTO results VALUES ('stale', x'00', 0)")
+    db.execute("INSERT INTO results VALUES ('stale', x'00', 0, '')")
     db.commit()
     sizes = dict(db.execute("SELECT key, LENGTH(report) FROM results").fetchall())
     newest = max(sizes, key=lambda k: k != "stale")
@@ -220,7 +191,6 @@ def write_assets_dir(tmp_path: Path) -> Path:
     for i in range(4):
         (folder / f"m{i}.obj").write_text(quad_obj([(trapezoid(0.2 * (k + 1), 3 * k), UNIT_UV) for k in range(i + 1)]))
     (folder / "broken.obj").write_text("v 0 0 0\nf 1 2 9\n")
-    age(*folder.iterdir())
     return folder
 
 
@@ -283,7 +253,7 @@ def test_no_cache_flag_and_config_key_leave_the_cache_alone(tmp_path):
     assert bad.returncode == 2 and "cache: expected true or false" in bad.stderr
 
 
-def test_usd_sublayer_edits_invalidate_the_stage(tmp_path, tmp_path_factory, counting):
+def test_usd_sublayer_edits_invalidate_the_stage(tmp_path, tmp_path_factory, counting, an_hour_later):
     pytest.importorskip("pxr")
     from pxr import Sdf, Usd, UsdGeom
 
@@ -297,7 +267,6 @@ def test_usd_sublayer_edits_invalidate_the_stage(tmp_path, tmp_path_factory, cou
     root = Sdf.Layer.CreateNew(str(tmp_path / "shot.usda"))
     root.subLayerPaths.append("geometry.usda")
     root.Save()
-    age(sub, tmp_path / "shot.usda")
     folder = tmp_path_factory.mktemp("cache")
     first = cached_run(folder, [(str(tmp_path / "shot.usda"), Settings())])
     assert counting.paths == ["shot.usda"] and first[0].counts["quads"] == 1
@@ -306,7 +275,6 @@ def test_usd_sublayer_edits_invalidate_the_stage(tmp_path, tmp_path_factory, cou
     mesh.CreateFaceVertexCountsAttr([3])
     mesh.CreateFaceVertexIndicesAttr([0, 1, 2])
     stage.GetRootLayer().Save()
-    age(sub)
     second = cached_run(folder, [(str(tmp_path / "shot.usda"), Settings())])
     assert counting.paths == ["shot.usda", "shot.usda"] and second[0].counts["triangles"] == 1
 

@@ -129,12 +129,10 @@ def test_a_worker_that_cannot_see_the_file_leaves_no_cache_entry(tmp_path):
     cache.close()
 
 
-def test_cached_files_are_not_submitted(client, assets, tmp_path, monkeypatch):
+def test_cached_files_are_not_submitted(client, assets, tmp_path, monkeypatch, an_hour_later):
     from affinity.pipeline.cache import ResultCache
 
     tasks = [(str(p), Settings()) for p in sorted(assets.glob("mesh_*.obj"))]
-    for path, _ in tasks:  # out of the racy window, so the pre-keys are kept
-        os.utime(path, (os.stat(path).st_atime - 3600, os.stat(path).st_mtime - 3600))
     submitted = []
     real = cluster_module.check_on_cluster
 
@@ -154,6 +152,36 @@ def test_cached_files_are_not_submitted(client, assets, tmp_path, monkeypatch):
         runs.append([r.n_findings for r in check_files(tasks, cache=cache, cluster=reach_the_cluster)])
         cache.close()
     assert submitted == [len(tasks)] and connections == [1] and runs[0] == runs[1]
+
+
+def test_a_file_swapped_while_the_cluster_checks_it_is_not_stored(client, tmp_path, monkeypatch):
+    """The client hashes the file for its key, a worker reads it after a swap; restored, the cached run
+    must equal a fresh one (issue 47)."""
+    from affinity.pipeline.cache import ResultCache
+
+    mesh = tmp_path / "mesh.obj"
+    affine, disaffine = quad_obj([(SQUARE, UNIT_UV)]), quad_obj([(trapezoid(0.5), UNIT_UV)])
+    mesh.write_text(affine)
+    tasks = [(str(mesh), Settings())]
+    key = ResultCache.key
+
+    def key_then_swap(self, path, *args, **kwargs):
+        found = key(self, path, *args, **kwargs)
+        mesh.write_text(disaffine)
+        return found
+
+    def cached_run() -> list[int]:
+        cache = ResultCache(str(tmp_path / "cache"), tool="t")
+        try:
+            return [r.n_findings for r in check_files(tasks, cache=cache, cluster=lambda: nullcontext(client))]
+        finally:
+            cache.close()
+
+    monkeypatch.setattr(ResultCache, "key", key_then_swap)
+    assert cached_run() == [1]  # the worker read the swapped file
+    monkeypatch.undo()
+    mesh.write_text(affine)
+    assert cached_run() == [r.n_findings for r in check_files(tasks, jobs=1)] == [0]
 
 
 def dead_address() -> str:

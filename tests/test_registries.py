@@ -34,7 +34,6 @@ from affinity.rules import RULES, rule, unregister
 from affinity.settings import Settings
 
 ROOT = Path(__file__).resolve().parents[1]
-AN_HOUR = 3600
 #: A unit-square uv on a trapezoid: the split misplaces the texture (Q101 at the default threshold).
 TRAPEZOID_OBJ = """v 0 0 0
 v 4 0 0
@@ -51,12 +50,6 @@ f 1/1 2/2 3/3 4/4
 def png_header(width: int, height: int) -> bytes:
     """The first bytes of a PNG: enough for the texel unit, which reads only the image size."""
     return b"\x89PNG\r\n\x1a\n" + struct.pack(">I4sII", 13, b"IHDR", width, height) + b"\x08\x02\x00\x00\x00"
-
-
-def age(*paths: Path) -> None:
-    """Date files an hour back, out of the cache's racy window."""
-    for path in paths:
-        os.utime(path, (path.stat().st_atime - AN_HOUR, path.stat().st_mtime - AN_HOUR))
 
 
 def grid_obj(n: int, header: str = "") -> str:
@@ -128,14 +121,14 @@ class OpenCounter:
         monkeypatch.setattr(io, "open", counting_open)
 
 
-def test_a_big_obj_is_opened_once_per_check_with_and_without_the_cache(tmp_path, monkeypatch, capsys):
+def test_a_big_obj_is_opened_once_per_check_with_and_without_the_cache(tmp_path, monkeypatch, capsys,
+                                                                         an_hour_later):
     (tmp_path / "tex.png").write_bytes(png_header(64, 64))
     (tmp_path / "look.mtl").write_text("newmtl wood\nmap_Kd tex.png\n")
     mesh = tmp_path / "big.obj"
     header = "mtllib look.mtl\nusemtl wood\ng top # affinity: ignore[Q2]\n"
     mesh.write_text(grid_obj(300, header))  # 90,000 quads, 3.5 MB
     assert mesh.stat().st_size > 3_000_000
-    age(*tmp_path.iterdir())
     monkeypatch.setenv("AFFINITY_CACHE_DIR", str(tmp_path / "cache"))
     outputs = []
     for args, opens in ((["--no-cache"], 1), ([], 1), ([], 0)):  # no cache; a cold cache; a warm one
@@ -204,13 +197,12 @@ def q104():
 
 
 @pytest.fixture
-def normal_mapped(tmp_path) -> Path:
+def normal_mapped(tmp_path, an_hour_later) -> Path:
     """``mesh.obj`` (the trapezoid) -> ``look.mtl`` -> ``tex.png`` (64 px) and ``nrm.png`` (128 px)."""
     (tmp_path / "tex.png").write_bytes(png_header(64, 64))
     (tmp_path / "nrm.png").write_bytes(png_header(128, 128))
     (tmp_path / "look.mtl").write_text("newmtl wood\nmap_Kd tex.png\nmap_Nx nrm.png\n")
     (tmp_path / "mesh.obj").write_text("mtllib look.mtl\nusemtl wood\n" + TRAPEZOID_OBJ)
-    age(*tmp_path.iterdir())
     return tmp_path
 
 
@@ -231,7 +223,6 @@ def _recheck_after_touching_the_normal_map(assets: Path, cache: Path, monkeypatc
     _cached_check(cache, assets / "mesh.obj")
     assert checked == ["mesh.obj"]
     (assets / "nrm.png").write_bytes(png_header(256, 256))
-    age(assets / "nrm.png")
     checked.clear()
     _cached_check(cache, assets / "mesh.obj")
     return checked
@@ -261,13 +252,12 @@ def test_a_normal_map_rule_needs_one_rule_and_one_resource_role(q104, normal_map
     assert missing.details == ["map_Nx nrm.png (in look.mtl) not found"]
 
 
-def test_the_cache_follows_a_built_in_normal_map_role(tmp_path, tmp_path_factory, monkeypatch):
+def test_the_cache_follows_a_built_in_normal_map_role(tmp_path, tmp_path_factory, monkeypatch, an_hour_later):
     """``norm`` is registered (design.md, "Textures by role"): touching the normal map checks the mesh again."""
     (tmp_path / "tex.png").write_bytes(png_header(64, 64))
     (tmp_path / "nrm.png").write_bytes(png_header(128, 128))
     (tmp_path / "look.mtl").write_text("newmtl wood\nmap_Kd tex.png\nnorm nrm.png\n")
     (tmp_path / "mesh.obj").write_text("mtllib look.mtl\nusemtl wood\n" + TRAPEZOID_OBJ)
-    age(*tmp_path.iterdir())
     assert _recheck_after_touching_the_normal_map(tmp_path, tmp_path_factory.mktemp("c"), monkeypatch) == ["mesh.obj"]
 
 

@@ -1,4 +1,4 @@
-"""The Blender extension: a sidebar panel, Check / Select / Next operators, the results list.
+"""The Blender extension: a sidebar panel, Check / Fix / Select / Next operators, the results list.
 
 This is the only module of the project that imports ``bpy`` at import time; it is
 imported by the extension's ``__init__.py`` (written by
@@ -10,7 +10,9 @@ count, worst value and unit. **Select** (a row's button) selects that row's
 faces in Edit Mode; **Next** selects and frames the row's next worst face. With
 *Write affinity_error* on, Check also stores the per-face error as the float face
 attribute ``affinity_error`` and paints it into the colour attribute
-``affinity_error_color`` that the viewport's Attribute colouring shows.
+``affinity_error_color`` that the viewport's Attribute colouring shows. **Fix**
+refines the selected flagged faces of the active object as ``affinity fix`` does
+(:mod:`.fix`), all its flagged faces when none is selected.
 """
 
 from __future__ import annotations
@@ -32,6 +34,7 @@ from ..settings import DIAGONALS, MEASURES, Settings
 from . import compat
 from .check import check_object, face_error, severity
 from .convert import ERROR_ATTRIBUTE, ERROR_COLOR, base_color_texture, polygon_corners
+from .fix import fix_object
 
 #: Rules the panel offers: the per-face and per-mesh ones (Q9xx are about files).
 PANEL_RULES = [code for code in RULES if not code.startswith("Q9")]
@@ -68,6 +71,15 @@ def _settings_annotations() -> dict:
             name=f"Write {ERROR_ATTRIBUTE}", default=False,
             description=f"Store the per-face error as the face attribute {ERROR_ATTRIBUTE} and show it "
                         f"as the colour attribute {ERROR_COLOR}",
+        ),
+        "fix_level": EnumProperty(
+            name="Fix level", default="warning",
+            items=[(level, level.capitalize(), f"Fix Q101-Q103 findings at {level} and above")
+                   for level in ("info", "warning", "error")],
+        ),
+        "max_refine": IntProperty(
+            name="Max refine", default=8, min=2, soft_max=32,
+            description="Refine a face into at most N x N faces; one that needs more is left (re-UV it)",
         ),
         "results": CollectionProperty(type=AFFINITY_PG_result),
         "results_index": IntProperty(name="Result"),
@@ -234,6 +246,40 @@ class AFFINITY_OT_check(bpy.types.Operator):
         return {"FINISHED"}
 
 
+class AFFINITY_OT_fix(bpy.types.Operator):
+    """Refine the selected flagged faces (all flagged faces when none is selected) until their crease is
+    gone; the faces beside them are re-cut so nothing cracks"""
+
+    bl_idname = "affinity.fix"
+    bl_label = "Fix"
+    bl_options = {"REGISTER", "UNDO"}  # noqa: RUF012 (Blender reads a set)
+
+    @classmethod
+    def poll(cls, context):
+        return context.active_object is not None and context.active_object.type == "MESH"
+
+    def execute(self, context):
+        props = context.scene.affinity
+        obj = context.active_object
+        was_edit = context.mode == "EDIT_MESH"
+        _ensure_mode(context, "OBJECT")
+        selected = np.zeros(len(obj.data.polygons), dtype=bool)
+        obj.data.polygons.foreach_get("select", selected)
+        faces = np.flatnonzero(selected) if was_edit and selected.any() else None
+        try:
+            plan = fix_object(obj, faces, level=props.fix_level, max_refine=props.max_refine, **lint_options(props))
+        except ValueError as error:
+            self.report({"WARNING"}, str(error))
+            return {"CANCELLED"}
+        if was_edit:
+            bpy.ops.object.mode_set(mode="EDIT")
+        left = ", ".join(f"{count} {reason}" for reason, count in zip(*np.unique(plan.left_reasons,
+                                                                                  return_counts=True)))
+        self.report({"INFO"}, f"{len(plan.refine_faces)} faces refined, {len(plan.transition_faces)} re-cut, "
+                              f"{plan.faces_added:+d} faces" + (f"; left: {left}" if left else ""))
+        return {"FINISHED"}
+
+
 def _row(context, index: int):
     props = context.scene.affinity
     index = props.results_index if index < 0 else index
@@ -356,6 +402,10 @@ class AFFINITY_PT_panel(bpy.types.Panel):
         layout.prop(props, "use_modifiers")
         layout.prop(props, "write_error")
         layout.operator(AFFINITY_OT_check.bl_idname)
+        row = layout.row(align=True)
+        row.prop(props, "fix_level", text="")
+        row.prop(props, "max_refine")
+        row.operator(AFFINITY_OT_fix.bl_idname)
         for line in filter(None, props.notes.split("\n")):
             layout.label(text=line, icon="INFO")
         if len(props.results):
@@ -371,6 +421,7 @@ CLASSES = (
     AFFINITY_PG_result,
     AFFINITY_PG_settings,
     AFFINITY_OT_check,
+    AFFINITY_OT_fix,
     AFFINITY_OT_select,
     AFFINITY_OT_next,
     AFFINITY_UL_results,

@@ -7,7 +7,6 @@ import paths stay).
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -80,13 +79,12 @@ def check_object(obj, **options) -> ObjectCheck:
 
 def _finding_dicts(mesh, hits, settings, original_face) -> list[dict]:
     from ..findings import FileReport
-    from ..output import file_findings
+    from ..output import file_findings, finding_dict
 
     report = FileReport(path=mesh.path, counts=mesh.counts(), hits=hits, group_names=mesh.group_names)
     rows = []
     for finding in file_findings(report)[0]:
-        row = dataclasses.asdict(finding)
-        del row["prim"]
+        row = finding_dict(finding)
         measure = settings.measure_of(finding.code)
         if measure is not None:  # as in affinity check --format json
             row["measure"] = measure

@@ -52,6 +52,7 @@ def run(args) -> int:
 
     require(("PIL", "matplotlib"), "report")
 
+    from ..output.names import printable
     from ..pipeline.files import collect_paths
     from ..scenes import study_scenes
     from ..study.cases import mesh_cases
@@ -82,6 +83,6 @@ def run(args) -> int:
         table = PACKAGE_TABLE if args.table == "package" else args.table
         paths = write_outputs(rows, skipped, settings, args.output, _command_line(args), table)
     except OSError as err:
-        raise UsageError(f"{args.output}: cannot write ({err.strerror or err})") from None
+        raise UsageError(f"{printable(args.output)}: cannot write ({err.strerror or err})") from None
     progress(f"wrote {', '.join(paths)}")
     return EXIT_CLEAN

@@ -13,9 +13,13 @@ import contextlib
 import math
 import os
 import sys
+from typing import TYPE_CHECKING
 
 from ..errors import UsageError
 from . import EXIT_CLEAN, EXIT_ERROR, EXIT_FINDINGS
+
+if TYPE_CHECKING:
+    from ..shards.selection import Shard, ShardRecord
 
 
 def _codes(text: str) -> list[str]:
@@ -61,6 +65,12 @@ def _jobs(text: str) -> int:
     return int(text)
 
 
+def _shard(text: str) -> Shard:
+    from ..shards.selection import parse_shard
+
+    return parse_shard(text)
+
+
 def _time(text: str) -> float:
     try:
         time = float(text)
@@ -84,7 +94,6 @@ def _measure(text: str) -> str:
 def add_parser(sub) -> None:
     from ..loaders.formats import described
     from ..output import FORMATS
-    from ..rules import LEVELS
     from ..settings import DIAGONALS, MEASURES
 
     p = sub.add_parser(
@@ -128,6 +137,31 @@ def add_parser(sub) -> None:
                        help="record every current finding in FILE (counts per file, group and rule) and exit")
     p.add_argument("-j", "--jobs", type=_jobs, metavar="N",
                    help="check files in N processes (default: all CPUs, fewer when the files are small)")
+    add_gate_arguments(p)
+    p.add_argument("--max-findings", type=_count, metavar="N",
+                   help="json/junit/sarif/github: keep the worst N findings per file and rule, and say what was "
+                        "truncated (without it sarif and github keep the worst 5,000 of the whole run)")
+    p.add_argument("--show-files", action="store_true", help="list the files that would be checked and exit")
+    p.add_argument("--shard", type=_shard, metavar="K/N",
+                   help="check only shard K of N (1-based): each file in exactly one shard, the same on every "
+                        "machine; affinity merge joins the shards' --format json results into one")
+    p.add_argument("-o", "--output-file", metavar="PATH",
+                   help="write the output to PATH (whole or not at all); - is standard output")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="check the files on a Dask cluster: a scheduler address, env (DASK_SCHEDULER_ADDRESS) "
+                        "or local:N (N local worker processes); needs the distributed extra. "
+                        "none checks on this machine whatever the configuration says")
+    p.add_argument("--no-cache", action="store_true",
+                   help="check every file again instead of reusing the results of unchanged files "
+                        "(cache folder: AFFINITY_CACHE_DIR, else the user cache folder)")
+    add_display_arguments(p)
+    p.set_defaults(run=run)
+
+
+def add_gate_arguments(p) -> None:
+    """The options that decide the exit code :func:`publish` returns."""
+    from ..rules import LEVELS
+
     p.add_argument("--fail-on", choices=LEVELS, default="error",
                    help="the lowest level whose findings make exit 1 (default: error, a plainly visible "
                         "crease; warning also fails on the milder ones)")
@@ -136,23 +170,14 @@ def add_parser(sub) -> None:
     p.add_argument("--fail-on-skip", action="store_true",
                    help="exit 2 when a file was skipped (a Git LFS pointer, a USD stage with no mesh), so a "
                         "checkout without 'git lfs pull' cannot pass with nothing checked")
-    p.add_argument("--max-findings", type=_count, metavar="N",
-                   help="json/junit/sarif/github: keep the worst N findings per file and rule, and say what was "
-                        "truncated (without it sarif and github keep the worst 5,000 of the whole run)")
-    p.add_argument("--show-files", action="store_true", help="list the files that would be checked and exit")
-    p.add_argument("-o", "--output-file", metavar="PATH", help="write the output to PATH (whole or not at all)")
-    p.add_argument("--scheduler", metavar="ADDRESS",
-                   help="check the files on a Dask cluster: a scheduler address, env (DASK_SCHEDULER_ADDRESS) "
-                        "or local:N (N local worker processes); needs the distributed extra. "
-                        "none checks on this machine whatever the configuration says")
-    p.add_argument("--no-cache", action="store_true",
-                   help="check every file again instead of reusing the results of unchanged files "
-                        "(cache folder: AFFINITY_CACHE_DIR, else the user cache folder)")
+
+
+def add_display_arguments(p) -> None:
+    """The options of what :func:`publish` writes besides ``--format`` and ``-o``."""
     p.add_argument("--statistics", action="store_true",
                    help="text: counts per rule instead of findings; json/sarif/github/junit: counts added")
     p.add_argument("--verbose", action="store_true", help="show every finding in text output")
     p.add_argument("-q", "--quiet", action="store_true", help="print findings and nothing else")
-    p.set_defaults(run=run)
 
 
 def _overrides(args) -> dict:
@@ -172,16 +197,19 @@ def _overrides(args) -> dict:
     return {"thresholds": thresholds, **{k: v for k, v in given.items() if v is not None}}
 
 
-def _report_problems(reports, quiet: bool, skips_fail: bool = False) -> None:
+def report_problems(reports, quiet: bool, skips_fail: bool = False) -> None:
     """Unreadable files (always), skipped files (unless quiet; always when they fail the run) and the
     loader's notes (unless quiet), one line each on stderr."""
+    from ..output.names import printable
+
     for report in reports:
+        path = printable(report.path)
         if report.error is not None:
-            sys.stderr.write(f"{report.path}:{report.error_line}: Q901 unreadable: {report.error}\n")
+            sys.stderr.write(f"{path}:{report.error_line}: Q901 unreadable: {report.error}\n")
         elif report.skipped is not None and (skips_fail or not quiet):
-            sys.stderr.write(f"{report.path}: skipped ({report.skipped})\n")
+            sys.stderr.write(f"{path}: skipped ({report.skipped})\n")
         for note in [] if quiet else report.notes:
-            sys.stderr.write(f"{report.path}: note: {note}\n")
+            sys.stderr.write(f"{path}: note: {note}\n")
 
 
 def _progress_bar():
@@ -264,14 +292,29 @@ def _tasks(resolver, paths: list[str]) -> list:
     ]
 
 
+def _shard_tasks(tasks: list, shard: Shard, resolver, baseline: bool) -> tuple[list, ShardRecord]:
+    """The tasks of shard ``shard`` (:mod:`affinity.shards.selection`), in run order, and the record its
+    result carries. Paths are hashed relative to the folder of the configuration file governing the
+    working directory, else to the working directory."""
+    from ..shards.selection import select_shard
+
+    source = resolver.resolve(os.curdir).source
+    root = os.getcwd() if source is None else os.path.dirname(os.path.abspath(source))
+    positions, record = select_shard([path for path, _ in tasks], shard, root, baseline)
+    return [tasks[i] for i in positions], record
+
+
 def _write_baseline(reports, path: str, quiet: bool) -> None:
     from ..pipeline import baseline
 
     recorded = baseline.record(reports, path)
     baseline.write(recorded, path)
     if not quiet:
+        from ..output.names import printable
+
         files = len({key[0] for key in recorded.counts})
-        sys.stderr.write(f"Wrote {sum(recorded.counts.values())} findings in {files} files to the baseline {path}.\n")
+        sys.stderr.write(f"Wrote {sum(recorded.counts.values())} findings in {files} files to the baseline "
+                         f"{printable(path)}.\n")
 
 
 def run(args) -> int:
@@ -282,6 +325,8 @@ def run(args) -> int:
 
     if args.baseline and args.write_baseline:
         raise UsageError("--baseline and --write-baseline exclude each other")
+    if args.shard is not None and args.write_baseline:
+        raise UsageError("--write-baseline records the whole run's findings: run it without --shard")
     resolver = Resolver(_overrides(args), config=args.config, isolated=args.isolated)
     paths = list(args.paths)
     if args.demo:
@@ -291,7 +336,7 @@ def run(args) -> int:
     if args.show_settings:
         from ..output.show_settings import write_settings
 
-        write_settings(resolver, paths or [os.curdir], sys.stdout)
+        _write_output_file(args.output_file, lambda out: write_settings(resolver, paths or [os.curdir], out))
         return EXIT_CLEAN
     if args.baseline:
         from ..pipeline import baseline
@@ -299,8 +344,13 @@ def run(args) -> int:
         known = baseline.read(args.baseline)  # before the check: a bad baseline fails fast
 
     tasks = _tasks(resolver, paths)
+    shard = None
+    if args.shard is not None:
+        tasks, shard = _shard_tasks(tasks, args.shard, resolver, bool(args.baseline))
     if args.show_files:
-        _write_output_file(args.output_file, lambda out: out.writelines(path + "\n" for path, _ in tasks))
+        from ..output.names import printable
+
+        _write_output_file(args.output_file, lambda out: out.writelines(printable(path) + "\n" for path, _ in tasks))
         return EXIT_CLEAN
     run_options = resolver.run_options()
     show_progress = len(tasks) > 1 and sys.stderr.isatty()
@@ -308,20 +358,30 @@ def run(args) -> int:
     with _result_cache(args, run_options) as cache:
         reports = check_files(tasks, args.jobs, _progress_bar() if show_progress else None,
                               usd=UsdOptions(args.time, args.uv_primvar), cache=cache, cluster=cluster)
-    _report_problems(reports, args.quiet, args.fail_on_skip)
-    failed = any(r.error is not None or (args.fail_on_skip and r.skipped is not None) for r in reports)
+    report_problems(reports, args.quiet, args.fail_on_skip)
     if args.write_baseline:
         _write_baseline(reports, args.write_baseline, args.quiet)
-        return EXIT_ERROR if failed else EXIT_CLEAN
+        return EXIT_ERROR if _failed(reports, args.fail_on_skip) else EXIT_CLEAN
 
     check_run = CheckRun(reports, resolver.resolve(os.curdir).settings,
-                         max_findings=args.max_findings, statistics=args.statistics)
+                         max_findings=args.max_findings, statistics=args.statistics, shard=shard)
     if args.baseline:
         check_run.reports, check_run.baselined = baseline.apply(reports, known)
+    return publish(check_run, args)
+
+
+def publish(check_run, args) -> int:
+    """Write ``check_run`` as ``args`` asks (``--format``, ``-o``, ``--verbose``, ``--statistics``, ``-q``)
+    and return the run's exit code (``--fail-on``, ``--exit-zero``, ``--fail-on-skip``; design.md)."""
     _write_output_file(args.output_file, lambda out: _write_output(check_run, args, out))
-    if failed:
+    if _failed(check_run.reports, args.fail_on_skip):
         return EXIT_ERROR
     return EXIT_CLEAN if args.exit_zero or not _fails(check_run.reports, args.fail_on) else EXIT_FINDINGS
+
+
+def _failed(reports, fail_on_skip: bool) -> bool:
+    """Whether the run exits 2 whatever its findings: an unreadable file, or a skipped one with ``--fail-on-skip``."""
+    return any(r.error is not None or (fail_on_skip and r.skipped is not None) for r in reports)
 
 
 def _fails(reports, fail_on: str) -> bool:
@@ -333,7 +393,8 @@ def _fails(reports, fail_on: str) -> bool:
 
 
 def _write_output_file(path: str | None, write) -> None:
-    """``write(out)`` to stdout, or to ``path`` atomically (a failed run leaves no partial file)."""
+    """``write(out)`` to stdout, or to ``path`` atomically (a failed run leaves no partial file; ``-`` is
+    standard output, written whole too)."""
     if path is None:
         write(sys.stdout)
         return
@@ -343,7 +404,9 @@ def _write_output_file(path: str | None, write) -> None:
         with atomic_write(path) as out:
             write(out)
     except OSError as err:
-        raise UsageError(f"{path}: cannot write the output: {err.strerror or err}") from None
+        from ..output.names import printable
+
+        raise UsageError(f"{printable(path)}: cannot write the output: {err.strerror or err}") from None
 
 
 def _write_output(check_run, args, out) -> None:

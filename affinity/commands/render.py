@@ -53,6 +53,7 @@ def run(args) -> int:
     from ..draw import RenderOptions, render_mesh
     from ..draw.texture import TextureError
     from ..errors import MeshError, SkippedFile
+    from ..output.names import printable
 
     try:
         options = RenderOptions(
@@ -63,15 +64,15 @@ def run(args) -> int:
         result = render_mesh(args.mesh, options,
                              warn=lambda line: sys.stderr.write(f"affinity render: warning: {line}\n"))
     except MeshError as err:
-        raise UsageError(f"{err.path}:{err.line}: {err.reason}") from None
+        raise UsageError(f"{printable(err.path)}:{err.line}: {err.reason}") from None
     except SkippedFile as skip:
-        raise UsageError(f"{skip.path}: skipped ({skip.reason}): nothing to render") from None
+        raise UsageError(f"{printable(skip.path)}: skipped ({skip.reason}): nothing to render") from None
     except (TextureError, ValueError) as err:
         raise UsageError(str(err)) from None
     try:
         result.save_png(args.output)
     except OSError as err:
-        raise UsageError(f"{args.output}: cannot write ({err.strerror or err})") from None
+        raise UsageError(f"{printable(args.output)}: cannot write ({err.strerror or err})") from None
     if not args.quiet:
-        sys.stderr.write(result.summary() + f"; wrote {args.output}\n")
+        sys.stderr.write(result.summary() + f"; wrote {printable(args.output)}\n")
     return EXIT_CLEAN

@@ -71,16 +71,19 @@ def _positive(text: str) -> int:
 
 def _check_writable(path: str) -> None:
     """Fail before the work, with a clear line, when ``path`` cannot be written."""
+    from ..output.names import printable
+
     target = os.path.realpath(path)  # a link is written through (affinity.atomic)
     folder = os.path.dirname(target)
     if os.path.isdir(target):
-        raise UsageError(f"{path}: is a directory (name the HTML file to write)")
+        raise UsageError(f"{printable(path)}: is a directory (name the HTML file to write)")
     if os.path.exists(target) and not os.path.isfile(target):
         return  # a device or pipe, written in place
     if not os.path.isdir(folder):
-        raise UsageError(f"{path}: cannot write the report: no such directory {folder}")
+        raise UsageError(f"{printable(path)}: cannot write the report: no such directory {printable(folder)}")
     if not os.access(folder, os.W_OK):
-        raise UsageError(f"{path}: cannot write the report: the directory {folder} is not writable")
+        raise UsageError(f"{printable(path)}: cannot write the report: the directory {printable(folder)} "
+                         "is not writable")
 
 
 def _inputs(paths: list[str], resolver) -> list:
@@ -98,12 +101,13 @@ def _inputs(paths: list[str], resolver) -> list:
 
 def _write(path: str, html: str) -> None:
     from ..atomic import atomic_write
+    from ..output.names import printable
 
     try:
         with atomic_write(path) as out:
             out.write(html)
     except OSError as err:
-        raise UsageError(f"{path}: cannot write the report ({err.strerror or err})") from None
+        raise UsageError(f"{printable(path)}: cannot write the report ({err.strerror or err})") from None
 
 
 def run(args) -> int:
@@ -112,6 +116,7 @@ def run(args) -> int:
     from tqdm import tqdm
 
     from ..config import Resolver
+    from ..output.names import printable
     from ..report.build import ReportOptions, collect_run
     from ..report.page import render_page
 
@@ -136,7 +141,7 @@ def run(args) -> int:
                              resolver.resolve(os.curdir).settings, bar, options, demo=not args.meshes, start=start)
         skipped = [result.file for result in report.meshes if result.file.skipped is not None]
         if len(inputs) == 1 and skipped:  # a report of nothing: say so, write nothing
-            raise UsageError(f"{skipped[0].path}: skipped ({skipped[0].skipped}): nothing to report")
+            raise UsageError(f"{printable(skipped[0].path)}: skipped ({skipped[0].skipped}): nothing to report")
         bar.set_postfix_str("writing the page")
         collected = time.perf_counter()
         html = render_page(report)
@@ -145,13 +150,13 @@ def run(args) -> int:
 
     failed = [result.file for result in report.meshes if result.file.error is not None]
     for file in failed:
-        sys.stderr.write(f"{file.path}:{file.error_line}: Q901 unreadable: {file.error}\n")
+        sys.stderr.write(f"{printable(file.path)}:{file.error_line}: Q901 unreadable: {file.error}\n")
     for file in skipped:
-        sys.stderr.write(f"{file.path}: skipped ({file.skipped})\n")
+        sys.stderr.write(f"{printable(file.path)}: skipped ({file.skipped})\n")
     if not args.quiet:
         unreadable = f", {len(failed)} unreadable" if failed else ""
         unreadable += f", {len(skipped)} skipped" if skipped else ""
-        sys.stderr.write(f"affinity report: wrote {args.output} "
+        sys.stderr.write(f"affinity report: wrote {printable(args.output)} "
                          f"({len(inputs)} file{'s' * (len(inputs) != 1)}{unreadable}, "
                          f"{len(html.encode()) / 1e6:.1f} MB, {finished - start:.1f} s wall: "
                          f"{report.seconds:.1f} s collecting, {finished - collected:.1f} s writing the page)\n")

@@ -34,6 +34,7 @@ def add_parser(sub) -> None:
 def run(args) -> int:
     require(("mpmath",), "stability")
     from ..atomic import atomic_write
+    from ..output.names import printable
     from ..stability import table
     from ..stability.run import PRECISIONS
     from ..stability.run import run as run_catalogue
@@ -42,7 +43,7 @@ def run(args) -> int:
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as err:
-        raise UsageError(f"{folder}: cannot create ({err.strerror or err})") from None
+        raise UsageError(f"{printable(str(folder))}: cannot create ({err.strerror or err})") from None
     started = time.perf_counter()
     rows = run_catalogue(PRECISIONS if args.float32 else PRECISIONS[:1])
     seconds = time.perf_counter() - started
@@ -53,6 +54,6 @@ def run(args) -> int:
         with atomic_write(folder / MARKDOWN_NAME) as f:
             f.write(table.markdown(rows, seconds))
     except OSError as err:
-        raise UsageError(f"{folder}: cannot write ({err.strerror or err})") from None
+        raise UsageError(f"{printable(str(folder))}: cannot write ({err.strerror or err})") from None
     failed = any(r.status == "fail" and r.precision == "float64" and not r.naive for r in rows)
     return EXIT_FINDINGS if failed else EXIT_CLEAN

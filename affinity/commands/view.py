@@ -34,13 +34,14 @@ def _scores(mesh, path: str, attribute: str | None):
     """The chosen attribute's scores under the file's configuration, None when the mesh has nothing to score."""
     from ..config import file_settings
     from ..lint import quad_scores, scored_code_of, scored_codes
+    from ..output.names import printable
 
     if attribute is None:
         code = next(iter(scored_codes(mesh)), None)  # uv, else colours, else normals
     else:
         code = scored_code_of(attribute, mesh)
         if code not in scored_codes(mesh):
-            raise UsageError(f"{path}: the mesh has no {attribute} attribute to score")
+            raise UsageError(f"{printable(path)}: the mesh has no {attribute} attribute to score")
     if code is None:
         return None
     return quad_scores(mesh, file_settings(path), code)
@@ -48,15 +49,16 @@ def _scores(mesh, path: str, attribute: str | None):
 
 def run(args) -> int:
     from ..loaders import load
+    from ..output.names import printable
     from ..view import overview_image, show
 
     require(("pyvista",), "view")
     try:
         mesh = load(args.mesh)
     except MeshError as err:
-        raise UsageError(f"{err.path}:{err.line}: {err.reason}") from None
+        raise UsageError(f"{printable(err.path)}:{err.line}: {err.reason}") from None
     except SkippedFile as skip:
-        raise UsageError(f"{skip.path}: skipped ({skip.reason})") from None
+        raise UsageError(f"{printable(skip.path)}: skipped ({skip.reason})") from None
     scores = _scores(mesh, args.mesh, args.attribute)
     if args.screenshot is None:
         show(mesh, scores, args.up)
@@ -67,5 +69,5 @@ def run(args) -> int:
     try:
         write_png(args.screenshot, pixels)
     except OSError as err:
-        raise UsageError(f"{args.screenshot}: cannot write ({err.strerror or err})") from None
+        raise UsageError(f"{printable(args.screenshot)}: cannot write ({err.strerror or err})") from None
     return EXIT_CLEAN

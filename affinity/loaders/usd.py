@@ -19,7 +19,11 @@ Mapping to the mesh model, per prim:
   unless :attr:`UsdOptions.time` says otherwise; every other value is read at
   the same time;
 - ``faceVertexCounts``/``faceVertexIndices`` as faces of any size, the stored
-  cage as is (``subdivisionScheme`` and ``holeIndices`` are not applied);
+  cage as is (``subdivisionScheme`` and ``holeIndices`` are not applied; a stage
+  with Catmull-Clark or Loop meshes, USD's default, gets one note saying the
+  findings are for the cage);
+- where the points and topology are authored (:func:`geometry_source`), so prims
+  that reference one geometry layer can be reported once, at that layer;
 - ``orientation = "leftHanded"`` reverses every face's winding, keeping corner 0
   (``a b c d`` becomes ``a d c b``): the split diagonal 0-2 stays the one a
   renderer triangulates along;
@@ -140,40 +144,71 @@ def load_usd(path, options: UsdOptions | None = None) -> Mesh:
     values are invalid; SkippedFile (``no-mesh``) when it has no mesh to check.
     """
     try:
-        from pxr import Tf, Usd, UsdGeom
+        from pxr import Tf, Usd
     except ImportError:
         raise MeshError(path, 0, f"reading USD needs usd-core: {INSTALL}") from None
-    options = options or UsdOptions()
     try:
         stage = Usd.Stage.Open(os.fspath(path))
     except Tf.ErrorException as error:
-        reason = _pxr_reason(error)
+        reason = pxr_reason(error)
         line = _TEXT_LINE.search(reason)  # .usda parse errors say where: "file.usda:7:9: ..."
         raise MeshError(path, int(line.group(1)) if line else 0, f"cannot open the stage: {reason}") from None
+    mesh = load_stage(stage, os.fspath(path), options)
+    mesh.resources = [Resource(role="usd-asset", name=asset, path=os.path.normpath(absolute))
+                      for asset, absolute in layer_assets(path)]
+    return mesh
+
+
+def load_stage(stage, path: str, options: UsdOptions | None = None, prim_paths: list[str] | None = None,
+               bad_prims: dict[str, str] | None = None) -> Mesh:
+    """The drawn mesh prims of an open ``Usd.Stage`` as one mesh named ``path``: all of them, or those
+    of ``prim_paths`` (in that order), as :func:`load_usd` reads a file.
+
+    Raises MeshError and SkippedFile as :func:`load_usd` does. With ``bad_prims`` (a dict) a prim
+    that cannot be read is left out and its path mapped to the reason there instead of raising.
+    """
+    from pxr import Tf, Usd, UsdGeom
+
+    options = options or UsdOptions()
     time = Usd.TimeCode.EarliestTime() if options.time is None else Usd.TimeCode(options.time)
     try:
         xforms = UsdGeom.XformCache(time)
-        prims, notes = _mesh_prims(stage, time)
+        if prim_paths is None:
+            prims, notes = _mesh_prims(stage, time)
+        else:
+            prims, notes = [stage.GetPrimAtPath(prim_path) for prim_path in prim_paths], []
     except Tf.ErrorException as error:
-        raise MeshError(path, 0, f"cannot read the stage: {_pxr_reason(error)}") from None
+        raise MeshError(path, 0, f"cannot read the stage: {pxr_reason(error)}") from None
     if not prims:  # a material, light or layout layer: nothing of ours to check
         raise SkippedFile(path, "no-mesh")
-    parts = []
+    parts, sources, read = [], [], []
     for prim in prims:
         try:
-            parts.append(_read_prim(prim, time, xforms, options.uv_primvar))
+            part, source = _read_prim(prim, time, xforms, options.uv_primvar), \
+                geometry_source(prim, time)
         except (_BadPrim, Tf.ErrorException) as error:
-            reason = str(error) if isinstance(error, _BadPrim) else _pxr_reason(error)
-            raise MeshError(path, 0, f"{prim.GetPath()}: {reason}") from None
+            reason = str(error) if isinstance(error, _BadPrim) else pxr_reason(error)
+            if bad_prims is None:
+                raise MeshError(path, 0, f"{prim.GetPath()}: {reason}") from None
+            bad_prims[str(prim.GetPath())] = reason
+            continue
+        parts.append(part)
+        sources.append(source)
+        read.append(prim)
+    if not read:  # every prim asked for was bad (and reported in bad_prims)
+        raise SkippedFile(path, "no-mesh")
+    prims = read
+    subdivided = _subdivision_note(prims, time)
+    if subdivided:
+        notes.append(subdivided)
     if options.uv_primvar and all(part.texcoords is None for part in parts):
         notes.append(f"no mesh has the primvar {options.uv_primvar!r}: texture coordinates not checked")
-    mesh = _concatenate(os.fspath(path), parts, [str(prim.GetPath()) for prim in prims])
+    mesh = _concatenate(path, parts, [str(prim.GetPath()) for prim in prims])
+    mesh.prim_sources = sources
     mesh.up_axis = _stage_metadata(stage, "upAxis", lambda: str(UsdGeom.GetStageUpAxis(stage)), notes)
     mesh.meters_per_unit = _stage_metadata(stage, "metersPerUnit", lambda: float(UsdGeom.GetStageMetersPerUnit(stage)),
                                            notes)
     mesh.notes = notes
-    mesh.resources = [Resource(role="usd-asset", name=asset, path=os.path.normpath(absolute))
-                      for asset, absolute in layer_assets(path)]
     _bind_materials(mesh, prims, options.uv_primvar)
     return mesh
 
@@ -200,6 +235,47 @@ def _bind_materials(mesh: Mesh, prims: list, uv_primvar: str | None) -> None:
     mesh.face_material = np.repeat(np.asarray(per_prim, dtype=np.int32), sizes)
 
 
+def geometry_source(prim, time) -> tuple[str, str] | None:
+    """``(layer, prim path in that layer)`` where the mesh prim's ``points``, ``faceVertexCounts`` and
+    ``faceVertexIndices`` are authored (the strongest opinion with a value), the layer named by its
+    real path (its identifier when it has none, e.g. an anonymous layer); None when the three come
+    from different places. Prims that reference one geometry layer share their source."""
+    from pxr import UsdGeom
+
+    usd_mesh = UsdGeom.Mesh(prim)
+    sources = {_authored_at(attr, time) for attr in (usd_mesh.GetPointsAttr(), usd_mesh.GetFaceVertexCountsAttr(),
+                                                     usd_mesh.GetFaceVertexIndicesAttr())}
+    return sources.pop() if len(sources) == 1 else None
+
+
+def _authored_at(attr, time) -> tuple[str, str] | None:
+    """(layer, prim path) of the strongest spec of ``attr`` holding a default or time samples."""
+    for spec in attr.GetPropertyStack(time):
+        if spec.HasDefaultValue() or spec.layer.GetNumTimeSamplesForPath(spec.path):
+            return spec.layer.realPath or spec.layer.identifier, str(spec.path.GetPrimPath())
+    return None
+
+
+#: Subdivision schemes a renderer may refine: the numbers of this tool are for the cage they start from.
+SUBDIVIDED = ("catmullClark", "loop")
+
+
+def _subdivision_note(prims, time) -> str | None:
+    """One note for the prims whose ``subdivisionScheme`` (authored, or USD's default Catmull-Clark)
+    makes them subdivision surfaces; None when there are none."""
+    from pxr import UsdGeom
+
+    schemes = [str(UsdGeom.Mesh(prim).GetSubdivisionSchemeAttr().Get(time)) for prim in prims]
+    count = sum(scheme in SUBDIVIDED for scheme in schemes)
+    if not count:
+        return None
+    named = " or ".join(sorted({scheme for scheme in schemes if scheme in SUBDIVIDED}))
+    return (f"{count} of {len(prims)} mesh prim{'s' * (len(prims) != 1)} subdivide{'s' * (count == 1)} "
+            f"(subdivisionScheme {named}, "
+            "authored or USD's default): the findings are for the cage, which is what Storm draws at its default "
+            "complexity and what game engines draw")
+
+
 def _stage_metadata(stage, name: str, read, notes: list[str]):
     """``read()``, the stage's ``name`` metadata; None and a note when it cannot be read
     (e.g. a value of the wrong type): the meshes are checked all the same."""
@@ -208,12 +284,12 @@ def _stage_metadata(stage, name: str, read, notes: list[str]):
     try:
         return read()
     except (Tf.ErrorException, TypeError, ValueError) as error:
-        reason = _pxr_reason(error) if isinstance(error, Tf.ErrorException) else str(error)
+        reason = pxr_reason(error) if isinstance(error, Tf.ErrorException) else str(error)
         notes.append(f"the stage's {name} cannot be read ({reason}): not recorded")
         return None
 
 
-def _pxr_reason(error) -> str:
+def pxr_reason(error) -> str:
     """The first (most specific) message of a ``Tf.ErrorException``, on one line."""
     text = getattr(error.args[0], "commentary", str(error)) if error.args else str(error)
     return " ".join(_INTERNAL_NAME.sub("", text).split())
@@ -351,6 +427,15 @@ def _uv_primvar(primvars, time, name: str | None) -> _Primvar | None:
         chosen = next((pv for pv in primvars.FindPrimvarsWithInheritance()
                        if str(pv.GetTypeName()) in _TEXCOORD2 and pv.HasValue()), None)
     return _primvar(chosen, time, width=2)
+
+
+def uv_primvar_name(prim, time, name: str | None = None) -> str | None:
+    """The attribute name (``primvars:st``) of the primvar the loader reads as ``prim``'s texture
+    coordinates, with :attr:`UsdOptions.uv_primvar` ``name``; None when it has none."""
+    from pxr import UsdGeom
+
+    uv = _uv_primvar(UsdGeom.PrimvarsAPI(prim), time, name)
+    return None if uv is None else uv.name
 
 
 def _normals(usd_mesh, primvars, time) -> _Primvar | None:

@@ -8,15 +8,21 @@ for CI test reports). This package holds what they share: the flat
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
 import os
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..findings import FileReport, RuleHits
 from ..rules import LEVELS, RULES, with_unit
 from ..settings import Settings
+from .names import printable
+
+if TYPE_CHECKING:
+    from ..shards.selection import ShardRecord
 
 FORMATS = ("text", "json", "sarif", "github", "junit")
 #: SARIF results / GitHub annotations per run without ``--max-findings``: code scanning takes at most 25,000.
@@ -33,6 +39,8 @@ class CheckRun:
     ``max_findings`` caps the findings the structured formats keep per file and
     rule (the worst; ``--max-findings``); without it SARIF and GitHub output keep
     at most ``run_cap`` per run (:meth:`capped`). ``statistics`` asks for per-rule counts.
+    ``shard`` (:class:`affinity.shards.selection.ShardRecord`) is set when the run
+    checked one shard of a larger one (``--shard K/N``).
     """
 
     reports: list[FileReport]
@@ -41,6 +49,7 @@ class CheckRun:
     max_findings: int | None = None
     statistics: bool = False
     run_cap: int = RUN_CAP
+    shard: ShardRecord | None = None
 
     def tally(self) -> dict[str, int]:
         """Counts for a summary: ``files``, ``checked``, ``unreadable``, ``skipped``, ``findings``, ``baselined``."""
@@ -81,7 +90,11 @@ class Finding:
 
     In a USD stage, ``prim`` is the mesh prim's path, ``face`` counts within that
     prim, and ``line``/``column`` are 0; ``prim`` is None in other formats and for
-    file-level findings.
+    file-level findings. Where several prims reference one geometry layer
+    (:attr:`FileReport.shared`), the finding is reported once: ``prim`` is the first
+    of them, ``layer`` and ``layer_prim`` say where the mesh is authored, ``prims``
+    lists every referencing prim, ``value`` is the worst over them and
+    ``prim_values`` (when their values differ) gives each prim's own (None: no finding there).
     """
 
     path: str
@@ -97,13 +110,30 @@ class Finding:
     group: str
     message: str
     prim: str | None = None
+    layer: str | None = None
+    layer_prim: str | None = None
+    prims: list[str] | None = None
+    prim_values: list[float | None] | None = None
     shift: float | None = None
     bound: str | None = None
     texture: str | None = None
     role: str | None = None
 
-    #: The fields of Q101's visible reading (design.md): set where C was read through a texture.
-    VISIBLE = ("shift", "bound", "texture", "role")
+
+#: The Finding fields only a USD stage fills: left out of structured output where they are None.
+USD_FIELDS = ("prim", "layer", "layer_prim", "prims", "prim_values")
+#: The fields of Q101's visible reading (design.md): set where C was read through a texture, else left out.
+VISIBLE_FIELDS = ("shift", "bound", "texture", "role")
+
+
+def finding_dict(f: Finding) -> dict:
+    """The finding as a dict with the keys of a JSON finding (the USD-only ones where they apply).
+
+    Shallow: the lists (``prims``) are the finding's own, not copies (``dataclasses.asdict`` deep-copies
+    every value, which took 6 s for 8,827 findings naming 32 prims each).
+    """
+    return {field.name: value for field in dataclasses.fields(f)
+            if (value := getattr(f, field.name)) is not None or field.name not in (*USD_FIELDS, *VISIBLE_FIELDS)}
 
 
 def writer(name: str):
@@ -128,8 +158,9 @@ def _rows(report: FileReport, hits: RuleHits, take: np.ndarray) -> list[tuple[in
     usd = report.prim_face_start is not None
     if usd:  # no lines; faces count within their prim (the file-level face -1 stays -1)
         faces, lines = faces - report.prim_face_start[groups], np.zeros_like(lines)
+    shared = {entry["prim"]: entry for entry in report.shared}
     return [
-        (order, Finding(
+        (order, _shared_geometry(Finding(
             path=report.path,
             line=int(line),
             column=1 if line > 0 else 0,
@@ -144,7 +175,7 @@ def _rows(report: FileReport, hits: RuleHits, take: np.ndarray) -> list[tuple[in
             message=": ".join(filter(None, [rule.summary, seen.pop("remark", None), detail])),
             prim=group_name(report, g) if usd and order >= 0 else None,
             **seen,
-        ))
+        ), shared))
         for order, face, line, value, g, detail, level, seen in zip(
             hits.faces[take].tolist(), faces.tolist(), lines.tolist(),
             hits.values[take].tolist(), groups.tolist(), details, hits.levels()[take].tolist(), visible,
@@ -170,9 +201,23 @@ def _visible_fields(hits: RuleHits, take: np.ndarray, path: str) -> list[dict]:
         texture = os.path.relpath(os.path.abspath(columns.textures[pick]), folder)
         rows.append({"threshold": columns.limits[1], "unit": columns.units[pick], "shift": shift,
                      "bound": BOUND_NAMES.get(bound), "texture": texture, "role": columns.roles[pick],
-                     "remark": f"the split shifts the {columns.roles[pick]} texture {texture} by "
-                               f"{format_value(shift)} texels"})
+                     "remark": visible_remark(columns.roles[pick], texture, shift)})
     return rows
+
+
+def visible_remark(role: str, texture: str, shift: float) -> str:
+    """What a finding read through a texture says after its rule's summary: which texture and how far the
+    split shifts it."""
+    return f"the split shifts the {role} texture {texture} by {format_value(shift)} texels"
+
+
+def _shared_geometry(f: Finding, shared: dict[str, dict]) -> Finding:
+    """``f`` with where its geometry is authored and the prims that reference it, when several do."""
+    entry = shared.get(f.prim)
+    if entry is not None:
+        f.layer, f.layer_prim, f.prims = entry["layer"], entry["layer_prim"], entry["prims"]
+        f.prim_values = dict((face, values) for face, values in entry["values"].get(f.code, [])).get(f.face)
+    return f
 
 
 def severity(f: Finding) -> tuple[int, float]:
@@ -302,9 +347,20 @@ def text_line(f: Finding) -> str:
     """The ruff-style line ``path:line:col: CODE name: message (value vs threshold unit) [face F]``
     (design.md); ``path:prim:face N: ...`` in USD, no ``[face]`` for file-level findings."""
     if f.prim is not None:
-        return f"{f.path}:{f.prim}:face {f.face}: {f.code} {f.name}: {describe(f)}"
+        return f"{printable(f.path)}:{f.prim}:face {f.face}: {f.code} {f.name}: {describe(f)}{authored_where(f)}"
     face = f" [face {f.face}]" if f.face >= 0 else ""
-    return f"{f.path}:{f.line}:{f.column}: {f.code} {f.name}: {describe(f)}{face}"
+    return f"{printable(f.path)}:{f.line}:{f.column}: {f.code} {f.name}: {describe(f)}{face}"
+
+
+def authored_where(f: Finding) -> str:
+    """`` [authored in LAYER:/prim, referenced by /a (3.2), /b (1.1)]`` for a finding on geometry several
+    prims reference (each prim's own value where they differ); ``""`` otherwise."""
+    if f.prims is None:
+        return ""
+    values = f.prim_values or [None] * len(f.prims)
+    prims = ", ".join(p if v is None and f.prim_values is None else f"{p} ({'-' if v is None else format_value(v)})"
+                      for p, v in zip(f.prims, values))
+    return f" [authored in {printable(working_relative(f.layer) or f.layer)}:{f.layer_prim}, referenced by {prims}]"
 
 
 def working_relative(path: str) -> str | None:

@@ -8,7 +8,11 @@ and, when the format has source lines, ``region.startLine`` = the face's line
 (binary PLY and USD have none, so there the region is left out) — and by a
 logical location: the face, or in a USD stage the mesh prim (kind ``object``,
 its path as fully qualified name; the face within it is in the message and the
-properties). ``properties`` carry face, value, threshold, group and, in USD, prim.
+properties). ``properties`` carry face, value, threshold, group and, in USD, prim. A mesh
+that several prims reference from one geometry layer is one result: its logical
+locations are every referencing prim, its related location the geometry layer (and the
+prim there), and its properties add ``layer``, ``layer_prim``, ``prims`` and, where the
+prims' values differ, ``prim_values``.
 
 ``partialFingerprints["quadAffinity/v1"]`` identifies a finding across runs: a
 hash of rule, file, group and the measured value rounded to 6 significant
@@ -27,6 +31,10 @@ file keeps the worst N results per rule instead, and the run's
 the total; ``--statistics`` adds ``properties.statistics`` (per-rule
 counts). The log is written compact.
 
+A shard's log (``--shard K/N``) names its shard in ``automationDetails.id``
+(``quad-affinity/shard-K-of-N/``, the category code scanning keys uploads by), so
+the shards' uploads do not replace each other; a merged log has none.
+
 Unreadable (Q901) and skipped files are not results: they are tool execution
 notifications of the run's invocation, and an unreadable file makes
 ``executionSuccessful`` false.
@@ -44,7 +52,18 @@ from urllib.parse import quote
 from .. import __version__
 from ..findings import FileReport
 from ..rules import RULES, UNREADABLE, rule_page
-from . import CheckRun, Finding, face_label, located, statistics, truncation, value_token, working_relative
+from . import (
+    VISIBLE_FIELDS,
+    CheckRun,
+    Finding,
+    authored_where,
+    face_label,
+    located,
+    statistics,
+    truncation,
+    value_token,
+    working_relative,
+)
 
 SARIF_VERSION = "2.1.0"
 SARIF_SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
@@ -62,6 +81,12 @@ def _descriptor(rule) -> dict:
         "defaultConfiguration": {"level": sarif_level(rule.level)},
         "properties": {"unit": rule.unit, "defaultThreshold": rule.default_threshold},
     }
+
+
+def shard_category(shard) -> str:
+    """The code scanning category of shard K of N: ``quad-affinity/shard-K-of-N/`` (a trailing ``/``
+    makes the whole id the category, with no run id)."""
+    return f"quad-affinity/shard-{shard.index}-of-{shard.of}/"
 
 
 def sarif_level(level: str) -> str:
@@ -106,18 +131,26 @@ def _result(f: Finding, ordinal: int, location: dict, rule_index: int) -> dict:
     logical = _logical_location(f)
     if logical:
         result_location["logicalLocations"] = [logical]
-    return {
+    result = {
         "ruleId": f.code,
         "ruleIndex": rule_index,
         "level": sarif_level(f.level),
-        "message": {"text": located(f)},
+        "message": {"text": located(f) + authored_where(f)},
         "locations": [result_location],
         "partialFingerprints": {FINGERPRINT: fingerprint(f.code, location["uri"], f.group, f.value, ordinal)},
         "properties": {"name": f.name, "face": f.face, "value": f.value,
                        "threshold": f.threshold, "unit": f.unit, "level": f.level, "group": f.group,
                        **({} if f.prim is None else {"prim": f.prim}),
-                       **{name: getattr(f, name) for name in Finding.VISIBLE if getattr(f, name) is not None}},
+                       **{name: getattr(f, name) for name in VISIBLE_FIELDS if getattr(f, name) is not None}},
     }
+    if f.prims is not None:  # geometry several prims reference: where it is authored, and who references it
+        result_location["logicalLocations"] = [_prim_location(prim) for prim in f.prims]
+        result["relatedLocations"] = [{"id": 0, "physicalLocation": {"artifactLocation": artifact_location(f.layer)},
+                                       "logicalLocations": [_prim_location(f.layer_prim)],
+                                       "message": {"text": "where the mesh is authored"}}]
+        result["properties"].update(layer=f.layer, layer_prim=f.layer_prim, prims=f.prims,
+                                    **({} if f.prim_values is None else {"prim_values": f.prim_values}))
+    return result
 
 
 def _results(run: CheckRun) -> tuple[list[dict], str | None]:
@@ -131,10 +164,14 @@ def _results(run: CheckRun) -> tuple[list[dict], str | None]:
     return results, run.cap_notice(len(kept), len(rows), "SARIF results")
 
 
+def _prim_location(prim: str) -> dict:
+    return {"name": prim.rsplit("/", 1)[-1], "fullyQualifiedName": prim, "kind": "object"}
+
+
 def _logical_location(f: Finding) -> dict | None:
     """The USD mesh prim, or the face (qualified by its group); None for file-level findings."""
     if f.prim is not None:
-        return {"name": f.prim.rsplit("/", 1)[-1], "fullyQualifiedName": f.prim, "kind": "object"}
+        return _prim_location(f.prim)
     if not face_label(f):
         return None
     qualified = "/".join(filter(None, [f.group, face_label(f)]))
@@ -195,6 +232,7 @@ def document(run: CheckRun) -> dict:
             "originalUriBaseIds": {SRCROOT: {"uri": _folder_uri(Path.cwd())}},
             "columnKind": "unicodeCodePoints",
             "results": results,
+            **({} if run.shard is None else {"automationDetails": {"id": shard_category(run.shard)}}),
             **({"properties": properties} if properties else {}),
         }],
     }

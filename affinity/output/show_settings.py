@@ -14,6 +14,7 @@ from typing import TextIO
 from ..config import Resolver
 from ..rules import RULES, resolve_codes
 from ..settings import Settings
+from .names import printable
 
 
 def _toml(value) -> str:
@@ -76,9 +77,9 @@ def write_settings(resolver: Resolver, paths: list[str], out: TextIO) -> None:
         settings = resolved.settings
         source = resolved.source or "no configuration file (defaults and command-line flags)"
         head = [
-            _comment(f"settings for {', '.join(names)}"),
-            _comment(f"from {source}"),
-            _comment(f"globs relative to {settings.root or '(none)'}"),
+            _comment(f"settings for {', '.join(map(printable, names))}"),
+            _comment(f"from {printable(str(source))}"),
+            _comment(f"globs relative to {printable(str(settings.root)) if settings.root else '(none)'}"),
             _comment(f"rules enabled: {', '.join(resolve_codes(settings.select, settings.ignore))}"),
         ]
         out.write(("\n" if i else "") + "\n".join(head + settings_toml(settings)) + "\n")

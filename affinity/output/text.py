@@ -9,6 +9,7 @@ from __future__ import annotations
 from typing import TextIO
 
 from . import CheckRun, file_findings, level_counts, statistics, text_line
+from .names import printable
 
 #: Findings shown per file and rule before "... and N more" (design.md, Clarifications).
 TEXT_LIMIT = 20
@@ -29,7 +30,7 @@ def write_findings(run: CheckRun, out: TextIO, verbose: bool = False) -> None:
     for report in run.reports:
         findings, omitted = file_findings(report, None if verbose else TEXT_LIMIT)
         lines = [text_line(f) + "\n" for f in findings]
-        lines += [f"{report.path}: ... and {n} more {code} (use --verbose or --format json for all)\n"
+        lines += [f"{printable(report.path)}: ... and {n} more {code} (use --verbose or --format json for all)\n"
                   for code, n in omitted.items()]
         out.write("".join(lines))
 

@@ -28,6 +28,7 @@ from ..atomic import atomic_write
 from ..errors import UsageError
 from ..findings import FileReport, RuleHits
 from ..output import group_name, value_token
+from ..output.names import printable
 
 SCHEMA = "quad-affinity-baseline"
 VERSION = 1
@@ -81,7 +82,7 @@ def write(baseline: Baseline, path: str) -> None:
             json.dump({"schema": SCHEMA, "version": VERSION, "entries": entries}, f, indent=1)
             f.write("\n")
     except OSError as err:
-        raise UsageError(f"{path}: cannot write the baseline: {err.strerror or err}") from None
+        raise UsageError(f"{printable(path)}: cannot write the baseline: {err.strerror or err}") from None
 
 
 def read(path: str) -> Baseline:
@@ -98,9 +99,9 @@ def read(path: str) -> Baseline:
             counts[key] = int(entry["count"])
             values[key] = [value_token(float(v)) for v in entry.get("values", [])]
     except OSError as err:
-        raise UsageError(f"{path}: cannot read the baseline: {err.strerror or err}") from None
+        raise UsageError(f"{printable(path)}: cannot read the baseline: {err.strerror or err}") from None
     except (ValueError, KeyError, TypeError, AttributeError) as err:
-        raise UsageError(f"{path}: not a valid baseline file: {err}") from None
+        raise UsageError(f"{printable(path)}: not a valid baseline file: {err}") from None
     return Baseline(os.path.dirname(os.path.abspath(path)), counts, values)
 
 

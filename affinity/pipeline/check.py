@@ -14,7 +14,7 @@ from contextlib import AbstractContextManager, nullcontext
 from functools import partial
 
 from ..errors import MeshError, SkippedFile
-from ..findings import FileReport, settle
+from ..findings import FileReport, mesh_report
 from ..mesh import Mesh
 from ..settings import Settings
 
@@ -32,7 +32,6 @@ def check_file(path: str, settings: Settings, usd=None, source: bytes | None = N
 def load_and_check(path: str, settings: Settings, usd=None,
                    source: bytes | None = None) -> tuple[FileReport, Mesh | None]:
     """:func:`check_file`, also handing back the loaded mesh (None when it could not be read)."""
-    from ..lint import lint_mesh
     from ..loaders import load, reads_whole
 
     try:
@@ -43,16 +42,7 @@ def load_and_check(path: str, settings: Settings, usd=None,
         mesh = load(path, usd, source)
         ignores = _inline_ignores(source, mesh) if reads_whole(path) else []
         del source  # not needed past here: a big file's bytes are not held while its mesh is linted
-        report = FileReport(
-            path,
-            counts=mesh.counts(),
-            hits=settle(lint_mesh(mesh, settings), settings, list(mesh.group_names), ignores),
-            group_names=list(mesh.group_names),
-            prim_face_start=mesh.prim_face_start,
-            up_axis=mesh.up_axis,
-            meters_per_unit=mesh.meters_per_unit,
-            notes=list(mesh.notes),
-        )
+        report = mesh_report(path, mesh, settings, ignores)
     except SkippedFile as skip:
         return FileReport(path, skipped=skip.reason), None
     except MeshError as err:
@@ -191,13 +181,12 @@ def _check_here(tasks: list[tuple[str, Settings]], jobs: int | None, usd) -> Ite
         yield from map(check, paths, settings)
         return
 
-    from concurrent.futures import ProcessPoolExecutor
-
     from .. import lint, loaders  # noqa: F401  imported before the workers fork, so each inherits them
+    from .workers import local_pool
 
     # Small chunks balance uneven file sizes; a few per worker keep the pickling overhead low.
     chunksize = max(1, len(tasks) // (workers * 8))
-    with ProcessPoolExecutor(max_workers=workers) as pool:
+    with local_pool(workers) as pool:
         yield from pool.map(check, paths, settings, chunksize=chunksize)
 
 

@@ -22,6 +22,7 @@ from pathlib import Path
 
 from ..errors import UsageError
 from ..loaders.formats import MESH_SUFFIXES
+from ..output.names import printable
 from ..settings import Settings, glob_matches
 
 
@@ -120,7 +121,8 @@ def collect_paths(paths: list[str], settings_of: Callable[[str], Settings] | Non
 
     A path that does not exist is a :class:`UsageError`. A directory with no mesh
     file is one too when it is all there is; among other paths it is a warning
-    (``warn``) and the run goes on.
+    (``warn``) and the run goes on. A file reached several ways is kept once, under
+    the first spelling (:func:`once_each`).
     """
     settings_of = settings_of or (lambda folder: Settings())
     paths = paths or [os.curdir]
@@ -135,11 +137,29 @@ def collect_paths(paths: list[str], settings_of: Callable[[str], Settings] | Non
         elif os.path.exists(given):
             files.append(given)
         else:
-            raise UsageError(f"{given}: no such file or directory")
+            raise UsageError(f"{printable(given)}: no such file or directory")
     for given in empty:
-        message = f"{given}: no mesh files ({', '.join(MESH_SUFFIXES)}) in this directory"
+        message = f"{printable(given)}: no mesh files ({', '.join(MESH_SUFFIXES)}) in this directory"
         if not files:
             raise UsageError(message)
         if warn is not None:
             warn(f"warning: {message}")
-    return list(dict.fromkeys(files))
+    return once_each(files)
+
+
+def once_each(files: list[str]) -> list[str]:
+    """``files`` with every file once, under the first of its spellings: relative or absolute, with
+    ``./`` or ``..``, through a symbolic link or a hard link (one file: one device and inode)."""
+    seen: set = set()
+    kept = []
+    for path in files:
+        try:
+            st = os.stat(path)
+        except (OSError, ValueError):  # gone since it was found: the check says so, under this name
+            identity = os.path.abspath(path)
+        else:  # a file system without inode numbers (0) falls back to the resolved path
+            identity = (st.st_dev, st.st_ino) if st.st_ino else os.path.realpath(path)
+        if identity not in seen:
+            seen.add(identity)
+            kept.append(path)
+    return kept

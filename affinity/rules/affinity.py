@@ -67,10 +67,13 @@ def uv_disaffinity(quads) -> tuple:
         example.obj:10:1: Q101 uv-disaffine: texture coordinates are not an affine image of the positions: no texture found, texels of an assumed 1024x1024 texture (give the size with --texture-size or the texture-size setting) (175.7 vs 0.5 texels) [face 0]
 
     How to fix:
-        Re-UV the quad as a parallelogram matching its shape (Blender: UV > Follow
-        Active Quads, or straighten the island), subdivide it so each piece is
-        closer to a parallelogram, or triangulate before baking so every tool uses
-        the same diagonal.
+        Run affinity fix: it refines the quad into n x n quads on its own bilinear
+        surface, carrying the bilinear uv, until each piece's split error is under
+        the threshold (the texture looks as the quad describes it; up to n^2 - 1
+        more faces, the neighbours re-cut so nothing cracks). Where that needs more
+        than --max-refine, re-UV the quad as a parallelogram matching its shape
+        (Blender: UV > Follow Active Quads) and re-bake. Triangulating only fixes
+        which diagonal every tool uses; it does not remove the crease.
     """
     rows, uv = quads.uv
     diagonal = quads.settings.diagonal
@@ -101,8 +104,10 @@ def color_disaffinity(quads) -> tuple:
         example.obj:6:1: Q102 color-disaffine: vertex colours are not an affine image of the positions (110.4 vs 2/255) [face 0]
 
     How to fix:
-        Repaint the corner colours so opposite corners average to the same colour,
-        subdivide the quad, or triangulate before baking so the diagonal is explicit.
+        Run affinity fix to refine the quad into n x n quads carrying the bilinear
+        colours (up to n^2 - 1 more faces), or repaint the corner colours so
+        opposite corners average to the same colour. Triangulating only fixes which
+        diagonal every tool uses; it does not remove the seam.
     """
     rows, colors = quads.complete("colors")
     return rows, color_steps(quads.split_error(rows, colors).T)
@@ -135,9 +140,10 @@ def normal_disaffinity(quads) -> tuple:
         example.obj:10:1: Q103 normal-disaffine: normals are not an affine image of the positions (9.847 vs 2 degrees) [face 0]
 
     How to fix:
-        Subdivide the quad or even out its corners (Blender: Mesh > Clean Up, or
-        relax the loop), or triangulate before baking normals so the split diagonal
-        is fixed.
+        Run affinity fix to refine the quad into n x n quads carrying the bilinear
+        normals (up to n^2 - 1 more faces), or even out its corner normals (Blender:
+        Mesh > Clean Up, or relax the loop). Triangulating only fixes which diagonal
+        every tool uses; it does not remove the bend.
     """
     rows, unit = quads.complete("normals")  # unit length already (see affinity.lint.CornerTables.gather)
     m = quads.split_error(rows, unit)

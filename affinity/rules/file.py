@@ -100,6 +100,7 @@ def missing_resources(mesh, settings) -> tuple | None:
     # (face -1); its detail names the resource and, where the texel unit would have come
     # from that texture, the texture-size used instead. Returns (faces, lines, values, details) or None.
     from ..loaders.resources import ROLES
+    from ..output.names import printable  # names come from the file: never send its control characters
 
     folder = os.path.dirname(mesh.path)
     texels = mesh.texcoords is not None and "Q101" in RULES
@@ -117,10 +118,11 @@ def missing_resources(mesh, settings) -> tuple | None:
         lines.append(resource.line)
         if resource.library is None:
             texture_unit_lost = texels and used is None and role.name == "mtllib"
-            details.append(f"{role.statement} {resource.name} {problem}" + (fallback if texture_unit_lost else ""))
+            details.append(f"{role.statement} {printable(resource.name)} {problem}"
+                           + (fallback if texture_unit_lost else ""))
         else:
             shown = os.path.relpath(resource.path, folder) if folder else resource.path
-            details.append(f"{role.statement} {shown} (in {resource.library}) {problem}"
+            details.append(f"{role.statement} {printable(shown)} (in {printable(resource.library)}) {problem}"
                            + (fallback if texels and resource.path == used else ""))
     if not lines:
         return None
