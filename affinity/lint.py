@@ -188,9 +188,19 @@ class QuadBatch:
         return planar_quads_by_component(self.uv[1])
 
 
-def texture_grid(mesh: Mesh, settings: Settings, faces: np.ndarray | None = None):
-    """Each quad's texel grid (:func:`affinity.textures.binding.texel_grid`): its material's texture
-    size from the header, else the ``texture-size`` setting."""
+def texture_grid(mesh: Mesh, settings: Settings) -> tuple[tuple[int, int], bool]:
+    """The (w, h) texel grid of the mesh's ``map_Kd`` image when its header reads, else the
+    ``texture-size`` setting; and whether it was assumed (no readable texture). Q101 counts each quad
+    in its own material's texture (:func:`quad_texel_grid`)."""
+    from .loaders.imagesize import image_size
+
+    size = image_size(mesh.texture_path())
+    return (size, False) if size is not None else ((settings.texture_size,) * 2, True)
+
+
+def quad_texel_grid(mesh: Mesh, settings: Settings, faces: np.ndarray | None = None):
+    """Each quad's texel grid (:func:`affinity.textures.binding.texel_grid`): the size of the texture its
+    material binds, from the header, else the ``texture-size`` setting."""
     from .textures.binding import texel_grid
 
     return texel_grid(mesh, settings.texture_size, faces)
@@ -206,12 +216,12 @@ def _map_quad_batches(mesh: Mesh, settings: Settings, measure, attributes=(), gr
     """Run ``measure(batch: QuadBatch)`` on every batch of the mesh's quads, in
     parallel threads (NumPy releases the GIL in its loops); results in file order.
     ``attributes`` names the tables the measure reads besides the positions; ``grid`` is the texel grid
-    of the uv (:func:`texture_grid`, computed here when None)."""
+    of the uv (:func:`quad_texel_grid`, computed here when None)."""
     tables = CornerTables(mesh)
     names = ("positions", *attributes)
     quads = np.flatnonzero(mesh.face_sizes == 4)
     if grid is None and "texcoords" in attributes:
-        grid = texture_grid(mesh, settings, quads)
+        grid = quad_texel_grid(mesh, settings, quads)
 
     def run(start: int):
         faces = quads[start : start + BATCH_SIZE]
@@ -272,7 +282,7 @@ def lint_mesh(mesh: Mesh, settings: Settings, visible: bool = True) -> list[Rule
         return found
 
     attributes = sorted({rule.attribute for rule in quad_rules if rule.attribute})
-    grid = texture_grid(mesh, settings) if "texcoords" in attributes else None
+    grid = quad_texel_grid(mesh, settings) if "texcoords" in attributes else None
     batches = _map_quad_batches(mesh, settings, flag, attributes, grid) if quad_rules else []
     for rule in quad_rules:
         faces = np.concatenate([found[rule.code][0] for found in batches] or [np.zeros(0, dtype=np.int64)])
@@ -295,7 +305,7 @@ def lint_mesh(mesh: Mesh, settings: Settings, visible: bool = True) -> list[Rule
 
 def _texel_details(settings: Settings, rule, faces: np.ndarray, grid) -> list | None:
     """For a rule read in texels: the note on the first finding (``faces`` (n,) in file order) of a quad
-    whose texture size was assumed (``grid``, :func:`texture_grid`), None elsewhere; None altogether when
+    whose texture size was assumed (``grid``, :func:`quad_texel_grid`), None elsewhere; None altogether when
     every size is known."""
     if rule.unit_for(settings.measure) != "texels" or grid is None:
         return None

@@ -109,8 +109,7 @@ def measure(path: Path) -> dict:
     if mesh.texcoords is not None:
         values = quad_scores(mesh, settings, "Q101").values
         largest = float(values.max()) if len(values) else None
-    grid = texture_grid(mesh, settings)
-    (width, height), assumed = grid.sizes.astype(int).reshape(-1, 2)[0].tolist(), bool(grid.assumed.all())
+    (width, height), assumed = texture_grid(mesh, settings)
     result = subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--isolated", "--no-cache",
                              "--format", "json", str(path)], capture_output=True, text=True, check=False)
     doc = json.loads(result.stdout)
