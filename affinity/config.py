@@ -190,6 +190,13 @@ def _texture_size(value, where: str) -> int:
     return value
 
 
+def _non_negative(value, where: str) -> float:
+    number = _number(value, where)
+    if number < 0:
+        raise ConfigError(f"{where}: expected a number at or above 0")
+    return number
+
+
 def _globs(value, where: str) -> list[str]:
     if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
         raise ConfigError(f"{where}: expected a list of path globs")
@@ -210,6 +217,9 @@ _KEYS = {
     "measure": ("measure", _measure),
     "diagonal": ("diagonal", lambda v, where: _choice(v, DIAGONALS, where)),
     "texture-size": ("texture_size", _texture_size),
+    "visible-error": ("visible_error", _non_negative),
+    "visible-warning": ("visible_warning", _non_negative),
+    "visible-min-shift": ("visible_min_shift", _non_negative),
     "exclude": ("exclude", _globs),
     "extend-exclude": ("extend_exclude", _globs),
     "levels": ("levels", _levels),

@@ -9,6 +9,52 @@ import numpy as np
 
 
 @dataclass(eq=False)
+class VisibleColumns:
+    """Q101's visible reading of a rule's n findings (design.md, "The visible reading").
+
+    Attributes
+    ----------
+    values : (n,) float64, C (NaN where no texture was read)
+    shifts : (n,) float64, the split's shift in texels where C was read, NaN elsewhere
+    bounds : (n,) int8, 0 exact, 1 at least (refinement stopped above visible-error), 2 at most
+    picks : (n,) int32, index into ``textures``, ``roles`` and ``units`` of the texture behind each C (-1: none)
+    textures : the texture files, as the material names them (a UDIM tile: its file)
+    roles : their roles, ``base colour``, ``normal``, ``height``, ``scalar`` (a height map whose image is a
+        normal map: ``normal (bump)``)
+    units : their units, ``1/255`` or ``degrees``
+    limits : (visible-error, visible-warning, visible-min-shift)
+    fixed : ``[levels]`` gives the rule one level: the limits do not set it
+    """
+
+    values: np.ndarray
+    shifts: np.ndarray
+    bounds: np.ndarray
+    picks: np.ndarray
+    textures: list[str]
+    roles: list[str]
+    units: list[str]
+    limits: tuple[float, float, float]
+    fixed: bool = False
+
+    ARRAYS = ("values", "shifts", "bounds", "picks")
+
+    def subset(self, rows: np.ndarray) -> VisibleColumns:
+        return VisibleColumns(*(getattr(self, name)[rows] for name in self.ARRAYS), self.textures, self.roles,
+                              self.units, self.limits, self.fixed)
+
+    def levels(self) -> np.ndarray:
+        """(n,) str: the visible reading's level where C was read, "" elsewhere."""
+        from .textures.visible import VisibleLimits
+
+        levels = np.full(len(self.shifts), "", dtype=object)
+        if self.fixed:
+            return levels
+        read = np.isfinite(self.shifts)
+        levels[read] = VisibleLimits(*self.limits).levels(self.values[read], self.shifts[read])
+        return levels
+
+
+@dataclass(eq=False)
 class RuleHits:
     """Every finding of one rule in one file.
 
@@ -36,6 +82,9 @@ class RuleHits:
         The unit of ``values`` under the file's reading; None: the rule's unit.
     details : list of str or None
         One remark per finding, said after the rule's summary (Q902 names the resource).
+    visible : VisibleColumns or None
+        Q101's visible reading: where it read C, ``values`` hold C and the level follows the
+        ``visible-*`` settings (None: no texture was read).
     """
 
     code: str
@@ -48,6 +97,7 @@ class RuleHits:
     unit: str | None = None
     details: list[str] | None = None
     error_above: float | None = None
+    visible: VisibleColumns | None = None
 
     def __len__(self) -> int:
         return len(self.faces)
@@ -59,12 +109,17 @@ class RuleHits:
         return np.asarray(LEVELS)[self.level_ranks()]
 
     def level_ranks(self) -> np.ndarray:
-        """(n,) int8: each finding's level as its index in ``LEVELS`` (0 ``error``, 1 ``warning``, 2 ``info``)."""
+        """(n,) int8: each finding's level as its index in ``LEVELS`` (0 ``error``, 1 ``warning``, 2 ``info``);
+        where the visible reading read C, its level (design.md, "The visible reading")."""
         from .rules import LEVELS, RULES
 
         rank = np.full(len(self), LEVELS.index(self.level or RULES[self.code].level), dtype=np.int8)
         if self.error_above is not None:
             rank[self.values > self.error_above] = 0
+        if self.visible is not None:
+            visible = self.visible.levels()
+            for index, level in enumerate(LEVELS):
+                rank[visible == level] = index
         return rank
 
     def at_or_above(self, level: str) -> RuleHits:
@@ -73,11 +128,20 @@ class RuleHits:
 
         return self.subset(self.level_ranks() <= LEVELS.index(level))
 
+    def reading(self, row: int, unit: str) -> tuple[str, str]:
+        """How finding ``row``'s value reads: its bound mark (``">="``, ``"<="`` or ``""``) and its unit (the
+        visible reading's where C was read, else ``unit``, the rule's under the file's reading)."""
+        columns = self.visible
+        if columns is None or not np.isfinite(columns.shifts[row]) or columns.picks[row] < 0:
+            return "", unit
+        return {1: ">=", 2: "<="}.get(int(columns.bounds[row]), ""), columns.units[columns.picks[row]]
+
     def subset(self, rows: np.ndarray) -> RuleHits:
         """The findings at ``rows`` (an index array or a boolean mask), level and unit kept."""
         details = None if self.details is None else np.asarray(self.details, dtype=object)[rows].tolist()
         return RuleHits(self.code, self.faces[rows], self.lines[rows], self.values[rows], self.threshold,
-                        self.groups[rows], self.level, self.unit, details, self.error_above)
+                        self.groups[rows], self.level, self.unit, details, self.error_above,
+                        None if self.visible is None else self.visible.subset(rows))
 
 
 @dataclass(eq=False)
@@ -145,6 +209,10 @@ def settle(hits: list[RuleHits], settings, group_names: list[str], inline=()) ->
         rule = RULES[h.code]
         h.level, h.unit = settings.level(h.code), h.unit or rule.unit_for(settings.measure)
         h.error_above = settings.error_above(h.code)
+        if h.visible is not None:
+            limits = settings.visible_limits
+            h.visible.limits = (limits.error, limits.warning, limits.min_shift)
+            h.visible.fixed = h.code in settings.levels
         silenced = np.zeros(len(h), dtype=bool)
         groups = [i for i, name in enumerate(group_names)
                   if any(fnmatchcase(name, glob) and _matches(h.code, codes) for glob, codes in settings.group_ignores)]
@@ -254,8 +322,9 @@ def report_to_bytes(report: FileReport) -> bytes:
 
     meta = {f.name: getattr(report, f.name) for f in fields(report) if f.name not in ("hits", "prim_face_start")}
     meta["hits"] = [{"code": h.code, "threshold": h.threshold, "level": h.level, "unit": h.unit,
-                     "details": h.details, "error_above": h.error_above} for h in report.hits]
-    arrays = [getattr(hits, name) for hits in report.hits for name in _HIT_ARRAYS]
+                     "details": h.details, "error_above": h.error_above, "visible": _visible_meta(h.visible)}
+                    for h in report.hits]
+    arrays = [array for hits in report.hits for array in _hit_arrays(hits)]
     if report.prim_face_start is not None:
         arrays.append(report.prim_face_start)
     arrays = [np.ascontiguousarray(a) for a in arrays]
@@ -285,16 +354,38 @@ def report_from_bytes(data: bytes) -> FileReport:
             offset += arrays[-1].nbytes
         if offset != len(body):
             raise ValueError("arrays and header disagree")
-        hits = [
-            RuleHits(h["code"], threshold=h["threshold"], level=h["level"], unit=h["unit"], details=h["details"],
-                     error_above=h["error_above"], **dict(zip(_HIT_ARRAYS, arrays[4 * k : 4 * k + 4])))
-            for k, h in enumerate(meta.pop("hits"))
-        ]
-        prim_face_start = arrays[4 * len(hits)] if len(arrays) > 4 * len(hits) else None
+        hits, taken = [], 0
+        for h in meta.pop("hits"):
+            own = dict(zip(_HIT_ARRAYS, arrays[taken : taken + len(_HIT_ARRAYS)]))
+            taken += len(_HIT_ARRAYS)
+            visible = h.pop("visible")
+            if visible is not None:
+                columns = arrays[taken : taken + len(VisibleColumns.ARRAYS)]
+                taken += len(columns)
+                visible = VisibleColumns(*columns, visible["textures"], visible["roles"], visible["units"],
+                                         tuple(visible["limits"]), visible["fixed"])
+            hits.append(RuleHits(**h, **own, visible=visible))
+        prim_face_start = arrays[taken] if len(arrays) > taken else None
         return FileReport(**meta, hits=hits, prim_face_start=prim_face_start)
     except (zlib.error, KeyError, TypeError, IndexError, AttributeError) as err:
         raise ValueError(f"not a stored report: {type(err).__name__}: {err}") from None
 
 
 _HIT_ARRAYS = ("faces", "lines", "values", "groups")
-_BLOB_MAGIC = b"QAR2"  # QAR2: hits carry error_above
+_BLOB_MAGIC = b"QAR3"  # QAR2: hits carry error_above; QAR3: and Q101's visible reading
+
+
+def _visible_meta(visible: VisibleColumns | None) -> dict | None:
+    """The lists and settings of a visible reading, for the blob's JSON header (its arrays go after it)."""
+    if visible is None:
+        return None
+    return {"textures": visible.textures, "roles": visible.roles, "units": visible.units,
+            "limits": visible.limits, "fixed": visible.fixed}
+
+
+def _hit_arrays(hits: RuleHits) -> list[np.ndarray]:
+    """The arrays :func:`report_to_bytes` stores for one rule's hits: its own, then its visible reading's."""
+    arrays = [getattr(hits, name) for name in _HIT_ARRAYS]
+    if hits.visible is not None:
+        arrays += [getattr(hits.visible, name) for name in VisibleColumns.ARRAYS]
+    return arrays

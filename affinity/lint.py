@@ -21,7 +21,6 @@ import numpy as np
 from .attributes import ATTRIBUTES, attribute_named, scoring_rules
 from .findings import RuleHits
 from .geometry import PlanarQuads, planar_quads_by_component, squared_lengths
-from .loaders.imagesize import image_size
 from .measures import split_error_by_component, split_scale
 from .mesh import Mesh
 from .rules import RULES, resolve_codes
@@ -120,7 +119,8 @@ class QuadBatch:
 
     What a rule's check reads: ``faces`` (Q,) int64 face indices in file order,
     ``corners`` (4, Q) corner indices, ``settings``, ``texture_size`` (w, h)
-    texels, ``planar`` (the quads in their own planes), ``uv`` and
+    texels, (2,) for all quads or (Q, 2) per quad (:meth:`texel_size`),
+    ``planar`` (the quads in their own planes), ``uv`` and
     ``uv_planar`` (the quads with uv at all four corners), ``complete(name)``
     and ``split_error(rows, attrs)``.
     """
@@ -145,6 +145,11 @@ class QuadBatch:
         if id(array) not in self._indices:
             self._indices[id(array)] = array.take(self.corners)
         return self._indices[id(array)]
+
+    def texel_size(self, rows) -> np.ndarray:
+        """(2,) or (n, 2) float64 texel grid of the quads ``rows`` (a slice or indices into the batch)."""
+        size = np.asarray(self.texture_size, dtype=np.float64)
+        return size if size.ndim == 1 else size[rows]
 
     @cached_property
     def planar(self) -> PlanarQuads:
@@ -184,10 +189,21 @@ class QuadBatch:
 
 
 def texture_grid(mesh: Mesh, settings: Settings) -> tuple[tuple[int, int], bool]:
-    """The (w, h) texel grid of the uv: the ``map_Kd`` image's size when readable, else the
-    ``texture-size`` setting; and whether it was assumed (no readable texture)."""
+    """The (w, h) texel grid of the mesh's ``map_Kd`` image when its header reads, else the
+    ``texture-size`` setting; and whether it was assumed (no readable texture). Q101 counts each quad
+    in its own material's texture (:func:`quad_texel_grid`)."""
+    from .loaders.imagesize import image_size
+
     size = image_size(mesh.texture_path())
     return (size, False) if size is not None else ((settings.texture_size,) * 2, True)
+
+
+def quad_texel_grid(mesh: Mesh, settings: Settings, faces: np.ndarray | None = None):
+    """Each quad's texel grid (:func:`affinity.textures.binding.texel_grid`): the size of the texture its
+    material binds, from the header, else the ``texture-size`` setting."""
+    from .textures.binding import texel_grid
+
+    return texel_grid(mesh, settings.texture_size, faces)
 
 
 def assumed_texture_note(size: int) -> str:
@@ -196,19 +212,21 @@ def assumed_texture_note(size: int) -> str:
             "(give the size with --texture-size or the texture-size setting)")
 
 
-def _map_quad_batches(mesh: Mesh, settings: Settings, measure, attributes=()) -> list:
+def _map_quad_batches(mesh: Mesh, settings: Settings, measure, attributes=(), grid=None) -> list:
     """Run ``measure(batch: QuadBatch)`` on every batch of the mesh's quads, in
     parallel threads (NumPy releases the GIL in its loops); results in file order.
-    ``attributes`` names the tables the measure reads besides the positions."""
+    ``attributes`` names the tables the measure reads besides the positions; ``grid`` is the texel grid
+    of the uv (:func:`quad_texel_grid`, computed here when None)."""
     tables = CornerTables(mesh)
     names = ("positions", *attributes)
-    texture_size = texture_grid(mesh, settings)[0] if "texcoords" in attributes else None
     quads = np.flatnonzero(mesh.face_sizes == 4)
+    if grid is None and "texcoords" in attributes:
+        grid = quad_texel_grid(mesh, settings, quads)
 
     def run(start: int):
         faces = quads[start : start + BATCH_SIZE]
         corners = mesh.face_start[faces] + np.arange(4)[:, None]  # (4, Q): corner-major
-        return measure(QuadBatch(tables, settings, faces, corners, texture_size))
+        return measure(QuadBatch(tables, settings, faces, corners, None if grid is None else grid.of(faces)))
 
     starts = range(0, len(quads), BATCH_SIZE)
     if len(starts) <= 1:
@@ -221,13 +239,15 @@ def _map_quad_batches(mesh: Mesh, settings: Settings, measure, attributes=()) ->
         return list(pool.map(run, starts))
 
 
-def lint_mesh(mesh: Mesh, settings: Settings) -> list[RuleHits]:
+def lint_mesh(mesh: Mesh, settings: Settings, visible: bool = True) -> list[RuleHits]:
     """Apply every rule enabled by ``settings.select``/``settings.ignore`` to ``mesh``.
 
-    Q101 is in texels (texture size from ``mesh.texture_path()`` when that image
-    is readable, else ``settings.texture_size``), or the paper's dimensionless score
-    with ``settings.measure == "barycentric"``; Q102 in 1/255 steps; Q103 in
-    degrees. A quad is measured for an attribute only when all four corners have it.
+    Q101 is in texels (each quad's texture size from its material's texture header,
+    else ``settings.texture_size``), or the paper's dimensionless score with
+    ``settings.measure == "barycentric"``; Q102 in 1/255 steps; Q103 in degrees. A
+    quad is measured for an attribute only when all four corners have it. With
+    ``visible``, Q101's findings on quads whose textures decode are read through them
+    (C, design.md "The visible reading"; ``RuleHits.visible``).
 
     Returns
     -------
@@ -235,6 +255,9 @@ def lint_mesh(mesh: Mesh, settings: Settings) -> list[RuleHits]:
     faces in file order within each.
     """
     enabled = [RULES[code] for code in resolve_codes(settings.select, settings.ignore)]
+    reads_textures = (visible and RULES["Q101"] in enabled and RULES["Q101"].unit_for(settings.measure) == "texels"
+                      and mesh.texcoords is not None and (mesh.material_maps or mesh.material_textures))
+    preparing = _prepare_textures(mesh) if reads_textures else None
     hits = []
     for rule in enabled:
         found = rule.check(mesh, settings) if rule.scope == "mesh" else None
@@ -264,7 +287,8 @@ def lint_mesh(mesh: Mesh, settings: Settings) -> list[RuleHits]:
         return found
 
     attributes = sorted({rule.attribute for rule in quad_rules if rule.attribute})
-    batches = _map_quad_batches(mesh, settings, flag, attributes) if quad_rules else []
+    grid = quad_texel_grid(mesh, settings) if "texcoords" in attributes else None
+    batches = _map_quad_batches(mesh, settings, flag, attributes, grid) if quad_rules else []
     scored = [rule for rule in quad_rules if rule.scored and getattr(mesh, rule.attribute) is not None]
     for rule in quad_rules:
         faces = np.concatenate([found[rule.code][0] for found in batches] or [np.zeros(0, dtype=np.int64)])
@@ -272,13 +296,18 @@ def lint_mesh(mesh: Mesh, settings: Settings) -> list[RuleHits]:
             values = np.concatenate([found[rule.code][1] for found in batches])
             threshold = thresholds[rule.code]
             breaks = np.concatenate([found[rule.code][2] for found in batches])
-            hits.append(
-                RuleHits(rule.code, faces, mesh.face_line[faces], values,
-                         0.0 if threshold is None else float(threshold), mesh.face_group[faces],
-                         details=_texel_details(mesh, settings, rule, faces)
-                         or _cause_details(rule.code, breaks, [r.code for r in scored if r.attribute in
-                                                               CAUSE_MASKS.get(rule.code, ())]))
-            )
+            taken = [r.code for r in scored if r.attribute in CAUSE_MASKS.get(rule.code, ())]
+            found = RuleHits(rule.code, faces, mesh.face_line[faces], values,
+                             0.0 if threshold is None else float(threshold), mesh.face_group[faces],
+                             details=_texel_details(settings, rule, faces, grid)
+                             or _cause_details(rule.code, breaks, taken))
+            if reads_textures and rule.code == "Q101":
+                if preparing is not None:
+                    preparing.join()
+                _read_visible(mesh, settings, found)
+            hits.append(found)
+    if preparing is not None:  # no Q101 finding read it: the decode is not left running into the next file
+        preparing.join()
     order = {code: i for i, code in enumerate(RULES)}
     return sorted(hits, key=lambda h: order[h.code])
 
@@ -352,12 +381,44 @@ def _cause_details(code: str, breaks: np.ndarray, taken: list[str]) -> list | No
     return np.where(breaks, detail, None).tolist()
 
 
-def _texel_details(mesh: Mesh, settings: Settings, rule, faces: np.ndarray) -> list | None:
-    """For a rule read in texels of an assumed texture: the note on the file's first finding
-    (``faces`` (n,) in file order), None elsewhere; None altogether when the texture is known."""
-    if rule.unit_for(settings.measure) != "texels" or not texture_grid(mesh, settings)[1]:
+def _texel_details(settings: Settings, rule, faces: np.ndarray, grid) -> list | None:
+    """For a rule read in texels: the note on the first finding (``faces`` (n,) in file order) of a quad
+    whose texture size was assumed (``grid``, :func:`quad_texel_grid`), None elsewhere; None altogether when
+    every size is known."""
+    if rule.unit_for(settings.measure) != "texels" or grid is None:
         return None
-    return [assumed_texture_note(settings.texture_size), *[None] * (len(faces) - 1)]
+    assumed = np.flatnonzero(grid.assumed[faces])
+    if not len(assumed):
+        return None
+    details = [None] * len(faces)
+    details[assumed[0]] = assumed_texture_note(settings.texture_size)
+    return details
+
+
+def _prepare_textures(mesh: Mesh):
+    """The background thread decoding the mesh's textures while the lint runs (None: nothing to decode)."""
+    from .textures.reading import prepare_textures
+
+    return prepare_textures(mesh)
+
+
+def _read_visible(mesh: Mesh, settings: Settings, hits: RuleHits) -> None:
+    """Q101's ``hits`` read through the textures their quads bind: C replaces the shift as the value where
+    a texture decodes (the shift kept in ``hits.visible``); a texture that does not gives a note."""
+    from .textures.reading import visible_reading
+
+    found = visible_reading(mesh, settings, hits.faces, hits.values)
+    if found is None:
+        return
+    columns, notes = found
+    read = np.isfinite(columns.values)
+    if read.any():
+        hits.values = np.where(read, columns.values, hits.values)
+        hits.visible = columns
+    if notes:
+        hits.details = hits.details or [None] * len(hits)
+        for row, note in notes.items():
+            hits.details[row] = "; ".join(filter(None, [hits.details[row], note]))
 
 
 def quad_uv_error(mesh: Mesh, diagonal: str = "02") -> tuple[np.ndarray, np.ndarray]:
@@ -441,7 +502,7 @@ def quad_scores(mesh: Mesh, settings: Settings, code: str) -> QuadScores:
     """
     rule = RULES[code]
     everything = replace(settings, select=[code], ignore=[], thresholds={**settings.thresholds, code: -np.inf})
-    hits = lint_mesh(mesh, everything)
+    hits = lint_mesh(mesh, everything, visible=False)
     faces = hits[0].faces if hits else np.zeros(0, dtype=np.int64)
     values = hits[0].values if hits else np.zeros(0)
     return QuadScores(code, ATTRIBUTES[rule.attribute].name, rule.unit_for(settings.measure),

@@ -310,13 +310,14 @@ def texels(m: np.ndarray, texture_size) -> np.ndarray:
     Parameters
     ----------
     m : (Q, 2) float64 split error in uv units.
-    texture_size : int or (width, height)
+    texture_size : int, (width, height), or (Q, 2) float per quad
 
     Returns
     -------
     (Q,) float64
     """
-    return lengths(m * np.broadcast_to(np.asarray(texture_size, dtype=np.float64), (2,)))
+    size = np.asarray(texture_size, dtype=np.float64)
+    return lengths(m * (size if size.ndim else np.broadcast_to(size, (2,))))
 
 
 def color_steps(m: np.ndarray) -> np.ndarray:

@@ -50,6 +50,9 @@ class Mesh:
         Index into ``material_names``, -1 for faces without ``usemtl``.
     material_textures : dict of str to str
         Material name to its ``map_Kd`` path (resolved against the .mtl file's folder).
+    material_maps : dict of str to list of affinity.loaders.texturemaps.TextureMap
+        Material name to every texture it reads through the uv, by role (base colour,
+        normal, height, scalar maps).
     resources : list of affinity.loaders.resources.Resource
         The files the mesh file references (material libraries, texture maps by
         role, USD layers), in file order, as its loader read them.
@@ -84,6 +87,7 @@ class Mesh:
     material_names: list[str] = field(default_factory=list)
     face_material: np.ndarray | None = None
     material_textures: dict[str, str] = field(default_factory=dict)
+    material_maps: dict[str, list] = field(default_factory=dict)
     resources: list = field(default_factory=list)
     prim_face_start: np.ndarray | None = None
     prim_sources: list | None = None

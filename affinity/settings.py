@@ -67,6 +67,9 @@ class Settings:
     (configured as ``[levels] Q101 = {error = 2.0}``): a finding above it is an
     ``error``, one between the flag threshold and it gets the rule's level; a
     rule in ``levels`` gets that one level whatever its values.
+    ``visible_error``, ``visible_warning`` (1/255 steps, degrees for normal maps) and
+    ``visible_min_shift`` (texels) level Q101's findings read through a decoded texture
+    (design.md, "The visible reading"; :attr:`visible_limits`).
     """
 
     select: list[str] | None = None
@@ -75,6 +78,9 @@ class Settings:
     measure: str = "error"
     diagonal: str = "both"
     texture_size: int = 1024
+    visible_error: float = 8.0
+    visible_warning: float = 2.0
+    visible_min_shift: float = 1.0
     exclude: list[str] = field(default_factory=lambda: list(DEFAULT_EXCLUDE))
     per_file_ignores: dict[str, list[str]] = field(default_factory=dict)
     levels: dict[str, str] = field(default_factory=dict)
@@ -87,6 +93,13 @@ class Settings:
     def split_measure(self) -> str:
         """The reading of Q102/Q103 (and of Q101 unless barycentric): ``error`` or ``centre``."""
         return "centre" if self.measure == "centre" else "error"
+
+    @property
+    def visible_limits(self):
+        """The ``visible-*`` settings as :class:`affinity.textures.visible.VisibleLimits`."""
+        from .textures.visible import VisibleLimits
+
+        return VisibleLimits(self.visible_error, self.visible_warning, self.visible_min_shift)
 
     def measure_of(self, code: str) -> str | None:
         """The reading a finding of a scored rule (Q101-Q103) was measured in, else None: the

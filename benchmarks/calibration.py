@@ -10,6 +10,14 @@ findings by level, the other error-level findings, and the exit code of
 should exit 0 where the largest uv error is under the visibility threshold
 (2 texels) and nothing else is an error, 1 where it is over.
 
+A second table gives the visible reading (design.md, "The visible reading") on
+textured meshes: ``../shared/meshes/textured`` (Spot with its own texture) and a
+generated lat-long sphere under three generated 1024 x 1024 textures, a flat
+colour, a checker and text. Per mesh: Q101's findings (quads whose shift is at or
+over the flag threshold), their levels on the texel reading (error over 2 texels)
+and on the visible reading (C through the texture), how many of the visible
+values are lower bounds (``at least``), and the exit code.
+
     python benchmarks/calibration.py [--small] [--out DIR] [--meshes FOLDER]
 
 writes ``DIR/calibration.md`` (default ``reports/bench``) and the raw rows as
@@ -125,6 +133,76 @@ def table(rows: list[dict]) -> str:
     return "\n".join(lines) + "\n"
 
 
+VISIBLE_HEAD = ["textured mesh", "texture", "Q101 findings", "texel reading: warning / error",
+                "visible reading: info / warning / error", "at least", "exit"]
+TEXTURE_SIZE = 1024
+
+
+def lat_long_sphere(columns: int = 64, rows: int = 32) -> str:
+    """A unit sphere of ``columns`` x ``rows`` quads, uv its longitude and latitude (each row of quads a
+    trapezoid under a rectangle of texture, narrower towards the poles)."""
+    u, v = np.meshgrid(np.linspace(0, 1, columns + 1), np.linspace(0, 1, rows + 1))
+    longitude, latitude = 2 * np.pi * u, np.pi * (v - 0.5)
+    positions = np.stack([np.cos(latitude) * np.cos(longitude), np.cos(latitude) * np.sin(longitude),
+                          np.sin(latitude)], axis=-1)
+    return quad_grid_obj(positions, np.stack([u, v], axis=-1))
+
+
+def generated_textures(folder: Path) -> dict[str, str]:
+    """Name -> what it is, of three 1024 x 1024 PNG textures written to ``folder``: a flat colour, a checker
+    of 32 squares across, and lines of text."""
+    from PIL import Image, ImageDraw
+
+    Image.new("RGB", (TEXTURE_SIZE, TEXTURE_SIZE), (180, 140, 90)).save(folder / "flat.png")
+    cells = (np.arange(TEXTURE_SIZE) * 32) // TEXTURE_SIZE
+    checker = np.where(((cells[:, None] + cells[None, :]) % 2)[..., None] == 0, 235, 40).astype(np.uint8)
+    Image.fromarray(np.repeat(checker, 3, axis=2)).save(folder / "checker.png")
+    text = Image.new("RGB", (TEXTURE_SIZE, TEXTURE_SIZE), "white")
+    draw = ImageDraw.Draw(text)
+    for row in range(0, TEXTURE_SIZE, 14):
+        draw.text((4, row), "quad affinity: the split shifts the texture where uv is not affine " * 2, fill="black")
+    text.save(folder / "text.png")
+    return {"flat.png": "flat colour", "checker.png": "checker", "text.png": "text"}
+
+
+def textured(folder: Path, meshes: Path) -> list[tuple[Path, str]]:
+    """(OBJ, texture label) of the textured calibration meshes: the shared textured Spot when present, and the
+    generated sphere under each generated texture (an OBJ and MTL per texture, in ``folder``)."""
+    cases = []
+    spot = meshes / "textured" / "spot_control_mesh_textured.obj"
+    if spot.is_file():
+        cases.append((spot, "spot_texture.png (its own)"))
+    sphere = lat_long_sphere()
+    for name, label in generated_textures(folder).items():
+        stem = f"gen_uv_sphere_64x32_{Path(name).stem}"
+        (folder / f"{stem}.mtl").write_text(f"newmtl m\nmap_Kd {name}\n")
+        (folder / f"{stem}.obj").write_text(f"mtllib {stem}.mtl\nusemtl m\n" + sphere)
+        cases.append((folder / f"{stem}.obj", f"{name} ({label})"))
+    return cases
+
+
+def measure_visible(path: Path, texture: str) -> dict:
+    """One textured mesh's row: Q101's findings by level on the texel and the visible reading."""
+    result = subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--isolated", "--no-cache",
+                             "--format", "json", "--select", "Q101", str(path)], capture_output=True, text=True,
+                            check=False)
+    findings = json.loads(result.stdout)["findings"]
+    shifts = [f.get("shift", f["value"]) for f in findings]
+    visible = [f["level"] for f in findings]
+    return {"mesh": path.name, "texture": texture, "findings": len(findings),
+            "texel": [sum(s <= 2 for s in shifts), sum(s > 2 for s in shifts)],
+            "visible": [visible.count(level) for level in ("info", "warning", "error")],
+            "at_least": sum(f.get("bound") == "at least" for f in findings), "exit": result.returncode}
+
+
+def visible_table(rows: list[dict]) -> str:
+    lines = ["| " + " | ".join(VISIBLE_HEAD) + " |", "|---|---|---:|---:|---:|---:|---:|"]
+    for r in rows:
+        lines.append(f"| {r['mesh']} | {r['texture']} | {r['findings']:,} | {r['texel'][0]:,} / {r['texel'][1]:,} "
+                     f"| {' / '.join(f'{n:,}' for n in r['visible'])} | {r['at_least']:,} | {r['exit']} |")
+    return "\n".join(lines) + "\n"
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--small", action="store_true", help="generated meshes only, small sizes")
@@ -141,9 +219,12 @@ def main(argv: list[str] | None = None) -> None:
             (Path(folder) / name).write_text(text)
             paths.append(Path(folder) / name)
         rows = [measure(path) for path in paths]
+        visible_rows = [measure_visible(path, texture) for path, texture in textured(Path(folder), args.meshes)]
     (args.out / "calibration.json").write_text(json.dumps(rows, indent=1) + "\n")
-    (args.out / "calibration.md").write_text(table(rows))
-    sys.stdout.write(table(rows))
+    (args.out / "calibration_visible.json").write_text(json.dumps(visible_rows, indent=1) + "\n")
+    text = table(rows) + "\n" + visible_table(visible_rows)
+    (args.out / "calibration.md").write_text(text)
+    sys.stdout.write(text)
 
 
 if __name__ == "__main__":

@@ -104,7 +104,11 @@ def test_map_kd_image_size_sets_the_texel_unit(tmp_path):
     pil.new("RGB", (512, 256)).save(tmp_path / "wood.png")
     mesh = quads_mesh(TRAPEZOID, texcoords=[SQUARE_UV])
     mesh.material_names, mesh.material_textures = ["wood"], {"wood": str(tmp_path / "wood.png")}
-    np.testing.assert_allclose(found(mesh)["Q101"][1], [TRAPEZOID_ERROR * 512])
+    (hits,) = lint_mesh(mesh, Settings())
+    np.testing.assert_allclose(hits.visible.shifts, [TRAPEZOID_ERROR * 512])  # a flat texture: C = 0
+    np.testing.assert_allclose(hits.values, [0.0], atol=1e-3)
+    assert hits.visible.units == ["1/255"] and hits.visible.roles == ["base colour"]
+    np.testing.assert_allclose(found(mesh, texture_size=7)["Q101"][1], [0.0], atol=1e-3)
     mesh.material_textures = {"wood": str(tmp_path / "missing.png")}
     np.testing.assert_allclose(found(mesh, texture_size=100)["Q101"][1], [TRAPEZOID_ERROR * 100])
 

@@ -193,7 +193,7 @@ def choose_methods(mesh: Mesh, faces: np.ndarray, uv: np.ndarray | None, clip: n
 
     code = scored_code_of("uv" if routes_uv else ("color" if show == "color" else "normal"))
     flagged = np.zeros(mesh.n_faces, dtype=bool)
-    for hits in lint_mesh(mesh, replace(settings, select=[code], diagonal="02")):
+    for hits in lint_mesh(mesh, replace(settings, select=[code], diagonal="02"), visible=False):
         flagged[hits.faces] = True
     return np.where(flagged[faces], MVC, SPLIT)
 

@@ -1,4 +1,6 @@
-"""Textures for renders: a procedural checker, image files, and bilinear sampling.
+"""Textures for renders: a procedural checker, image files, and the close-ups' line pattern.
+
+Image files are decoded, and sampled bilinearly, by the core (:mod:`affinity.textures`).
 
 Texture coordinates follow OpenGL: ``(0, 0)`` is the bottom-left of the image,
 ``v`` grows upward, and coordinates wrap (repeat) outside [0, 1].
@@ -9,6 +11,10 @@ from __future__ import annotations
 import functools
 
 import numpy as np
+
+from ..textures.filtering import sample_bilinear
+
+__all__ = ["TextureError", "checker", "load_image", "sample_bilinear"]
 
 CHECKS = 32
 
@@ -38,45 +44,24 @@ class TextureError(Exception):
 
 
 def load_image(path: str) -> np.ndarray:
-    """Read an image file as (H, W, 3) float32 RGB in [0, 1] (Pillow, imported here)."""
-    from PIL import Image, UnidentifiedImageError
+    """Read an image file as (H, W, 3) float32 RGB in [0, 1]: decoded by the core
+    (:func:`affinity.textures.decode.decode`: once per run, never over the pixel budget).
 
-    from ..loaders.regular import RefusedFile, open_regular
+    Raises :class:`TextureError` naming the file and why it is not used."""
+    from ..loaders.regular import NOT_READ
+    from ..textures.decode import TextureUnusable, decode
 
     try:
-        with open_regular(path) as fh, Image.open(fh) as image:
-            return np.asarray(image.convert("RGB"), dtype=np.float32) / 255.0
-    except FileNotFoundError:
-        raise TextureError(f"{path}: no such texture file") from None
-    except RefusedFile as err:
-        raise TextureError(f"{path}: {err.strerror}") from None
-    except (UnidentifiedImageError, OSError) as err:
-        raise TextureError(f"{path}: not a readable image ({err.__class__.__name__})") from None
-
-
-def sample_bilinear(image: np.ndarray, uv: np.ndarray) -> np.ndarray:
-    """Bilinear texture filtering with repeat wrapping.
-
-    Parameters
-    ----------
-    image : (H, W, C) float
-    uv : (N, 2) float, OpenGL texture coordinates
-
-    Returns
-    -------
-    (N, C) float32
-    """
-    height, width = image.shape[:2]
-    x = uv[:, 0] * width - 0.5
-    y = (1.0 - uv[:, 1]) * height - 0.5
-    x0, y0 = np.floor(x), np.floor(y)
-    fx, fy = (x - x0)[:, None], (y - y0)[:, None]
-    x0 = x0.astype(np.int64) % width
-    y0 = y0.astype(np.int64) % height
-    x1, y1 = (x0 + 1) % width, (y0 + 1) % height
-    top = image[y0, x0] * (1 - fx) + image[y0, x1] * fx
-    bottom = image[y1, x0] * (1 - fx) + image[y1, x1] * fx
-    return (top * (1 - fy) + bottom * fy).astype(np.float32)
+        pixels = decode(path).pixels
+    except TextureUnusable as err:
+        reason = str(err)
+        if reason == "missing":
+            reason = "no such texture file"
+        elif not reason.endswith(NOT_READ):  # a FIFO or a device says what it is; anything else is no image
+            reason = f"not a readable image ({reason})"
+        raise TextureError(f"{path}: {reason}") from None
+    grey_or_colour = pixels[..., :3] if pixels.shape[2] >= 3 else np.repeat(pixels[..., :1], 3, axis=2)
+    return grey_or_colour.astype(np.float32) / 255.0
 
 
 #: Lines of the close-up pattern are this many pixels apart on screen, and this many pixels wide.

@@ -1,12 +1,16 @@
 """Wavefront material (.mtl) files: only what the linter needs, the texture maps per material.
 
 Which statements name texture maps is the resource registry's
-(:func:`affinity.loaders.resources.roles_named_in`): ``map_Kd`` today.
+(:func:`affinity.loaders.resources.roles_named_in`): ``map_Kd``, ``norm``, ``bump`` and the scalar maps.
 """
 
 from __future__ import annotations
 
 import os
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from .texturemaps import TextureMap
 
 from .regular import SIDE_FILE_BUDGET, read_regular
 
@@ -26,7 +30,18 @@ def material_maps(path) -> list[tuple[str, str, str, str]]:
 
     A missing or unreadable file gives an empty list: materials are optional.
     """
-    from .resources import roles_named_in
+    return [(role, material, texture.name, texture.path) for role, material, texture in map_statements(path)]
+
+
+def map_statements(path) -> list[tuple[str, str, TextureMap]]:
+    """``(resource role, material, texture)`` of every texture map statement of the MTL file ``path``
+    (the roles the resource registry names in MTL files), in file order: the texture as a
+    :class:`~affinity.loaders.texturemaps.TextureMap` whose role is the resource role's kind of texels
+    (None for a role that names none), its file resolved against the .mtl's folder, and the statement's
+    ``-s`` scale and ``-o`` offset of u and v (w is not used by a 2-D texture). A missing or unreadable
+    file gives an empty list."""
+    from .resources import ROLES, roles_named_in
+    from .texturemaps import TextureMap
 
     try:
         text = read_regular(path, SIDE_FILE_BUDGET).decode("utf-8", "replace")
@@ -44,9 +59,14 @@ def material_maps(path) -> list[tuple[str, str, str, str]]:
         if words[0] == "newmtl":
             material = " ".join(words[1:])
         elif words[0] in statements and material is not None:
-            name = texture_file_name(words[1:])
-            maps.append((statements[words[0]], material, name,
-                         os.path.normpath(os.path.join(folder, name.replace("\\", "/")))))
+            name, options = map_arguments(words[1:])
+            scale, offset = options.get("-s", (1.0, 1.0)), options.get("-o", (0.0, 0.0))
+            role = statements[words[0]]
+            maps.append((role, material, TextureMap(
+                role=ROLES[role].texture, name=name, source=words[0],
+                path=os.path.normpath(os.path.join(folder, name.replace("\\", "/"))),
+                scale=(scale[0], scale[1] if len(scale) > 1 else 1.0),
+                offset=(offset[0], offset[1] if len(offset) > 1 else 0.0))))
     return maps
 
 
@@ -62,17 +82,29 @@ def texture_file_name(arguments: list[str]) -> str:
     >>> texture_file_name(["-s", "1", "1", "1", "-clamp", "on", "wood grain.png"])
     'wood grain.png'
     """
-    k = 0
+    return map_arguments(arguments)[0]
+
+
+def map_arguments(arguments: list[str]) -> tuple[str, dict[str, tuple[float, ...]]]:
+    """The file name of a texture map statement after its options, and its vector options
+    (``-o``, ``-s``, ``-t``) with the numbers given (one to three).
+
+    >>> map_arguments(["-s", "2", "2", "1", "-o", "0.5", "-clamp", "on", "wood grain.png"])
+    ('wood grain.png', {'-s': (2.0, 2.0, 1.0), '-o': (0.5,)})
+    """
+    k, vectors = 0, {}
     while k < len(arguments) - 1 and (arguments[k] in _FIXED_ARGUMENTS or arguments[k] in _VECTOR_OPTIONS):
         option = arguments[k]
         k += 1
         if option in _FIXED_ARGUMENTS:
             k += _FIXED_ARGUMENTS[option]
             continue
-        for _ in range(3):
-            if k < len(arguments) - 1 and _is_number(arguments[k]):
-                k += 1
-    return " ".join(arguments[k:])
+        numbers = []
+        while len(numbers) < 3 and k < len(arguments) - 1 and _is_number(arguments[k]):
+            numbers.append(float(arguments[k]))
+            k += 1
+        vectors[option] = tuple(numbers)
+    return " ".join(arguments[k:]), vectors
 
 
 def _is_number(word: str) -> bool:

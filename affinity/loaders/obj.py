@@ -49,6 +49,7 @@ from .numbers import PAD, eight_digits, parse_floats, parse_ints
 from .regular import read_regular
 from .resources import obj_resources, uncommented
 from .text import BufferReader, NotText, Tokens, floats_or_raise, read_chunks, tokenize
+from .texturemaps import obj_material_maps
 
 _V, _VT, _VN, _F = 1, 2, 3, 4
 #: Numbers a line of each kind may carry: ``v x y z [w]``, ``v x y z r g b [a]``,
@@ -975,6 +976,7 @@ class _Assembly:
             material_names=material_names,
             face_material=face_material,
             material_textures=_diffuse_textures(resources),
+            material_maps=obj_material_maps(resources),
             resources=resources,
             notes=notes,
         )

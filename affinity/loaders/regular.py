@@ -38,12 +38,16 @@ class RefusedFile(OSError):
         super().__init__(0, reason, os.fspath(path))
 
 
+#: How every reason of a :class:`RefusedFile` ends: the file was not read at all.
+NOT_READ = ": not read"
+
+
 def not_regular(mode: int) -> str | None:
     """Why a file of ``mode`` (``st_mode``) is not read, or None for a regular file."""
     if stat.S_ISREG(mode):
         return None
     kind = next((words for is_kind, words in _KINDS if is_kind(mode)), "is not a regular file")
-    return f"{kind}, not a regular file: not read"
+    return f"{kind}, not a regular file{NOT_READ}"
 
 
 def open_regular(path, budget: int | None = None):
@@ -58,7 +62,7 @@ def open_regular(path, budget: int | None = None):
         info = os.fstat(fd)
         reason = not_regular(info.st_mode)
         if reason is None and budget is not None and info.st_size > budget:
-            reason = f"is {_size(info.st_size)}, over the {_size(budget)} budget of a side file: not read"
+            reason = f"is {_size(info.st_size)}, over the {_size(budget)} budget of a side file{NOT_READ}"
         if reason is not None:
             raise RefusedFile(path, reason)
         os.set_blocking(fd, True)
@@ -74,7 +78,7 @@ def read_regular(path, budget: int | None = None) -> bytes:
     with open_regular(path, budget) as fh:
         data = fh.read() if budget is None else fh.read(budget + 1)
     if budget is not None and len(data) > budget:
-        raise RefusedFile(path, f"grew past the {_size(budget)} budget of a side file while read: not read")
+        raise RefusedFile(path, f"grew past the {_size(budget)} budget of a side file while read{NOT_READ}")
     return data
 
 

@@ -28,6 +28,8 @@ class ResourceRole:
     named_in : the kind of file whose statements name it: ``"obj"``, ``"mtl"`` or ``"usd"``
     image : the file must be a readable image (PNG, JPEG, BMP, TGA) to be of use
     summary : what the file is for, one line
+    texture : for a texture map, what its texels are (design.md, "Textures by role"): ``"base colour"``,
+        ``"normal"``, ``"height"`` or ``"scalar"``; None for other files
     """
 
     name: str
@@ -35,6 +37,7 @@ class ResourceRole:
     named_in: str
     image: bool = False
     summary: str
+    texture: str | None = None
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -81,8 +84,16 @@ def unregister_role(name: str) -> None:
 
 register_role(ResourceRole(name="mtllib", statement="mtllib", named_in="obj",
                            summary="a Wavefront material library"))
-register_role(ResourceRole(name="map_Kd", statement="map_Kd", named_in="mtl", image=True,
+register_role(ResourceRole(name="map_Kd", statement="map_Kd", named_in="mtl", image=True, texture="base colour",
                            summary="the diffuse colour texture of a material (Q101's texel unit)"))
+register_role(ResourceRole(name="norm", statement="norm", named_in="mtl", image=True, texture="normal",
+                           summary="a tangent-space normal map"))
+for _statement in ("bump", "map_Bump", "map_bump"):
+    register_role(ResourceRole(name=_statement, statement=_statement, named_in="mtl", image=True, texture="height",
+                               summary="a height map (a normal map when its image is one, as Blender writes them)"))
+for _statement in ("map_Ks", "map_Ns", "map_Pr", "map_Pm", "map_Ke", "map_d", "disp"):
+    register_role(ResourceRole(name=_statement, statement=_statement, named_in="mtl", image=True, texture="scalar",
+                               summary="a scalar or secondary colour map of a material"))
 register_role(ResourceRole(name="usd-asset", statement="sublayer, reference or payload", named_in="usd",
                            summary="a layer a USD stage composes"))
 
@@ -158,7 +169,9 @@ def named_files(path: str, data=None) -> list[str]:
     """The files the file at ``path`` names itself (one level down, each once, in order):
     an OBJ's material libraries (from its bytes ``data``; read when None), an MTL file's
     texture maps of every role named in MTL files, a USD layer's sublayers, references and
-    payloads (none without ``pxr``). Other files name none. Paths are normalised, not made absolute."""
+    payloads and the files of its asset-valued attributes (textures; none without ``pxr``), a
+    MaterialX document's image files. A UDIM texture names its tiles on disk. Other files name
+    none. Paths are normalised, not made absolute."""
     suffix = os.path.splitext(path)[1].lower()
     if suffix == ".obj":
         if data is None:
@@ -168,10 +181,16 @@ def named_files(path: str, data=None) -> list[str]:
         folder = os.path.dirname(path)
         return list(dict.fromkeys(os.path.normpath(os.path.join(folder, name))
                                   for _, name in mtllib_statements(data)))
+    from .texturemaps import tile_files
+
     if suffix == ".mtl":
         from .mtl import material_maps
 
-        return list(dict.fromkeys(texture for *_, texture in material_maps(path)))
-    from .usd import USD_SUFFIXES, asset_paths
+        return tile_files(texture for *_, texture in material_maps(path))
+    if suffix == ".mtlx":
+        from .usdmaterials import mtlx_document_maps
 
-    return asset_paths(path) if suffix in USD_SUFFIXES else []
+        return tile_files(texture_map.path for texture_map in mtlx_document_maps(path, every=True))
+    from .usd import USD_SUFFIXES, asset_paths, texture_asset_paths
+
+    return [*asset_paths(path), *tile_files(texture_asset_paths(path))] if suffix in USD_SUFFIXES else []

@@ -87,21 +87,49 @@ class _Primvar:
     indices: np.ndarray | None = None
 
 
+def _layer(path: str):
+    """The Sdf layer at ``path``, None without ``pxr`` or when it cannot be opened."""
+    try:
+        from pxr import Sdf, Tf
+    except ImportError:
+        return None
+    try:
+        return Sdf.Layer.FindOrOpen(os.fspath(path))
+    except Tf.ErrorException:
+        return None
+
+
 def layer_assets(path: str) -> list[tuple[str, str]]:
     """``(asset, absolute path)`` of the sublayers, references and payloads the USD layer ``path``
     names, sorted by asset path (the resource role ``usd-asset``); none without ``pxr`` or when the
     layer cannot be opened."""
-    try:
-        from pxr import Sdf, Tf
-    except ImportError:
-        return []
-    try:
-        layer = Sdf.Layer.FindOrOpen(os.fspath(path))
-    except Tf.ErrorException:
-        return []
+    layer = _layer(path)
     if layer is None:
         return []
     return [(asset, layer.ComputeAbsolutePath(asset)) for asset in sorted(layer.GetCompositionAssetDependencies())]
+
+
+def texture_asset_paths(path: str) -> list[str]:
+    """The files the asset-valued attributes of the USD layer ``path`` name (a ``UsdUVTexture``'s
+    ``inputs:file``), resolved against the layer's folder, in path order; none without ``pxr`` or when the
+    layer cannot be opened. The result cache follows them (a changed texture changes C)."""
+    layer = _layer(path)
+    if layer is None:
+        return []
+    from pxr import Sdf
+
+    found = []
+
+    def visit(spec_path) -> None:
+        if not spec_path.IsPropertyPath():
+            return
+        spec = layer.GetAttributeAtPath(spec_path)
+        value = spec.default if spec is not None and spec.typeName == Sdf.ValueTypeNames.Asset else None
+        if isinstance(value, Sdf.AssetPath) and value.path:
+            found.append(os.path.normpath(os.path.join(os.path.dirname(os.fspath(path)), value.path)))
+
+    layer.Traverse(Sdf.Path.absoluteRootPath, visit)
+    return sorted(set(found))
 
 
 def asset_paths(path: str) -> list[str]:
@@ -213,7 +241,30 @@ def load_stage(stage, path: str, options: UsdOptions | None = None, prim_paths: 
     mesh.meters_per_unit = _stage_metadata(stage, "metersPerUnit", lambda: float(UsdGeom.GetStageMetersPerUnit(stage)),
                                            notes)
     mesh.notes = notes
+    _bind_materials(mesh, prims, options.uv_primvar)
     return mesh
+
+
+def _bind_materials(mesh: Mesh, prims: list, uv_primvar: str | None) -> None:
+    """Each prim's bound material (``material_names``, ``face_material`` per prim) and the textures it reads
+    through the uv primvar (``material_maps``, :mod:`affinity.loaders.usdmaterials`)."""
+    from pxr import Tf
+
+    from .usdmaterials import prim_material_maps
+
+    names, per_prim = [], []
+    for prim in prims:
+        try:
+            material, maps = prim_material_maps(prim, uv_primvar)
+        except Tf.ErrorException:
+            material, maps = None, []
+        if material is not None and material not in names:
+            names.append(material)
+            mesh.material_maps[material] = maps
+        per_prim.append(names.index(material) if material is not None else -1)
+    mesh.material_names = names
+    sizes = np.diff(mesh.prim_face_start)
+    mesh.face_material = np.repeat(np.asarray(per_prim, dtype=np.int32), sizes)
 
 
 def geometry_source(prim, time) -> tuple[str, str] | None:

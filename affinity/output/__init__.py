@@ -124,12 +124,20 @@ class Finding:
     layer_prim: str | None = None
     prims: list[str] | None = None
     prim_values: list[float | None] | None = None
+    shift: float | None = None
+    bound: str | None = None
+    texture: str | None = None
+    role: str | None = None
 
 
 #: The Finding fields only a USD stage fills: left out of structured output where they are None.
 USD_FIELDS = ("prim", "layer", "layer_prim", "prims", "prim_values")
+#: The fields of Q101's visible reading (design.md): set where C was read through a texture, else left out.
+VISIBLE_FIELDS = ("shift", "bound", "texture", "role")
 #: The fields of geometry several prims reference (:attr:`Columns.shared`).
 SHARED_FIELDS = USD_FIELDS[1:]
+#: The Finding fields left out of structured output where they are None.
+OPTIONAL_FIELDS = (*USD_FIELDS, *VISIBLE_FIELDS)
 
 
 def shared_fields(f: Finding) -> dict | None:
@@ -144,7 +152,7 @@ def finding_dict(f: Finding) -> dict:
     every value, which took 6 s for 8,827 findings naming 32 prims each).
     """
     return {name: value for name in Finding.__slots__
-            if (value := getattr(f, name)) is not None or name not in USD_FIELDS}
+            if (value := getattr(f, name)) is not None or name not in OPTIONAL_FIELDS}
 
 
 @dataclass(eq=False)
@@ -158,7 +166,10 @@ class Columns:
     summary, with the finding's detail) and ``prim`` (None outside USD and for
     file-level findings). ``shared`` is None unless some of the findings lie on
     geometry several prims reference: then one dict (the :data:`SHARED_FIELDS`) or
-    None a finding.
+    None a finding. ``visible`` is None unless Q101's visible reading read C for
+    some: then one dict a finding, empty where C was not read, else the
+    :data:`VISIBLE_FIELDS` and the ``threshold`` and ``unit`` of C (the shared
+    ones are the texel reading's).
     """
 
     path: str
@@ -175,24 +186,34 @@ class Columns:
     message: list[str]
     prim: list[str | None]
     shared: list[dict | None] | None = None
+    visible: list[dict] | None = None
 
     def __len__(self) -> int:
         return len(self.face)
 
+    @property
+    def plain(self) -> bool:
+        """Whether every finding has the shared unit and threshold and no USD sharing (the fast formats' case)."""
+        return self.shared is None and self.visible is None
+
     def findings(self) -> list[Finding]:
         shared = self.shared or [None] * len(self)
-        return [Finding(self.path, line, column, self.code, self.name, face, value, self.threshold, self.unit, level,
-                        group, message, prim, **(where or {}))
-                for line, column, face, value, level, group, message, prim, where in zip(
+        visible = self.visible or [{}] * len(self)
+        return [Finding(self.path, line, column, self.code, self.name, face, value,
+                        read.get("threshold", self.threshold), read.get("unit", self.unit), level, group, message, prim,
+                        **(where or {}), **{name: read[name] for name in VISIBLE_FIELDS if name in read})
+                for line, column, face, value, level, group, message, prim, where, read in zip(
                     self.line, self.column, self.face, self.value, self.level, self.group, self.message, self.prim,
-                    shared)]
+                    shared, visible)]
 
     @classmethod
     def of(cls, f: Finding) -> Columns:
         """One finding as columns."""
         where = shared_fields(f)
+        read = {name: getattr(f, name) for name in VISIBLE_FIELDS} if f.shift is not None else None
         return cls(f.path, f.code, f.name, f.unit, f.threshold, [f.line], [f.column], [f.face], [f.value], [f.level],
-                   [f.group], [f.message], [f.prim], None if where is None else [where])
+                   [f.group], [f.message], [f.prim], None if where is None else [where],
+                   None if read is None else [read])
 
 
 def writer(name: str):
@@ -214,11 +235,13 @@ def columns(report: FileReport, hits: RuleHits, take: np.ndarray) -> Columns:
         faces, lines = np.where(faces >= 0, faces - report.prim_face_start[groups], faces), np.zeros_like(lines)
     names = np.asarray([*report.group_names, ""], dtype=object)
     group = names[np.where((groups >= 0) & (groups < len(report.group_names)), groups, -1)].tolist()
-    if hits.details is None:
+    visible = None if hits.visible is None else _visible_fields(hits, take, report.path)
+    remarks = [None] * len(take) if visible is None else [read.pop("remark", None) for read in visible]
+    if hits.details is None and visible is None:
         message = [rule.summary] * len(take)
     else:
-        details = hits.details
-        message = [rule.summary if details[i] is None else f"{rule.summary}: {details[i]}" for i in take.tolist()]
+        details = [None] * len(take) if hits.details is None else [hits.details[i] for i in take.tolist()]
+        message = [": ".join(filter(None, [rule.summary, remark, detail])) for remark, detail in zip(remarks, details)]
     prim = [g if f >= 0 else None for g, f in zip(group, hits.faces[take].tolist())] if usd else [None] * len(take)
     shared = _shared_geometry(report, hits.code, prim, faces.tolist()) if usd and report.shared else None
     return Columns(
@@ -227,7 +250,7 @@ def columns(report: FileReport, hits: RuleHits, take: np.ndarray) -> Columns:
         threshold=None if rule.default_threshold is None else hits.threshold,
         line=lines.tolist(), column=(lines > 0).astype(np.int64).tolist(), face=faces.tolist(),
         value=hits.values[take].tolist(), level=hits.levels()[take].tolist(), group=group, message=message, prim=prim,
-        shared=shared,
+        shared=shared, visible=visible if visible is not None and any(visible) else None,
     )
 
 
@@ -242,6 +265,32 @@ def _shared_geometry(report: FileReport, code: str, prims: list[str | None],
                "prim_values": values[prim].get(face)}
               for prim, face in zip(prims, faces)]
     return shared if any(where is not None for where in shared) else None
+
+
+def _visible_fields(hits: RuleHits, take: np.ndarray, path: str) -> list[dict]:
+    """Per finding at ``take``: the Finding fields Q101's visible reading sets (``threshold``, ``unit``,
+    ``shift``, ``bound``, ``texture``, ``role``) and the message's ``remark``; empty where C was not read."""
+    from ..textures.visible import BOUND_NAMES
+
+    columns = hits.visible
+    folder = os.path.dirname(os.path.abspath(path))
+    rows = []
+    for shift, bound, pick in zip(columns.shifts[take].tolist(), columns.bounds[take].tolist(),
+                                  columns.picks[take].tolist()):
+        if pick < 0 or shift != shift:  # no texture read (NaN shift)
+            rows.append({})
+            continue
+        texture = os.path.relpath(os.path.abspath(columns.textures[pick]), folder)
+        rows.append({"threshold": columns.limits[1], "unit": columns.units[pick], "shift": shift,
+                     "bound": BOUND_NAMES.get(bound), "texture": texture, "role": columns.roles[pick],
+                     "remark": visible_remark(columns.roles[pick], texture, shift)})
+    return rows
+
+
+def visible_remark(role: str, texture: str, shift: float) -> str:
+    """What a finding read through a texture says after its rule's summary: which texture and how far the
+    split shifts it."""
+    return f"the split shifts the {role} texture {texture} by {format_value(shift)} texels"
 
 
 def badness(hits: RuleHits) -> np.ndarray:
@@ -417,8 +466,18 @@ def descriptions(c: Columns) -> list[str]:
     """
     if not c.unit:
         return list(c.message)
-    unit, against = _measured(c)
-    return [f"{m} ({v:.4g}{unit}{against})" for m, v in zip(c.message, c.value)]
+    if c.visible is None:
+        unit, against = _measured(c)
+        return [f"{m} ({v:.4g}{unit}{against})" for m, v in zip(c.message, c.value)]
+    return [_described(m, v, read.get("bound"), read.get("threshold", c.threshold), read.get("unit", c.unit))
+            for m, v, read in zip(c.message, c.value, c.visible)]
+
+
+def _described(message: str, value: float, bound: str | None, threshold: float | None, unit: str) -> str:
+    """One finding's message with its measurement: ``... (>=12 vs 8/255)`` for a value known only as a bound."""
+    value_text = {"at least": ">=", "at most": "<="}.get(bound, "") + format_value(value)
+    measured = value_text if threshold is None else f"{value_text} vs {format_value(threshold)}"
+    return f"{message} ({with_unit(measured, unit)})"
 
 
 def describe(f: Finding) -> str:
@@ -437,7 +496,7 @@ def text_lines(c: Columns) -> list[str]:
     """The ruff-style lines ``path:line:col: CODE level name: message (value vs threshold unit) [face F]``
     (design.md); ``path:prim:face N: CODE level ...`` in USD; no ``[face]`` for file-level findings."""
     path, code, name = printable(c.path), c.code, c.name
-    if c.unit and c.prim[0] is None and min(c.face, default=0) >= 0:  # measured faces of a mesh file
+    if c.unit and c.visible is None and c.prim[0] is None and min(c.face, default=0) >= 0:  # measured mesh faces
         unit, against = _measured(c)
         return [f"{path}:{line}:{column}: {code} {level} {name}: {m} ({v:.4g}{unit}{against}) [face {face}]"
                 for line, column, face, level, m, v in zip(c.line, c.column, c.face, c.level, c.message, c.value)]

@@ -11,7 +11,8 @@ Document layout::
       "findings": [{"path", "line", "column", "code", "name", "face", "value",
                     "threshold", "unit", "level", "group", "message", Q101-Q103 only: "measure",
                     USD only: "prim", and where several prims reference one geometry layer
-                    "layer", "layer_prim", "prims", "prim_values"}],
+                    "layer", "layer_prim", "prims", "prim_values"; Q101 read through a texture:
+                    "shift", "texture", "role", and "bound" ("at least" or "at most") where C is a bound}],
       "summary": {"files", "checked", "unreadable", "skipped", "findings",
                   "baselined", "by_rule": {"Q101": n, ...}, "by_level": {"warning": n, ...},
                   with --level: "not_shown": {"info": n, ...}},
@@ -78,7 +79,7 @@ def _finding_rows(settings):
 
     def rows(c: Columns) -> list[str]:
         encode = json.dumps
-        if c.shared is not None:  # geometry several prims reference: rare, written from whole findings
+        if not c.plain:  # geometry several prims reference, values read through a texture: whole findings
             extra = {} if (measure := settings.measure_of(c.code)) is None else {"measure": measure}
             return [encode({**finding_dict(f), **extra}, separators=(",", ":")) for f in c.findings()]
         head = f'{{"path":{encode(c.path)},"line":'

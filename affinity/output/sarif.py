@@ -58,6 +58,7 @@ from ..findings import FileReport
 from ..rules import RULES, UNREADABLE, rule_page
 from . import (
     VALUE_TOKEN,
+    VISIBLE_FIELDS,
     CheckRun,
     Columns,
     Selection,
@@ -150,29 +151,18 @@ def _result_rows(location: dict, rule_index: dict[str, int]):
         head = f'{{"ruleId":{encode(c.code)},"ruleIndex":{rule_index[c.code]},"level":"'
         shared = f',"threshold":{encode(c.threshold)},"unit":{encode(c.unit)},"level":"'
         results = []
-        for line, column, face, value, level, group, prim, text, ordinal, where in zip(
+        for line, column, face, value, level, group, prim, text, ordinal, where, read in zip(
                 c.line, c.column, c.face, c.value, c.level, c.group, c.prim, descriptions(c), ordinals.tolist(),
-                c.shared or [None] * len(c)):
+                c.shared or [None] * len(c), c.visible or [{}] * len(c)):
             located: dict = {"physicalLocation": _physical(location, line, column)}
             logical, label = _logical_location(prim, group, face)
             if logical:
                 located["logicalLocations"] = [logical]
             identity = fingerprint(c.code, location["uri"], group, value, ordinal)
-            if where is not None:  # geometry several prims reference: where it is authored, who references it
-                located["logicalLocations"] = [_prim_location(p) for p in where["prims"]]
-                results.append(encode({
-                    "ruleId": c.code, "ruleIndex": rule_index[c.code], "level": sarif_level(level),
-                    "message": {"text": f"{text}, {label}{authored_where(where)}"},
-                    "locations": [located],
-                    "relatedLocations": [{
-                        "id": 0, "physicalLocation": {"artifactLocation": artifact_location(where["layer"])},
-                        "logicalLocations": [_prim_location(where["layer_prim"])],
-                        "message": {"text": "where the mesh is authored"}}],
-                    "partialFingerprints": {FINGERPRINT: identity},
-                    "properties": {"name": c.name, "face": face, "value": value, "threshold": c.threshold,
-                                   "unit": c.unit, "level": level, "group": group, "prim": prim,
-                                   **{k: v for k, v in where.items() if v is not None}},
-                }, separators=compact))
+            if where is not None or read:  # shared geometry, or C read through a texture: a result of its own
+                results.append(encode(_rich_result(c, located, where, read, identity, rule_index[c.code], face,
+                                                   value, level, group, prim, f"{text}, {label}" if label else text),
+                                      separators=compact))
                 continue
             results.append(
                 f'{head}{sarif_level(level)}","message":{{"text":{encode(f"{text}, {label}" if label else text)}}},'
@@ -183,6 +173,28 @@ def _result_rows(location: dict, rule_index: dict[str, int]):
         return results
 
     return rows
+
+
+def _rich_result(c: Columns, located: dict, where: dict | None, read: dict, identity: str, rule_index: int,
+                 face: int, value: float, level: str, group: str, prim: str | None, text: str) -> dict:
+    """A result whose finding lies on geometry several prims reference (``where``: where it is authored, who
+    references it) or whose value was read through a texture (``read``: C's threshold and unit, the
+    :data:`~affinity.output.VISIBLE_FIELDS`)."""
+    properties = {"name": c.name, "face": face, "value": value, "threshold": read.get("threshold", c.threshold),
+                  "unit": read.get("unit", c.unit), "level": level, "group": group,
+                  **({} if prim is None else {"prim": prim}),
+                  **{name: read[name] for name in VISIBLE_FIELDS if read.get(name) is not None}}
+    result = {"ruleId": c.code, "ruleIndex": rule_index, "level": sarif_level(level),
+              "message": {"text": text + authored_where(where)}, "locations": [located],
+              "partialFingerprints": {FINGERPRINT: identity}, "properties": properties}
+    if where is not None:
+        located["logicalLocations"] = [_prim_location(p) for p in where["prims"]]
+        result["relatedLocations"] = [{
+            "id": 0, "physicalLocation": {"artifactLocation": artifact_location(where["layer"])},
+            "logicalLocations": [_prim_location(where["layer_prim"])],
+            "message": {"text": "where the mesh is authored"}}]
+        properties.update({k: v for k, v in where.items() if v is not None})
+    return result
 
 
 def _results(run: CheckRun) -> tuple[list[str], str | None]:

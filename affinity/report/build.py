@@ -178,13 +178,13 @@ def _texture_label(mesh: Mesh, view: View, texture: str | None = None) -> str:
         return f"texture {os.path.basename(texture)} (--texture)"
     if view.checks:
         return f"checker texture, {view.checks} squares across"
-    from ..loaders.imagesize import image_size
+    from ..textures.decode import why_not_decoded
 
     path = mesh.texture_path()
     if path is None:
         return "checker texture (the mesh names no map_Kd)"
-    name = os.path.basename(path)
-    return f"texture {name} (map_Kd)" if image_size(path) else f"checker texture (map_Kd {name} is not readable)"
+    name, refused = os.path.basename(path), why_not_decoded(path)
+    return f"texture {name} (map_Kd)" if refused is None else f"checker texture (map_Kd {name}: {refused})"
 
 
 def _render(result: MeshResult, texture: np.ndarray | None, step: StepTimer) -> None:

@@ -160,11 +160,23 @@ def amplified_uv(split: np.ndarray, exact: np.ndarray, same: np.ndarray, local: 
 
 
 def _map_kd(mesh: Mesh) -> str | None:
-    """The mesh's map_Kd path when it is a readable image, else None."""
-    from ..loaders.imagesize import image_size
+    """The mesh's map_Kd path when it is an image the core decodes (within the pixel budget), else None:
+    the close-ups then draw the line pattern."""
+    from ..textures.decode import why_not_decoded
 
     path = mesh.texture_path()
-    return path if path and image_size(path) else None
+    return path if why_not_decoded(path) is None else None
+
+
+def _unused_map_kd(mesh: Mesh) -> str:
+    """The note for a close-up drawn with lines although the mesh names a map_Kd: which and why not."""
+    import os
+
+    from ..textures.decode import why_not_decoded
+
+    path = mesh.texture_path()
+    refused = why_not_decoded(path) if path else None
+    return "" if refused is None else f" (map_Kd {os.path.basename(path)} is not drawn: {refused})"
 
 
 def _area(mesh: Mesh, faces: np.ndarray) -> float:
@@ -240,7 +252,7 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
     elif lines:
         label = f"lines of constant u (blue) and v (red) {LINE_SPACING:g} pixels apart" + (
             f", and an upright F every {GLYPH_SPACING:g} pixels in uv: where it reads mirrored, so is the texture"
-            if glyphs else "")
+            if glyphs else "") + _unused_map_kd(mesh)
     else:
         label = {"color": "vertex colours", "normal": "normals as RGB", "shaded": "shading"}[show]
     framed = ("the place's faces and their neighbours" if len(framed_faces) > 1

@@ -93,21 +93,26 @@ def drawn_fields(result: MeshResult) -> list[str]:
 
 
 def _texture(result: MeshResult) -> dict | None:
-    """The mesh's own texture (map_Kd), downscaled to :data:`TEXTURE_SIDE`, as a data URI with its real size."""
+    """The mesh's own texture (map_Kd), downscaled to :data:`TEXTURE_SIDE`, as a data URI with its real size.
+
+    Decoded by the core (:func:`affinity.textures.decode.decode`: regular files only, never over the pixel
+    budget, once per run); a texture it refuses leaves the view to the uv line pattern."""
     path = result.options.texture or result.mesh.texture_path()
     if not path or result.mesh.texcoords is None:
         return None
-    from PIL import Image, UnidentifiedImageError
+    from PIL import Image
+
+    from ..textures.decode import TextureUnusable, decode
 
     try:
-        with Image.open(path) as image:
-            size = image.size
-            image = image.convert("RGBA" if "A" in image.getbands() else "RGB")
-            image.thumbnail((TEXTURE_SIDE, TEXTURE_SIDE), Image.Resampling.LANCZOS)
-            buffer = io.BytesIO()
-            image.save(buffer, format="PNG", optimize=False)
-    except (OSError, UnidentifiedImageError):
+        pixels = decode(path).pixels
+    except TextureUnusable:
         return None
+    image = Image.fromarray(pixels[..., 0] if pixels.shape[2] == 1 else pixels)
+    size = image.size
+    image.thumbnail((TEXTURE_SIDE, TEXTURE_SIDE), Image.Resampling.LANCZOS)
+    buffer = io.BytesIO()
+    image.save(buffer, format="PNG", optimize=False)
     import os
 
     return {"uri": "data:image/png;base64," + base64.b64encode(buffer.getvalue()).decode(),

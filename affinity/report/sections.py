@@ -177,6 +177,20 @@ def study_section(run: ReportRun) -> Section:
 # --- one mesh ---------------------------------------------------------------------------------
 
 
+def _value_text(hits, row: int, unit: str) -> str:
+    """Finding ``row`` of ``hits`` as the report writes it: ``2.5 texels``, or ``>=40 1/255`` where Q101 read
+    C through a texture (its own unit and bound)."""
+    mark, unit = hits.reading(row, unit)
+    return mark + with_unit(number(hits.values[row]), unit)
+
+
+def _place_value_text(result: MeshResult, place, unit: str) -> str:
+    """A close-up's worst value as :func:`_value_text` writes it (the rule's unit where no finding has it)."""
+    hits = next((h for h in result.file.hits if h.code == place.code), None)
+    rows = np.flatnonzero(hits.faces == place.worst) if hits is not None else []
+    return _value_text(hits, int(rows[0]), unit) if len(rows) else with_unit(number(place.value), unit)
+
+
 def findings_section(result: MeshResult) -> Section:
     """Per rule: how many quads, the threshold, and the worst quads with face index, line and group."""
     title = "Findings"
@@ -190,7 +204,7 @@ def findings_section(result: MeshResult) -> Section:
         levels = hits.levels()
         worst = [
             {"face": int(hits.faces[i]), "line": int(hits.lines[i]), "level": str(levels[i]),
-             "group": result.file.group_names[hits.groups[i]], "value": with_unit(number(hits.values[i]), unit)}
+             "group": result.file.group_names[hits.groups[i]], "value": _value_text(hits, int(i), unit)}
             for i in worst_first(hits)[:WORST_LISTED]
         ]
         by_level = dict(zip(*np.unique(levels, return_counts=True)))
@@ -397,7 +411,7 @@ def closeups_section(result: MeshResult) -> Section:
                      else {"src": image_uri(view.amplified), "label": view.amplified_label})
         figures.append({
             "amplified": amplified, "face": place.worst, "code": place.code, "name": rule.name, "level": place.level,
-            "value": with_unit(number(place.value), unit), "faces": len(place.faces),
+            "value": _place_value_text(result, place, unit), "faces": len(place.faces),
             "line": int(mesh.face_line[place.worst]), "group": mesh.group_names[mesh.face_group[place.worst]],
             "texture": view.texture, "framed": view.framed, "error": error,
             "images": [(method, image_uri(image)) for method, image in view.images.items()],

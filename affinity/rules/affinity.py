@@ -35,10 +35,15 @@ def uv_disaffinity(quads) -> tuple:
     What it does:
         Measures, per quad, the largest difference between the two-triangle split
         and the quad's own bilinear interpolation of its texture coordinates, in
-        texels (texture size from the material's map_Kd image, else the
-        texture-size setting; the first finding of a file says when the size was
-        assumed), and flags quads above the threshold: a warning up to 2 texels,
-        an error above, where the crease is plainly visible. With --measure
+        texels (texture size from the header of the texture the face's material
+        binds, else the texture-size setting; the first finding of a file says when
+        the size was assumed), and flags quads above the threshold: a warning up to
+        2 texels, an error above, where the crease is plainly visible. Where the
+        quad's textures decode, the finding reads the crease through them instead:
+        C, the largest colour difference the split makes on screen, in 1/255 (degrees
+        for normal maps), levelled by visible-error, visible-warning and
+        visible-min-shift, the shift kept beside it (docs/measure.md, "The visible
+        reading"). With --measure
         centre it takes the split's shift at the quad's centre instead, with
         --measure barycentric the paper's dimensionless score at .01. On the
         example's trapezoid (side ratio r = 1/2) the split shifts the texture at
@@ -75,7 +80,7 @@ def uv_disaffinity(quads) -> tuple:
     diagonal = quads.settings.diagonal
     if quads.settings.measure == "barycentric":
         return rows, barycentric_score(quads.planar.take(rows), quads.uv_planar, diagonal)
-    return rows, texels(quads.split_error(rows, uv).T, quads.texture_size)
+    return rows, texels(quads.split_error(rows, uv).T, quads.texel_size(rows))
 
 
 @rule(code="Q102", name="color-disaffine", unit="1/255", default_threshold=2.0, visible_threshold=8.0, attribute="colors", scored=True,

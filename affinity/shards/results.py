@@ -25,7 +25,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from ..findings import FileReport, RuleHits
+from ..findings import FileReport, RuleHits, VisibleColumns
 from ..output.json import SCHEMA, VERSION
 from ..rules import RULES
 from ..settings import Settings
@@ -67,7 +67,7 @@ def read_result(path: str) -> CheckResult:
     try:
         return CheckResult(
             path=path,
-            reports=_reports(doc["files"], doc["findings"]),
+            reports=_reports(doc["files"], doc["findings"], _settings(doc["settings"])),
             settings=_settings(doc["settings"]),
             shard=None if "shard" not in doc else _shard_record(doc["shard"]),
             truncated="truncated" in doc,
@@ -96,14 +96,14 @@ def _settings(entry: dict) -> Settings:
     return Settings(**entry)
 
 
-def _reports(files: list[dict], findings: list[dict]) -> list[FileReport]:
+def _reports(files: list[dict], findings: list[dict], settings: Settings) -> list[FileReport]:
     by_path: dict[str, list[dict]] = {entry["path"]: [] for entry in files}
     for finding in findings:
         by_path[finding["path"]].append(finding)
-    return [_report(entry, by_path[entry["path"]]) for entry in files]
+    return [_report(entry, by_path[entry["path"]], settings) for entry in files]
 
 
-def _report(entry: dict, findings: list[dict]) -> FileReport:
+def _report(entry: dict, findings: list[dict], settings: Settings) -> FileReport:
     """The report of one JSON file entry and its findings (in the document's order)."""
     path = entry["path"]
     if "error" in entry:
@@ -120,7 +120,7 @@ def _report(entry: dict, findings: list[dict]) -> FileReport:
         prim_face_start = _prim_face_start(faces, groups, len(group_names))
         faces = faces + prim_face_start[groups]
     codes = np.array([f["code"] for f in findings], dtype=object)
-    hits = [_rule_hits(code, [findings[i] for i in rows], faces[rows], groups[rows])
+    hits = [_rule_hits(code, [findings[i] for i in rows], faces[rows], groups[rows], settings)
             for code in RULES if len(rows := np.flatnonzero(codes == code))]
     return FileReport(
         path,
@@ -158,36 +158,71 @@ def _prim_face_start(faces: np.ndarray, groups: np.ndarray, n_groups: int) -> np
     return np.concatenate([[0], np.cumsum(sizes)])
 
 
-def _rule_hits(code: str, rows: list[dict], faces: np.ndarray, groups: np.ndarray) -> RuleHits:
-    """One rule's findings in one file; ``faces`` and ``groups`` (n,) as :class:`RuleHits` keeps them."""
+def _rule_hits(code: str, rows: list[dict], faces: np.ndarray, groups: np.ndarray, settings: Settings) -> RuleHits:
+    """One rule's findings in one file; ``faces`` and ``groups`` (n,) as :class:`RuleHits` keeps them. Findings
+    read through a texture (with a ``shift``) become the hits' visible reading, levelled by ``settings``'
+    ``visible-*``; the others' level and visibility threshold are rebuilt from them alone."""
     rule = RULES[code]
     values = np.array([f["value"] for f in rows], dtype=np.float64)
     levels = np.array([f["level"] for f in rows], dtype=object)
+    visible = np.array(["shift" in f for f in rows], dtype=bool)
     errors = levels == "error"
     level, error_above = "error", None
-    if not errors.all():
-        others = set(levels[~errors].tolist())
+    if not errors[~visible].all():
+        others = set(levels[~visible & ~errors].tolist())
         if len(others) > 1:
             raise ValueError(f"{code} findings at levels {sorted(others)} besides error")
         level = others.pop()
-        error_above = float(values[~errors].max()) if errors.any() else None
-    details = [_detail(rule.summary, f["message"]) for f in rows]
-    threshold = rows[0]["threshold"]
+        error_above = float(values[~visible & ~errors].max()) if (errors & ~visible).any() else None
+    details = [_detail(rule.summary, f["message"], _visible_remark(f)) for f in rows]
+    plain = [f for f in rows if "shift" not in f]
+    threshold = plain[0]["threshold"] if plain else settings.threshold(code)
     hits = RuleHits(
         code, faces, np.array([f["line"] for f in rows], dtype=np.int64), values,
-        0.0 if threshold is None else float(threshold), groups, level=level, unit=rows[0]["unit"],
+        0.0 if threshold is None else float(threshold), groups, level=level,
+        unit=plain[0]["unit"] if plain else rule.unit_for(settings.measure),
         details=None if all(d is None for d in details) else details, error_above=error_above,
+        visible=_visible_columns(rows, settings) if visible.any() else None,
     )
     if not (hits.levels() == levels).all():
         raise ValueError(f"{code} findings whose levels no visibility threshold explains")
     return hits
 
 
-def _detail(summary: str, message: str) -> str | None:
-    """What a finding's message says after its rule's summary (None: nothing)."""
-    if message == summary:
+def _visible_remark(finding: dict) -> str | None:
+    """The remark the text of a finding read through a texture starts with (None for another finding)."""
+    from ..output import visible_remark
+
+    if "shift" not in finding:
         return None
-    head = summary + ": "
-    if not message.startswith(head):
+    return visible_remark(finding["role"], finding["texture"], finding["shift"])
+
+
+def _visible_columns(rows: list[dict], settings: Settings) -> VisibleColumns:
+    """The visible reading of findings that carry one (``shift``, ``texture``, ``role``, ``unit``, ``bound``);
+    a texture is named relative to its mesh's folder, as the JSON names it."""
+    import os
+
+    sources = list(dict.fromkeys((f["texture"], f["role"], f["unit"]) for f in rows if "shift" in f))
+    picks = np.array([sources.index((f["texture"], f["role"], f["unit"])) if "shift" in f else -1 for f in rows],
+                     dtype=np.int32)
+    folder = os.path.dirname(os.path.abspath(rows[0]["path"]))
+    limits = settings.visible_limits
+    return VisibleColumns(
+        values=np.array([f["value"] if "shift" in f else np.nan for f in rows], dtype=np.float64),
+        shifts=np.array([f.get("shift", np.nan) for f in rows], dtype=np.float64),
+        bounds=np.array([{"at least": 1, "at most": 2}.get(f.get("bound"), 0) for f in rows], dtype=np.int8),
+        picks=picks, textures=[os.path.normpath(os.path.join(folder, texture)) for texture, _, _ in sources],
+        roles=[role for _, role, _ in sources], units=[unit for _, _, unit in sources],
+        limits=(limits.error, limits.warning, limits.min_shift), fixed=rows[0]["code"] in settings.levels)
+
+
+def _detail(summary: str, message: str, remark: str | None = None) -> str | None:
+    """What a finding's message says after its rule's summary and ``remark`` (the visible reading's, which
+    the reports rebuild from the finding's fields; None: nothing more)."""
+    head = summary if remark is None else f"{summary}: {remark}"
+    if message == head:
+        return None
+    if not message.startswith(head + ": "):
         raise ValueError(f"message {message!r} is not the rule's summary")
-    return message[len(head):]
+    return message[len(head) + 2:]

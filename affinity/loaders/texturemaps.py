@@ -1,0 +1,108 @@
+"""The textures a mesh's uv set feeds, by role (design.md, "Textures by role").
+
+Each loader lists, per material, the texture maps the material reads through the
+mesh's uv: :class:`TextureMap` records in ``Mesh.material_maps``. An OBJ reads
+them from its MTL libraries (:func:`obj_material_maps`), a USD stage from
+UsdPreviewSurface and MaterialX networks (:mod:`affinity.loaders.usdmaterials`).
+A map's path may hold a UDIM token (``<UDIM>``, ``%(UDIM)d``): each tile is then
+its own file and size (:func:`udim_tiles`, :func:`udim_tile_of`).
+"""
+
+from __future__ import annotations
+
+import glob
+import os
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+#: The roles in the order the worst of them decides a finding when values tie (design.md).
+ROLES = ("base colour", "normal", "height", "scalar")
+_UDIM_TOKENS = ("<UDIM>", "<udim>", "%(UDIM)d")
+
+
+@dataclass(frozen=True, kw_only=True)
+class TextureMap:
+    """One texture a material reads through the mesh's uv.
+
+    Attributes
+    ----------
+    role : ``"base colour"``, ``"normal"``, ``"height"`` or ``"scalar"`` (None: a map whose texels no
+        reading knows, named by a role registered without a kind)
+    path : the file, resolved (it may hold a UDIM token)
+    name : the file as the material spells it
+    source : what names it, for messages: ``"map_Kd"``, ``"UsdUVTexture /Looks/Wood/Tex"``
+    scale, offset : the texture is read at ``uv * scale + offset`` (MTL ``-s``/``-o``)
+    """
+
+    role: str | None
+    path: str
+    name: str
+    source: str
+    scale: tuple[float, float] = (1.0, 1.0)
+    offset: tuple[float, float] = (0.0, 0.0)
+
+    @property
+    def udim(self) -> bool:
+        return any(token in self.path for token in _UDIM_TOKENS)
+
+    def texture_uv(self, uv: np.ndarray) -> np.ndarray:
+        """(..., 2) float64: where the texture is read for mesh uv ``uv`` (..., 2)."""
+        if self.scale == (1.0, 1.0) and self.offset == (0.0, 0.0):
+            return uv
+        return uv * np.asarray(self.scale) + np.asarray(self.offset)
+
+
+def udim_tiles(path: str) -> dict[int, str]:
+    """Tile number (1001, 1002, ... 1011 is the row above 1001) -> file, for a path with a UDIM token;
+    the tiles found on disk."""
+    for token in _UDIM_TOKENS:
+        if token in path:
+            head, tail = path.split(token, 1)
+            pattern = re.compile(re.escape(os.path.basename(head)) + r"(1\d{3})" + re.escape(tail) + "$")
+            found = {}
+            for candidate in glob.glob(glob.escape(head) + "[0-9]" * 4 + glob.escape(tail)):
+                match = pattern.search(os.path.basename(candidate))
+                if match:
+                    found[int(match.group(1))] = candidate
+            return dict(sorted(found.items()))
+    return {}
+
+
+def tile_files(paths) -> list[str]:
+    """``paths`` each once, in order, a UDIM path replaced by its tiles on disk (:func:`udim_tiles`)."""
+    files = []
+    for path in paths:
+        has_token = any(token in path for token in _UDIM_TOKENS)
+        files += list(udim_tiles(path).values()) if has_token else [path]
+    return list(dict.fromkeys(files))
+
+
+def udim_tile_of(uv: np.ndarray) -> np.ndarray:
+    """(Q,) int64 UDIM tile of quads whose corner uv are ``uv`` (Q, 4, 2): ``1001 + u + 10 v`` at
+    the quad's uv centre (a quad belongs to one tile; the tile's uv is its fractional part).
+
+    >>> udim_tile_of(np.array([[[0.1, 0.1], [0.9, 0.1], [0.9, 0.9], [0.1, 0.9]],
+    ...                        [[1.2, 1.2], [1.8, 1.2], [1.8, 1.8], [1.2, 1.8]]])).tolist()
+    [1001, 1012]
+    """
+    centre = np.floor(uv.mean(axis=1))
+    return (1001 + centre[:, 0] + 10 * centre[:, 1]).astype(np.int64)
+
+
+def obj_material_maps(resources: list) -> dict[str, list[TextureMap]]:
+    """Material -> its texture maps, from an OBJ's ``mtllib`` resources (``Mesh.resources``): the first
+    library defining a material wins, within a library its last statement of each role (as a renderer
+    reads them)."""
+    from .mtl import map_statements
+
+    maps: dict[str, list[TextureMap]] = {}
+    for library in (r for r in resources if r.role == "mtllib"):
+        own: dict[str, dict[str, TextureMap]] = {}
+        for role, material, texture in map_statements(library.path):
+            if texture.role is not None:
+                own.setdefault(material, {})[role] = texture
+        for material, by_statement in own.items():
+            maps.setdefault(material, list(by_statement.values()))
+    return maps

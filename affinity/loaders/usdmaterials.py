@@ -1,0 +1,207 @@
+"""The textures a USD mesh prim's bound material reads through its uv primvar (design.md, "Textures by role").
+
+Two kinds of material are read:
+
+- UsdPreviewSurface networks: each input of the surface shader connected to a
+  ``UsdUVTexture`` whose ``inputs:st`` comes from a ``UsdPrimvarReader_float2``
+  naming the prim's uv primvar; the texture is ``inputs:file``, resolved against the
+  layer that authored it (UDIM tokens kept);
+- MaterialX documents a material prim references (``references = @look.mtlx@</...>``):
+  usd-core cannot compose them, so the reference is followed at the Sdf level (the
+  material prim's spec) and the ``.mtlx`` XML is read with ElementTree: the
+  ``image`` and ``tiledimage`` nodes upstream of the surface shader's inputs, through
+  node graphs and ``normalmap`` nodes, with ``fileprefix`` and ``tiledimage``'s
+  ``uvtiling``/``uvoffset``.
+
+The role of a texture is the shader input it feeds: :data:`ROLE_OF_INPUT`, else
+``scalar``.
+"""
+
+from __future__ import annotations
+
+import os
+import xml.etree.ElementTree as ElementTree
+
+from .texturemaps import TextureMap
+
+#: Surface shader inputs by role (UsdPreviewSurface, standard_surface, open_pbr_surface, gltf_pbr).
+ROLE_OF_INPUT = {
+    "diffuseColor": "base colour", "base_color": "base colour", "baseColor": "base colour",
+    "normal": "normal", "geometry_normal": "normal",
+    "displacement": "height", "height": "height",
+}  # fmt: skip
+_IMAGE_NODES = ("image", "tiledimage")
+
+
+def prim_material_maps(prim, uv_primvar: str | None) -> tuple[str | None, list[TextureMap]]:
+    """The path of the material bound to ``prim`` and the textures it reads through the primvar
+    ``uv_primvar`` (None: ``st``); (None, []) when no material is bound."""
+    from pxr import UsdShade
+
+    material, _ = UsdShade.MaterialBindingAPI(prim).ComputeBoundMaterial()
+    if not material:
+        return None, []
+    maps = preview_surface_maps(material, uv_primvar or "st")
+    return str(material.GetPath()), maps or materialx_maps(material.GetPrim())
+
+
+def preview_surface_maps(material, uv_primvar: str) -> list[TextureMap]:
+    """The ``UsdUVTexture`` files feeding the material's UsdPreviewSurface, by the input they feed."""
+    source = material.ComputeSurfaceSource()
+    shader = source[0] if source else None
+    if not shader or shader.GetIdAttr().Get() != "UsdPreviewSurface":
+        return []
+    maps = []
+    for shader_input in shader.GetInputs():
+        for texture in _upstream_textures(shader_input):
+            if _primvar_read(texture) not in (None, uv_primvar):
+                continue  # the texture reads another uv set
+            file_input = texture.GetInput("file")
+            asset = file_input.Get() if file_input else None
+            if not asset or not asset.path:
+                continue
+            maps.append(TextureMap(role=ROLE_OF_INPUT.get(shader_input.GetBaseName(), "scalar"),
+                                   path=_resolved(file_input.GetAttr(), asset), name=asset.path,
+                                   source=f"UsdUVTexture {texture.GetPath()}"))
+    return maps
+
+
+def _upstream_textures(shader_input) -> list:
+    """The ``UsdUVTexture`` shaders a shader input is connected to, directly."""
+    from pxr import UsdShade
+
+    found = []
+    for info in shader_input.GetConnectedSources()[0]:
+        shader = UsdShade.Shader(info.source.GetPrim())
+        if shader and shader.GetIdAttr().Get() == "UsdUVTexture":
+            found.append(shader)
+    return found
+
+
+def _primvar_read(texture) -> str | None:
+    """The primvar a ``UsdUVTexture``'s ``st`` is read from (its primvar reader's ``varname``), None when
+    unconnected."""
+    from pxr import UsdShade
+
+    st = texture.GetInput("st")
+    if not st:
+        return None
+    for info in st.GetConnectedSources()[0]:
+        reader = UsdShade.Shader(info.source.GetPrim())
+        varname = reader.GetInput("varname") if reader else None
+        if varname and varname.Get() is not None:
+            return str(varname.Get())
+    return None
+
+
+def _resolved(attribute, asset) -> str:
+    """An asset path's file: the resolver's answer, else the authored path against the folder of the layer
+    that authored it (UDIM paths do not resolve)."""
+    if asset.resolvedPath:
+        return os.path.normpath(asset.resolvedPath)
+    layer = attribute.GetPropertyStack()[0].layer if attribute.GetPropertyStack() else None
+    folder = os.path.dirname(layer.realPath) if layer is not None and layer.realPath else ""
+    return os.path.normpath(os.path.join(folder, asset.path))
+
+
+def materialx_maps(material_prim) -> list[TextureMap]:
+    """The textures of the MaterialX material a material prim references (the first ``.mtlx`` reference
+    of its prim specs), read from the document's XML."""
+    for spec in material_prim.GetPrimStack():
+        for reference in spec.referenceList.GetAddedOrExplicitItems():
+            if reference.assetPath.lower().endswith(".mtlx"):
+                document = spec.layer.ComputeAbsolutePath(reference.assetPath)
+                if spec.layer.realPath and not os.path.isabs(document):
+                    document = os.path.join(os.path.dirname(spec.layer.realPath), reference.assetPath)
+                return mtlx_document_maps(document, reference.primPath.name or None)
+    return []
+
+
+def mtlx_document_maps(path: str, material: str | None = None, every: bool = False) -> list[TextureMap]:
+    """The image files feeding the surface shader of ``material`` (a ``surfacematerial`` name; None: the
+    first; with ``every``, of every material) in the MaterialX document ``path``; empty when it cannot be
+    read."""
+    try:
+        root = ElementTree.parse(path).getroot()
+    except (OSError, ElementTree.ParseError):
+        return []
+    nodes = _named_nodes(root)
+    materials = [n for n in root.iter("surfacematerial") if material in (None, n.get("name"))]
+    shaders = [_upstream(nodes, m.find("input[@name='surfaceshader']")) for m in materials[: None if every else 1]]
+    folder = os.path.dirname(os.path.abspath(path))
+    maps = []
+    for shader_input in (i for shader in shaders if shader is not None for i in shader.findall("input")):
+        role = ROLE_OF_INPUT.get(shader_input.get("name"), "scalar")
+        for image in _images_upstream(nodes, shader_input):
+            file_input = image.find("input[@name='file']")
+            name = file_input.get("value") if file_input is not None else None
+            if not name:
+                continue
+            name = _file_prefix(image, nodes, root.get("fileprefix", "")) + name
+            scale, offset = _tiling(image)
+            maps.append(TextureMap(role=role, path=os.path.normpath(os.path.join(folder, name)), name=name,
+                                   source=f"MaterialX {image.tag} {image.get('name')} ({os.path.basename(path)})",
+                                   scale=scale, offset=offset))
+    return maps
+
+
+def _named_nodes(root) -> dict:
+    """Every element with a name, by ``name`` and by ``graph/name`` inside node graphs; parents remembered."""
+    nodes = {}
+    for element in root:
+        nodes[element.get("name")] = element
+        if element.tag == "nodegraph":
+            for child in element:
+                nodes[f"{element.get('name')}/{child.get('name')}"] = child
+                child.set("_graph", element.get("name"))
+    return nodes
+
+
+def _upstream(nodes: dict, connection, graph: str | None = None):
+    """The node an ``input`` or ``output`` element (inside node graph ``graph``, None: at the top) is connected
+    to, through node graph outputs."""
+    if connection is None:
+        return None
+    if connection.get("nodename"):
+        name = connection.get("nodename")
+        return nodes.get(f"{graph}/{name}") if graph else nodes.get(name)
+    if connection.get("nodegraph"):
+        inner = connection.get("nodegraph")
+        return _upstream(nodes, nodes.get(f"{inner}/{connection.get('output') or 'out'}"), inner)
+    return None
+
+
+def _images_upstream(nodes: dict, connection, graph: str | None = None, depth: int = 0) -> list:
+    """The image nodes upstream of a connection (through normalmap and other nodes, at most 16 deep)."""
+    node = _upstream(nodes, connection, graph)
+    if node is None or depth > 16:
+        return []
+    if node.tag in _IMAGE_NODES:
+        return [node]
+    return [image for child in node.findall("input")
+            for image in _images_upstream(nodes, child, node.get("_graph"), depth + 1)]
+
+
+def _file_prefix(image, nodes: dict, document_prefix: str) -> str:
+    """The ``fileprefix`` in force at an image node: its own, else its node graph's, else the document's."""
+    graph = nodes.get(image.get("_graph")) if image.get("_graph") else None
+    for element in (image, graph):
+        if element is not None and element.get("fileprefix") is not None:
+            return element.get("fileprefix")
+    return document_prefix
+
+
+def _tiling(image) -> tuple[tuple[float, float], tuple[float, float]]:
+    """A ``tiledimage``'s scale and offset: MaterialX's ``ND_tiledimage`` graph reads the image at
+    ``uv * uvtiling - uvoffset``, so (``uvtiling``, ``-uvoffset``)."""
+    def vector(name, default):
+        element = image.find(f"input[@name='{name}']")
+        if element is None or not element.get("value"):
+            return default
+        a, b = (float(x) for x in element.get("value").split(","))
+        return a, b
+
+    if image.tag != "tiledimage":
+        return (1.0, 1.0), (0.0, 0.0)
+    offset = vector("uvoffset", (0.0, 0.0))
+    return vector("uvtiling", (1.0, 1.0)), (-offset[0], -offset[1])
