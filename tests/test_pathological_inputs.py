@@ -16,7 +16,7 @@ import subprocess
 import sys
 
 import pytest
-from helpers.cli import SQUARE, write
+from helpers.cli import SQUARE, TRAPEZOID, write
 
 from affinity.errors import MeshError
 from affinity.loaders import load, text
@@ -271,6 +271,23 @@ def test_a_bad_file_in_a_folder_is_one_q901_and_the_others_are_checked(tmp_path)
         f"{tmp_path / 'zeros.obj'}:1: Q901 unreadable: binary data (byte 0x00) at offset 0: not a text mesh"
         " (a zero-filled or damaged file?)"]
     document = json.loads(result.stdout)
+    assert [(os.path.basename(f["path"]), f["code"]) for f in document["findings"]] == [("trapezoid.obj", "Q101")]
+
+
+@pytest.mark.parametrize("cached", [False, True], ids=["no-cache", "cache"])
+def test_a_fifo_or_device_in_a_folder_is_one_q901_naming_it_and_the_others_are_checked(tmp_path, cached):
+    fifo = special(tmp_path, "pipe.obj", "fifo")
+    device = special(tmp_path, "zero.ply", "device")
+    special(tmp_path, "notes.txt", "fifo")  # not a mesh name: the walk passes it by, as it does a regular .txt
+    write(tmp_path, "trapezoid.obj", TRAPEZOID)
+    result = run("check", "--format", "json", *([] if cached else ["--no-cache"]), str(tmp_path),
+                 cache=tmp_path.parent / "cache" if cached else None)
+    assert result.returncode == 2
+    assert result.stderr.splitlines() == [f"{fifo}:0: Q901 unreadable: {WORDS['fifo']}: not read",
+                                          f"{device}:0: Q901 unreadable: {WORDS['device']}: not read"]
+    document = json.loads(result.stdout)
+    assert sorted(os.path.basename(entry["path"]) for entry in document["files"]) == [
+        "pipe.obj", "trapezoid.obj", "zero.ply"]
     assert [(os.path.basename(f["path"]), f["code"]) for f in document["findings"]] == [("trapezoid.obj", "Q101")]
 
 
