@@ -314,6 +314,19 @@ def test_one_triangle_faces_and_a_face_of_one_repeated_index(tmp_path):
     assert [(f["code"], f["face"], f["line"]) for f in document["findings"]] == [("Q201", faces, faces + 4)]
 
 
+@pytest.mark.parametrize("names", [127, 128, 40_000])
+def test_group_and_material_tables_hold_every_name_past_a_narrow_type(tmp_path, names):
+    # The tables take the narrowest integer type that holds the names (int8 to 127, then int16, int32):
+    # face k is in group k and material k, and a face before any usemtl has none (-1).
+    faces = "".join(f"g part{k}\nusemtl m{k}\nf 1 2 3\n" for k in range(names))
+    mesh = load(write(tmp_path, "named.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n" + faces))
+    assert mesh.group_names == ["", *(f"part{k}" for k in range(names))]
+    assert mesh.material_names == [f"m{k}" for k in range(names)]
+    assert mesh.face_group.tolist() == list(range(names + 1))
+    assert mesh.face_material.tolist() == list(range(-1, names))
+    assert mesh.face_line.tolist() == [4, *range(7, 3 * names + 5, 3)]
+
+
 @requires_usd
 def test_usd_stage_of_many_empty_prims_is_skipped_and_nested_references_are_read(tmp_path):
     empty = write(tmp_path, "empty.usda", "#usda 1.0\n" + "".join(f'def Xform "p{k}" {{\n}}\n' for k in range(2000)))
