@@ -173,15 +173,10 @@ def _regular_layers(path) -> tuple[list, bool]:
 def prim_type_names(layer) -> set[str]:
     """The type names of the prim specs of one Sdf ``layer``, those inside variants included (a
     variant can define a mesh), without composing anything: one look at each spec's path, O(specs)."""
-    names = set()
-
-    def visit(spec_path) -> None:
-        if spec_path.IsPrimPath():
-            names.add(layer.GetPrimAtPath(spec_path).typeName)
-
-    layer.Traverse(layer.pseudoRoot.path, visit)
-    names.discard("")
-    return names
+    spec_paths = []
+    layer.Traverse(layer.pseudoRoot.path, spec_paths.append)  # a builtin callback: no Python frame per spec
+    prim_at = layer.GetPrimAtPath
+    return {prim_at(spec_path).typeName for spec_path in spec_paths if spec_path.IsPrimPath()} - {""}
 
 
 def may_hold_mesh(type_names: set[str]) -> bool:
@@ -201,8 +196,7 @@ def load_usd(path, options: UsdOptions | None = None) -> Mesh:
     missing, the stage cannot be opened or traversed, or a prim's topology or
     values are invalid; SkippedFile (``no-mesh``) when it has no mesh to check. A stage none of whose
     layers holds a prim spec that may be a mesh (:func:`may_hold_mesh`) is skipped without composing it:
-    composition costs some 12 microseconds a prim (a stage of 100,000 empty prims: 1.2 s), the look at
-    the layers' specs a third of that.
+    on a stage of 100,000 empty prims composing took 1.2 s, the look at the layer's specs 0.23 s.
     """
     try:
         from pxr import Tf, Usd
