@@ -631,3 +631,28 @@ def test_uv_layout_labels_crowded_at_the_bottom_stay_inside_the_picture(tmp_path
     assert len(baselines) == 5 and svg.count("<circle") == 5
     assert 12 <= baselines[0] and baselines[-1] <= 640 - 3  # none below the picture's edge
     assert min(np.diff(baselines)) >= 15  # stacked a line apart: they overlap horizontally
+
+
+def test_a_colour_crease_below_one_8_bit_step_gets_no_amplified_panel_and_a_line_saying_why(tmp_path):
+    """One corner 0.3/255 lighter: the split's largest change is a fraction of that (the bilinear crease of one
+    corner's offset peaks at a quarter of it), which the PNG rounds away; a gain of thousands would paint its
+    float noise. Flagged at a threshold of 0.01/255, the close-up leaves the panel out and its caption says why."""
+    from affinity.report.build import ReportOptions, collect_mesh
+    from affinity.report.demo import MeshInput
+    from affinity.report.sections import closeups_section
+    from affinity.settings import Settings
+
+    colors = np.full((4, 3), 0.5)
+    colors[2] += 0.3 / 255
+    square = mesh_from_polygons("tiny", [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], [[0, 1, 2, 3]], colors=colors)
+    write_obj(square, tmp_path / "tiny.obj")
+    settings = Settings(select=["Q102"], thresholds={"Q102": 0.01})
+    result = collect_mesh(MeshInput(str(tmp_path / "tiny.obj"), "tiny.obj"), settings,
+                          options=ReportOptions(max_views=1))
+    (view,) = result.closeups
+    assert view.place.code == "Q102"
+    assert np.abs(view.images["split"] - view.images["exact"])[view.covered & view.own].max() < 1 / 255
+    assert view.amplified is None and view.gain == 1.0
+    assert "below one 8-bit step" in view.amplified_note
+    (figure,) = closeups_section(result).data["figures"]
+    assert figure["amplified"] is None and figure["amplified_note"] == view.amplified_note

@@ -50,6 +50,9 @@ AMPLIFIED = ("color", "normal")
 COLOUR_REACH = 0.5
 UV_REACH = 3.0
 GAIN_STEPS = (1, 2, 5)
+#: A colour or normal crease whose largest change on the place is below this (of 1) is under one 8-bit step: the
+#: PNGs round it away, and amplified they show rounding noise, so the close-up has no amplified panel and says why.
+EIGHT_BIT_STEP = 1 / 255
 
 
 @dataclass
@@ -63,7 +66,8 @@ class Closeup:
     view : the :class:`affinity.draw.closeup.CloseupView` drawn (camera, up, drawn faces)
     seen : (K,) int64, the mesh faces covering at least ``SEEN_PIXELS`` pixels of the split picture
     amplified : (S, S, 3) float, the split with its difference from exact (colours, normals) or its uv error
-        times ``gain``, where that is faint (a gain above 1), else None; ``amplified_label`` says which
+        times ``gain``, where that is faint (a gain above 1), else None; ``amplified_label`` says which, and
+        ``amplified_note`` why there is none where the difference is below one 8-bit step (``EIGHT_BIT_STEP``)
     dropped : why the close-up is not shown (its place covers too few pixels from every side), else None
     """
 
@@ -81,6 +85,7 @@ class Closeup:
     amplified: np.ndarray | None = None
     gain: float = 1.0
     amplified_label: str = ""
+    amplified_note: str = ""
     seen: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
 
     @property
@@ -114,11 +119,19 @@ def _amplified(split: np.ndarray, exact: np.ndarray, same: np.ndarray, unit: np.
     :func:`gain_for` of the largest finite change in ``unit`` (a scalar, or (S, S, K) with NaN where unknown)
     on the place's pixels ``place`` (S, S) bool that ``same`` keeps (all of ``same``'s when none or None)."""
     error = np.where(same[..., None], split - exact, 0.0)
+    gain = gain_for(largest_change(split, exact, same, place, unit), reach)
+    return exact + gain * error, gain
+
+
+def largest_change(split: np.ndarray, exact: np.ndarray, same: np.ndarray, place: np.ndarray | None,
+                   unit: np.ndarray | float = 1.0) -> float:
+    """The largest finite ``|split - exact|`` (S, S, K) in ``unit`` (a scalar, or (S, S, K) with NaN where
+    unknown) on the place's pixels ``place`` (S, S) bool that ``same`` (S, S) bool keeps (all of ``same``'s
+    when none or None); 0 where there are none."""
     keep = same if place is None or not (same & place).any() else same & place
     with np.errstate(invalid="ignore", divide="ignore"):
-        change = (np.abs(error) / unit)[keep]
-    gain = gain_for(float(change[np.isfinite(change)].max(initial=0.0)), reach)
-    return exact + gain * error, gain
+        change = (np.abs(split - exact) / unit)[keep]
+    return float(change[np.isfinite(change)].max(initial=0.0))
 
 
 def amplified_difference(split: np.ndarray, exact: np.ndarray, same: np.ndarray,
@@ -294,6 +307,12 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
         if show in AMPLIFIED:
             amplified, gain = amplified_difference(plain["split"], plain["exact"], covered, result.own)
             what = "its difference from exact"
+            change = largest_change(plain["split"], plain["exact"], covered, result.own)
+            if gain > 1 and change < EIGHT_BIT_STEP:
+                result.amplified_note = (f"No amplified panel: split and exact differ by at most "
+                                         f"{change * 255:.2g}/255 on the place, below one 8-bit step, so "
+                                         "amplified it would show rounding noise.")
+                gain = 1.0
         else:  # uv: the split's texture moved by gain times its error, drawn as the panels are
             local = local_footprints(exact.attrs)
             uv, gain = amplified_uv(split.attrs, exact.attrs, covered, local, result.own)
