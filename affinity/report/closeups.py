@@ -14,7 +14,7 @@ mirrored on the mirrored faces, which a symmetric pattern cannot show.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -95,6 +95,8 @@ class Closeup:
 
 
 def _show_for(mesh: Mesh, code: str) -> str:
+    if RULES[code].folding:
+        return "fold"
     attribute = RULES[code].attribute if RULES[code].scored else None
     if attribute is not None:
         return SHOW_FOR[attribute]
@@ -233,6 +235,35 @@ def _framed_view(mesh: Mesh, place: Place):
     return near, worst
 
 
+def positions_as_colours(mesh: Mesh) -> Mesh:
+    """``mesh`` with its positions, moved and scaled alike on every axis into [0, 1], as its vertex colours: the
+    rasterizer then interpolates the surface point of every pixel (flat on a split triangle, on the bilinear
+    patch for exact), and a uniform scale keeps the directions of its normals."""
+    used = mesh.positions[np.unique(mesh.corner_vertex)]
+    low, extent = used.min(axis=0), float(np.ptp(used, axis=0).max())
+    return replace(mesh, colors=np.clip((mesh.positions - low) / (extent if extent > 0 else 1.0), 0.0, 1.0))
+
+
+def _fold_picture(mesh: Mesh, place: Place, view, drawn, sub_face: np.ndarray) -> np.ndarray:
+    """(S, S, 3) float32: the fold close-up of ``drawn`` (a render of :func:`positions_as_colours`), shaded by
+    its surface's normals, lit across the worst face's fold (:func:`affinity.draw.fold.fold_light`), with the
+    split diagonal of each of the place's quads drawn (``sub_face`` (S, S) int: the face of ``view.drawn``)."""
+    from ..draw.closeup import face_vertices
+    from ..draw.fold import draw_diagonals, fold_light, shade_fold, surface_normals, triangle_normals
+    from ..draw.shading import BACKGROUND
+
+    quads = place.faces[mesh.face_sizes[place.faces] == 4]
+    corners = mesh.positions[face_vertices(mesh, quads)[0]].reshape(-1, 4, 3)
+    eye, target, _ = view.camera
+    toward_eye = np.subtract(eye, target) / np.linalg.norm(np.subtract(eye, target))
+    worst = int(np.flatnonzero(quads == place.worst)[0]) if place.worst in quads else 0
+    light = fold_light(triangle_normals(corners[worst:worst + 1])[0], toward_eye) if len(quads) else toward_eye
+    normals = surface_normals(drawn.frame.attrs, drawn.frame.face)
+    image = shade_fold(normals, drawn.frame.face >= 0, light, BACKGROUND)
+    draw_diagonals(image, sub_face, corners[:, [0, 2]], np.searchsorted(view.drawn, quads), drawn.camera.matrix)
+    return image
+
+
 def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_tolerance: float,
             texture: str | None = None) -> Closeup:
     """Draw one place (see the module docstring); ``texture`` is ``--texture``, overriding map_Kd."""
@@ -266,6 +297,9 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
         label = f"lines of constant u (blue) and v (red) {LINE_SPACING:g} pixels apart" + (
             f", and an upright F every {GLYPH_SPACING:g} pixels in uv: where it reads mirrored, so is the texture"
             if glyphs else "") + _unused_map_kd(mesh)
+    elif show == "fold":
+        label = ("the surface shaded by its own normals, lit across the fold, with the split's diagonal (corners "
+                 "0 to 2) in blue: the split draws two flat triangles meeting at it, exact the curved patch")
     else:
         label = {"color": "vertex colours", "normal": "normals as RGB", "shaded": "shading"}[show]
     framed = ("the place's faces and their neighbours" if len(framed_faces) > 1
@@ -277,12 +311,16 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
         # With the line pattern, the render's own texture is replaced pixel by pixel: a 1-texel one costs nothing.
         options = RenderOptions(method=method, show=show, width=size, height=size, camera=view.camera, up=view.up,
                                 texture=PLAIN if lines else image_file, pixel_tolerance=pixel_tolerance)
-        drawn = render_mesh(sub, options)
+        if show == "fold":  # the positions ride through the rasterizer as colours (scaled alike on every axis)
+            options = replace(options, show="color", texture=None)
+        drawn = render_mesh(positions_as_colours(sub) if show == "fold" else sub, options)
         image = drawn.image.copy()
         face = drawn.frame.face
         covered = face >= 0
         sub_face = np.where(covered, drawn.faces[np.maximum(face, 0)], -1)
         own = covered & in_place[np.maximum(sub_face, 0)]
+        if show == "fold":
+            image = _fold_picture(mesh, place, view, drawn, sub_face)
         edge = outline(own)
         if lines:  # at the place's scale: the split's footprint on the place's pixels, for every panel
             footprint = footprint or pixel_footprint(drawn.frame.attrs, own)
@@ -295,7 +333,7 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
         image[edge] = OVERLAY_TINT
         result.images[method] = image
         frames[method] = (drawn.frame, sub_face)
-    if show != "shaded" and {"split", "exact"} <= frames.keys():
+    if show in SHOW_FOR.values() and {"split", "exact"} <= frames.keys():
         (split, split_face), (exact, exact_face) = frames["split"], frames["exact"]
         covered = (split_face >= 0) & (split_face == exact_face)
         attribute = next(name for name, shown in SHOW_FOR.items() if shown == show)
