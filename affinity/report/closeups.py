@@ -275,6 +275,7 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
     from ..draw.texture import (
         GLYPH_SPACING,
         LINE_SPACING,
+        glyph_footprints,
         line_colours,
         load_image,
         local_footprints,
@@ -289,14 +290,15 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
     show = _show_for(mesh, place.code)
     image_file = texture or _map_kd(mesh)
     lines = show == "uv" and not image_file
-    glyphs = lines and RULES[place.code].mirroring
+    mirroring = lines and RULES[place.code].mirroring
+    glyphs = None  # the glyphs' footprint per coordinate, measured on the split's place
     footprint = None
     if show == "uv" and image_file:
         label = f"texture {os.path.basename(image_file)}" + ("" if texture else " (map_Kd)")
     elif lines:
         label = f"lines of constant u (blue) and v (red) {LINE_SPACING:g} pixels apart" + (
             f", and an upright F every {GLYPH_SPACING:g} pixels in uv: where it reads mirrored, so is the texture"
-            if glyphs else "") + _unused_map_kd(mesh)
+            if mirroring else "") + _unused_map_kd(mesh)
     elif show == "fold":
         label = ("the surface shaded by its own normals, lit across the fold, with the split's diagonal (corners "
                  "0 to 2) in blue: the split draws two flat triangles meeting at it, exact the curved patch")
@@ -324,6 +326,8 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
         edge = outline(own)
         if lines:  # at the place's scale: the split's footprint on the place's pixels, for every panel
             footprint = footprint or pixel_footprint(drawn.frame.attrs, own)
+            if mirroring and glyphs is None:
+                glyphs = glyph_footprints(drawn.frame.attrs, own, footprint)
             image[covered] = line_colours(drawn.frame.attrs[covered], footprint,
                                           local_footprints(drawn.frame.attrs)[covered], glyphs)
         if method == "split":
