@@ -9,6 +9,7 @@ Texture coordinates follow OpenGL: ``(0, 0)`` is the bottom-left of the image,
 from __future__ import annotations
 
 import functools
+import weakref
 
 import numpy as np
 
@@ -61,6 +62,23 @@ def mip_levels(image: np.ndarray) -> list[np.ndarray]:
 LOD_BIAS = 0.5
 
 
+#: Pyramids of read-only textures (the cached checker, say), by id, with a weak reference that proves the id's
+#: array is still the one the pyramid was built from: building one costs a 1024-texel checker 0.17 s.
+_PYRAMIDS: dict[int, tuple] = {}
+
+
+def _pyramid(image: np.ndarray) -> list[np.ndarray]:
+    """:func:`mip_levels` of ``image``, built once for a read-only array, every time for a writeable one."""
+    if image.flags.writeable:
+        return mip_levels(image)
+    known = _PYRAMIDS.get(id(image))
+    if known is None or known[0]() is not image:
+        if len(_PYRAMIDS) >= 4:
+            _PYRAMIDS.clear()
+        known = _PYRAMIDS[id(image)] = (weakref.ref(image), mip_levels(image))
+    return known[1]
+
+
 def sample_mipmapped(image: np.ndarray, uv: np.ndarray, footprint: np.ndarray) -> np.ndarray:
     """Trilinear texture filtering: bilinear in the two mip levels around each pixel's level of detail, blended.
 
@@ -86,7 +104,7 @@ def sample_mipmapped(image: np.ndarray, uv: np.ndarray, footprint: np.ndarray) -
         detail = np.maximum(np.log2(texels) + LOD_BIAS, 0.0)
     if not (detail > 0).any():
         return sample_bilinear(image, uv)
-    levels = mip_levels(image)
+    levels = _pyramid(image)
     detail = np.minimum(detail, len(levels) - 1)
     below = np.floor(detail).astype(np.int64)
     blend = (detail - below).astype(np.float32)[:, None]
@@ -104,10 +122,24 @@ class TextureError(Exception):
 
 
 def load_image(path: str) -> np.ndarray:
-    """Read an image file as (H, W, 3) float32 RGB in [0, 1]: decoded by the core
-    (:func:`affinity.textures.decode.decode`: once per run, never over the pixel budget).
+    """Read an image file as (H, W, 3) float32 RGB in [0, 1], read-only: decoded by the core
+    (:func:`affinity.textures.decode.decode`: once per run, never over the pixel budget), and kept for the
+    file's size and modification time, so the renders of one report share it and its mip pyramid.
 
     Raises :class:`TextureError` naming the file and why it is not used."""
+    import os
+
+    try:
+        status = os.stat(path)
+        stamp = (status.st_mtime_ns, status.st_size)
+    except OSError:
+        stamp = None
+    return _load_rgb(os.fspath(path), stamp)
+
+
+@functools.lru_cache(maxsize=4)
+def _load_rgb(path: str, stamp: tuple | None) -> np.ndarray:
+    """:func:`load_image` of ``path`` as it was at ``stamp`` (modification time and size)."""
     from ..loaders.regular import NOT_READ
     from ..textures.decode import TextureUnusable, decode
 
@@ -121,7 +153,9 @@ def load_image(path: str) -> np.ndarray:
             reason = f"not a readable image ({reason})"
         raise TextureError(f"{path}: {reason}") from None
     grey_or_colour = pixels[..., :3] if pixels.shape[2] >= 3 else np.repeat(pixels[..., :1], 3, axis=2)
-    return grey_or_colour.astype(np.float32) / 255.0
+    image = grey_or_colour.astype(np.float32) / 255.0
+    image.flags.writeable = False
+    return image
 
 
 #: Lines of the close-up pattern are this many pixels apart on screen, and this many pixels wide.
