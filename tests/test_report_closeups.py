@@ -631,3 +631,60 @@ def test_uv_layout_labels_crowded_at_the_bottom_stay_inside_the_picture(tmp_path
     assert len(baselines) == 5 and svg.count("<circle") == 5
     assert 12 <= baselines[0] and baselines[-1] <= 640 - 3  # none below the picture's edge
     assert min(np.diff(baselines)) >= 15  # stacked a line apart: they overlap horizontally
+
+
+def test_a_colour_crease_below_one_8_bit_step_gets_no_amplified_panel_and_a_line_saying_why(tmp_path):
+    """One corner 0.3/255 lighter: the split's largest change is a fraction of that (the bilinear crease of one
+    corner's offset peaks at a quarter of it), which the PNG rounds away; a gain of thousands would paint its
+    float noise. Flagged at a threshold of 0.01/255, the close-up leaves the panel out and its caption says why."""
+    from affinity.report.build import ReportOptions, collect_mesh
+    from affinity.report.demo import MeshInput
+    from affinity.report.sections import closeups_section
+    from affinity.settings import Settings
+
+    colors = np.full((4, 3), 0.5)
+    colors[2] += 0.3 / 255
+    square = mesh_from_polygons("tiny", [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], [[0, 1, 2, 3]], colors=colors)
+    write_obj(square, tmp_path / "tiny.obj")
+    settings = Settings(select=["Q102"], thresholds={"Q102": 0.01})
+    result = collect_mesh(MeshInput(str(tmp_path / "tiny.obj"), "tiny.obj"), settings,
+                          options=ReportOptions(max_views=1))
+    (view,) = result.closeups
+    assert view.place.code == "Q102"
+    assert np.abs(view.images["split"] - view.images["exact"])[view.covered & view.own].max() < 1 / 255
+    assert view.amplified is None and view.gain == 1.0
+    assert "below one 8-bit step" in view.amplified_note
+    (figure,) = closeups_section(result).data["figures"]
+    assert figure["amplified"] is None and figure["amplified_note"] == view.amplified_note
+
+
+def _best_overlap(image: np.ndarray, reference: np.ndarray) -> float:
+    """The largest normalised cross-correlation of two (H, W) bool masks over every circular shift (FFT)."""
+    a, b = image - image.mean(), reference - reference.mean()
+    correlation = np.fft.ifft2(np.fft.fft2(a) * np.conj(np.fft.fft2(b))).real
+    return float(correlation.max() / np.sqrt((a**2).sum() * (b**2).sum()))
+
+
+def test_a_mirrored_closeup_s_glyphs_are_the_unflipped_reference_s_mirrored_on_screen():
+    """The same 8 x 8 grid drawn twice from the same close-up camera (the camera depends on positions only):
+    once with its uv, once with u mirrored (1 - u, every quad Q302). The glyph ink of the mirrored one matches
+    the reference's ink mirrored left-right on screen (best over shifts: the glyph cells' phase differs) far
+    better than the reference as it is (a symmetric glyph would match both alike)."""
+    from affinity.draw.texture import GLYPH_INK
+    from affinity.report.closeups import closeup
+    from affinity.report.places import Place
+    from affinity.settings import Settings
+
+    upright = grid_mesh(8)
+    uv = upright.texcoords.copy()
+    uv[:, 0] = 1 - uv[:, 0]
+    mirrored = replace_uv(upright, uv)
+    place = Place("Q302", np.array([27]), np.array([1.0]), 27, 1.0, 1.0, "warning")
+    ink = {}
+    for name, mesh in (("upright", replace_uv(upright, upright.texcoords)), ("mirrored", mirrored)):
+        view = closeup(mesh, place, Settings(), 240, 0.5)
+        ink[name] = (np.abs(view.images["exact"] - GLYPH_INK).max(axis=-1) < 0.08).astype(float)
+        assert ink[name].mean() > 0.05  # big glyphs: a good share of the panel is ink
+    as_mirror = _best_overlap(ink["mirrored"], ink["upright"][:, ::-1])
+    as_is = _best_overlap(ink["mirrored"], ink["upright"])
+    assert as_mirror > 0.55 and as_mirror > 1.2 * as_is, (as_mirror, as_is)  # measured 0.62 against 0.47

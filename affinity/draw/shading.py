@@ -80,7 +80,8 @@ def shade(attrs: np.ndarray, covered: np.ndarray, inputs: ShadingInputs, show: s
           texture: np.ndarray | None, light: np.ndarray) -> np.ndarray:
     """Colour every covered pixel from its interpolated attributes.
 
-    ``uv`` shows the texture, ``color`` the vertex colours, ``normal`` the unit
+    ``uv`` shows the texture (trilinear mip-mapped by each pixel's footprint, so minified patterns do not alias
+    into moire: :func:`affinity.draw.texture.sample_mipmapped`), ``color`` the vertex colours, ``normal`` the unit
     normal as RGB, ``shaded`` the texture (or grey without uv) lit by a
     two-sided Lambert term.
 
@@ -96,13 +97,14 @@ def shade(attrs: np.ndarray, covered: np.ndarray, inputs: ShadingInputs, show: s
     -------
     (H, W, 3) float32 RGB in [0, 1], background where not covered.
     """
-    from .texture import sample_bilinear
+    from .texture import local_footprints, sample_mipmapped
 
     values = attrs[covered]
     if show == "color":
         colour = values[:, inputs.color]
     elif inputs.uv is not None:
-        colour = sample_bilinear(texture, values[:, inputs.uv])
+        footprint = local_footprints(attrs[..., inputs.uv])[covered]
+        colour = sample_mipmapped(texture, values[:, inputs.uv], footprint)
     else:
         colour = np.full((len(values), 3), 0.8)
     if show in ("normal", "shaded"):

@@ -14,7 +14,7 @@ mirrored on the mirrored faces, which a symmetric pattern cannot show.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -50,6 +50,9 @@ AMPLIFIED = ("color", "normal")
 COLOUR_REACH = 0.5
 UV_REACH = 3.0
 GAIN_STEPS = (1, 2, 5)
+#: A colour or normal crease whose largest change on the place is below this (of 1) is under one 8-bit step: the
+#: PNGs round it away, and amplified they show rounding noise, so the close-up has no amplified panel and says why.
+EIGHT_BIT_STEP = 1 / 255
 
 
 @dataclass
@@ -63,7 +66,8 @@ class Closeup:
     view : the :class:`affinity.draw.closeup.CloseupView` drawn (camera, up, drawn faces)
     seen : (K,) int64, the mesh faces covering at least ``SEEN_PIXELS`` pixels of the split picture
     amplified : (S, S, 3) float, the split with its difference from exact (colours, normals) or its uv error
-        times ``gain``, where that is faint (a gain above 1), else None; ``amplified_label`` says which
+        times ``gain``, where that is faint (a gain above 1), else None; ``amplified_label`` says which, and
+        ``amplified_note`` why there is none where the difference is below one 8-bit step (``EIGHT_BIT_STEP``)
     dropped : why the close-up is not shown (its place covers too few pixels from every side), else None
     """
 
@@ -81,6 +85,7 @@ class Closeup:
     amplified: np.ndarray | None = None
     gain: float = 1.0
     amplified_label: str = ""
+    amplified_note: str = ""
     seen: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
 
     @property
@@ -90,6 +95,8 @@ class Closeup:
 
 
 def _show_for(mesh: Mesh, code: str) -> str:
+    if RULES[code].folding:
+        return "fold"
     attribute = RULES[code].attribute if RULES[code].scored else None
     if attribute is not None:
         return SHOW_FOR[attribute]
@@ -114,11 +121,19 @@ def _amplified(split: np.ndarray, exact: np.ndarray, same: np.ndarray, unit: np.
     :func:`gain_for` of the largest finite change in ``unit`` (a scalar, or (S, S, K) with NaN where unknown)
     on the place's pixels ``place`` (S, S) bool that ``same`` keeps (all of ``same``'s when none or None)."""
     error = np.where(same[..., None], split - exact, 0.0)
+    gain = gain_for(largest_change(split, exact, same, place, unit), reach)
+    return exact + gain * error, gain
+
+
+def largest_change(split: np.ndarray, exact: np.ndarray, same: np.ndarray, place: np.ndarray | None,
+                   unit: np.ndarray | float = 1.0) -> float:
+    """The largest finite ``|split - exact|`` (S, S, K) in ``unit`` (a scalar, or (S, S, K) with NaN where
+    unknown) on the place's pixels ``place`` (S, S) bool that ``same`` (S, S) bool keeps (all of ``same``'s
+    when none or None); 0 where there are none."""
     keep = same if place is None or not (same & place).any() else same & place
     with np.errstate(invalid="ignore", divide="ignore"):
-        change = (np.abs(error) / unit)[keep]
-    gain = gain_for(float(change[np.isfinite(change)].max(initial=0.0)), reach)
-    return exact + gain * error, gain
+        change = (np.abs(split - exact) / unit)[keep]
+    return float(change[np.isfinite(change)].max(initial=0.0))
 
 
 def amplified_difference(split: np.ndarray, exact: np.ndarray, same: np.ndarray,
@@ -220,6 +235,35 @@ def _framed_view(mesh: Mesh, place: Place):
     return near, worst
 
 
+def positions_as_colours(mesh: Mesh) -> Mesh:
+    """``mesh`` with its positions, moved and scaled alike on every axis into [0, 1], as its vertex colours: the
+    rasterizer then interpolates the surface point of every pixel (flat on a split triangle, on the bilinear
+    patch for exact), and a uniform scale keeps the directions of its normals."""
+    used = mesh.positions[np.unique(mesh.corner_vertex)]
+    low, extent = used.min(axis=0), float(np.ptp(used, axis=0).max())
+    return replace(mesh, colors=np.clip((mesh.positions - low) / (extent if extent > 0 else 1.0), 0.0, 1.0))
+
+
+def _fold_picture(mesh: Mesh, place: Place, view, drawn, sub_face: np.ndarray) -> np.ndarray:
+    """(S, S, 3) float32: the fold close-up of ``drawn`` (a render of :func:`positions_as_colours`), shaded by
+    its surface's normals, lit across the worst face's fold (:func:`affinity.draw.fold.fold_light`), with the
+    split diagonal of each of the place's quads drawn (``sub_face`` (S, S) int: the face of ``view.drawn``)."""
+    from ..draw.closeup import face_vertices
+    from ..draw.fold import draw_diagonals, fold_light, shade_fold, surface_normals, triangle_normals
+    from ..draw.shading import BACKGROUND
+
+    quads = place.faces[mesh.face_sizes[place.faces] == 4]
+    corners = mesh.positions[face_vertices(mesh, quads)[0]].reshape(-1, 4, 3)
+    eye, target, _ = view.camera
+    toward_eye = np.subtract(eye, target) / np.linalg.norm(np.subtract(eye, target))
+    worst = int(np.flatnonzero(quads == place.worst)[0]) if place.worst in quads else 0
+    light = fold_light(triangle_normals(corners[worst:worst + 1])[0], toward_eye) if len(quads) else toward_eye
+    normals = surface_normals(drawn.frame.attrs, drawn.frame.face)
+    image = shade_fold(normals, drawn.frame.face >= 0, light, BACKGROUND)
+    draw_diagonals(image, sub_face, corners[:, [0, 2]], np.searchsorted(view.drawn, quads), drawn.camera.matrix)
+    return image
+
+
 def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_tolerance: float,
             texture: str | None = None) -> Closeup:
     """Draw one place (see the module docstring); ``texture`` is ``--texture``, overriding map_Kd."""
@@ -231,6 +275,7 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
     from ..draw.texture import (
         GLYPH_SPACING,
         LINE_SPACING,
+        glyph_footprints,
         line_colours,
         load_image,
         local_footprints,
@@ -245,14 +290,18 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
     show = _show_for(mesh, place.code)
     image_file = texture or _map_kd(mesh)
     lines = show == "uv" and not image_file
-    glyphs = lines and RULES[place.code].mirroring
+    mirroring = lines and RULES[place.code].mirroring
+    glyphs = None  # the glyphs' footprint per coordinate, measured on the split's place
     footprint = None
     if show == "uv" and image_file:
         label = f"texture {os.path.basename(image_file)}" + ("" if texture else " (map_Kd)")
     elif lines:
         label = f"lines of constant u (blue) and v (red) {LINE_SPACING:g} pixels apart" + (
             f", and an upright F every {GLYPH_SPACING:g} pixels in uv: where it reads mirrored, so is the texture"
-            if glyphs else "") + _unused_map_kd(mesh)
+            if mirroring else "") + _unused_map_kd(mesh)
+    elif show == "fold":
+        label = ("the surface shaded by its own normals, lit across the fold, with the split's diagonal (corners "
+                 "0 to 2) in blue: the split draws two flat triangles meeting at it, exact the curved patch")
     else:
         label = {"color": "vertex colours", "normal": "normals as RGB", "shaded": "shading"}[show]
     framed = ("the place's faces and their neighbours" if len(framed_faces) > 1
@@ -264,15 +313,21 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
         # With the line pattern, the render's own texture is replaced pixel by pixel: a 1-texel one costs nothing.
         options = RenderOptions(method=method, show=show, width=size, height=size, camera=view.camera, up=view.up,
                                 texture=PLAIN if lines else image_file, pixel_tolerance=pixel_tolerance)
-        drawn = render_mesh(sub, options)
+        if show == "fold":  # the positions ride through the rasterizer as colours (scaled alike on every axis)
+            options = replace(options, show="color", texture=None)
+        drawn = render_mesh(positions_as_colours(sub) if show == "fold" else sub, options)
         image = drawn.image.copy()
         face = drawn.frame.face
         covered = face >= 0
         sub_face = np.where(covered, drawn.faces[np.maximum(face, 0)], -1)
         own = covered & in_place[np.maximum(sub_face, 0)]
+        if show == "fold":
+            image = _fold_picture(mesh, place, view, drawn, sub_face)
         edge = outline(own)
         if lines:  # at the place's scale: the split's footprint on the place's pixels, for every panel
             footprint = footprint or pixel_footprint(drawn.frame.attrs, own)
+            if mirroring and glyphs is None:
+                glyphs = glyph_footprints(drawn.frame.attrs, own, footprint)
             image[covered] = line_colours(drawn.frame.attrs[covered], footprint,
                                           local_footprints(drawn.frame.attrs)[covered], glyphs)
         if method == "split":
@@ -282,7 +337,7 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
         image[edge] = OVERLAY_TINT
         result.images[method] = image
         frames[method] = (drawn.frame, sub_face)
-    if show != "shaded" and {"split", "exact"} <= frames.keys():
+    if show in SHOW_FOR.values() and {"split", "exact"} <= frames.keys():
         (split, split_face), (exact, exact_face) = frames["split"], frames["exact"]
         covered = (split_face >= 0) & (split_face == exact_face)
         attribute = next(name for name, shown in SHOW_FOR.items() if shown == show)
@@ -294,6 +349,12 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
         if show in AMPLIFIED:
             amplified, gain = amplified_difference(plain["split"], plain["exact"], covered, result.own)
             what = "its difference from exact"
+            change = largest_change(plain["split"], plain["exact"], covered, result.own)
+            if gain > 1 and change < EIGHT_BIT_STEP:
+                result.amplified_note = (f"No amplified panel: split and exact differ by at most "
+                                         f"{change * 255:.2g}/255 on the place, below one 8-bit step, so "
+                                         "amplified it would show rounding noise.")
+                gain = 1.0
         else:  # uv: the split's texture moved by gain times its error, drawn as the panels are
             local = local_footprints(exact.attrs)
             uv, gain = amplified_uv(split.attrs, exact.attrs, covered, local, result.own)

@@ -410,7 +410,8 @@ def closeups_section(result: MeshResult) -> Section:
         amplified = (None if view.amplified is None
                      else {"src": image_uri(view.amplified), "label": view.amplified_label})
         figures.append({
-            "amplified": amplified, "face": place.worst, "code": place.code, "name": rule.name, "level": place.level,
+            "amplified": amplified, "amplified_note": view.amplified_note,
+            "face": place.worst, "code": place.code, "name": rule.name, "level": place.level,
             "value": _place_value_text(result, place, unit), "faces": len(place.faces),
             "line": int(mesh.face_line[place.worst]), "group": mesh.group_names[mesh.face_group[place.worst]],
             "texture": view.texture, "framed": view.framed, "error": error,

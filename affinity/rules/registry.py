@@ -62,6 +62,8 @@ class Rule:
         changes them (Q101's dimensionless barycentric score)
     mirroring : a finding is a texture mirrored against the surface: its report close-up draws an
         asymmetric glyph in texture space (a symmetric pattern looks the same mirrored)
+    folding : a finding is the split folding along its diagonal: its report close-up draws the shaded surface,
+        lit across the fold, with the diagonal (texture lines are affine on either triangle and show no fold)
     scope : ``"quad"``: ``check(quads) -> (rows, values)`` over a batch of quads
         (``affinity.lint.QuadBatch``; ``rows`` index the batch, a slice for all);
         ``"mesh"``: ``check(mesh, settings) -> (faces, lines, values)`` or None
@@ -85,6 +87,7 @@ class Rule:
     attribute: str | None = None
     scored: bool = False
     mirroring: bool = False
+    folding: bool = False
     readings: Mapping[str, tuple[str, float]] = field(default_factory=dict)
     scope: str = "quad"
     check: Callable | None = None

@@ -96,7 +96,8 @@ def fold_degrees(quads: PlanarQuads, diagonal: str) -> np.ndarray:
     return np.maximum(fold02, fold13, out=fold02)
 
 
-@rule(code="Q202", name="nonplanar-quad", unit="degrees", default_threshold=45.0, references=REFERENCES)
+@rule(code="Q202", name="nonplanar-quad", unit="degrees", default_threshold=45.0, folding=True,
+      references=REFERENCES)
 def nonplanar(quads) -> tuple:
     """The split folds: the two triangles meet at an angle along the diagonal.
 
