@@ -106,13 +106,15 @@ _OBJ_KEYWORDS = frozenset(
 _LONG_LINE = re.compile(rb"[ \t]*(?:#|(?:fo?|l|p|g|curv2?|surf|parm|trim|hole|scrv|sp|con)[ \t])")
 
 
-def load_obj(path, chunk_bytes: int | None = None, source: bytes | None = None) -> Mesh:
+def load_obj(path, chunk_bytes: int | None = None, source: bytes | None = None, fast: bool = True) -> Mesh:
     """Read a Wavefront OBJ file (and the texture maps of its ``mtllib`` files, ``Mesh.resources``).
 
     ``chunk_bytes`` (default :data:`~affinity.loaders.text.CHUNK_BYTES`) is how
     much is parsed at a time; the mesh does not depend on it. ``source`` is the
     file's bytes when the caller has read them already (the check hashes them
     for its cache and scans them for inline ignores: one read of the file).
+    ``fast=False`` reads every chunk on the general path, token by token: the mesh, and the
+    error of a bad file, are the same (a test compares the two paths).
     """
     from concurrent.futures import ThreadPoolExecutor  # here, not at import: off a cached check's path
 
@@ -125,7 +127,7 @@ def load_obj(path, chunk_bytes: int | None = None, source: bytes | None = None) 
                              long_line=_LONG_LINE)
         try:
             for chunk in chunks:
-                pending.append(pool.submit(_parse_chunk, chunk, path))
+                pending.append(pool.submit(_parse_chunk, chunk, path, fast))
                 if len(pending) > 2 * _WORKERS:  # bound the chunks held in memory
                     assembly.add(assembly.result(pending.pop(0)))
         except NotText as error:  # the lines before the bad bytes speak first; then its line is known
@@ -138,8 +140,8 @@ def load_obj(path, chunk_bytes: int | None = None, source: bytes | None = None) 
     return assembly.mesh(path, obj_resources(os.fspath(path), source) if assembly.mtllib else [])
 
 
-def _parse_chunk(chunk, path) -> _Part:
-    part = _alike_part(chunk)
+def _parse_chunk(chunk, path, fast: bool) -> _Part:
+    part = _alike_part(chunk) if fast else None
     if part is not None:
         return part
     tokens = tokenize(chunk, path, slash=True)
@@ -147,11 +149,11 @@ def _parse_chunk(chunk, path) -> _Part:
     kind = _line_kinds(tokens, counts)
     element_lines = {k: np.flatnonzero(kind == k) for k in _WIDTHS}
     nan_colors = []
-    elements = {k: _elements(tokens, path, lines, k, nan_colors) for k, lines in element_lines.items()}
+    elements = {k: _elements(tokens, path, lines, k, nan_colors, fast) for k, lines in element_lines.items()}
     _check_colors(tokens, path, element_lines[_V], elements[_V])
     elements = {k: rows.T for k, rows in elements.items()}  # by component, as the column reader gives them
     face_lines = np.flatnonzero(kind == _F)
-    sizes, corners, relative, bounds, face_slashes = _faces(tokens, path, kind, face_lines)
+    sizes, corners, relative, bounds, face_slashes = _faces(tokens, path, kind, face_lines, fast)
     if tokens.slashes != face_slashes:
         # Some '/' is not where a face layout puts one; when every one is, none
         # can touch a number of a v/vt/vn line and the lines need no look.
@@ -422,7 +424,7 @@ def _token_block(tokens: Tokens, lines, width: int, previous: bool = False):
     return block + (tokens.ends[index - 1],) if previous else block
 
 
-def _elements(tokens: Tokens, path, lines, which, nan_colors: list) -> np.ndarray:
+def _elements(tokens: Tokens, path, lines, which, nan_colors: list, fast: bool) -> np.ndarray:
     """(n, width) float64 numbers of the ``which`` lines, NaN where a line has fewer.
 
     NaN colours (``v x y z r g b`` lines) are kept and counted in ``nan_colors``
@@ -431,7 +433,7 @@ def _elements(tokens: Tokens, path, lines, which, nan_colors: list) -> np.ndarra
     if len(lines) == 0:
         return np.zeros((0, _WIDTHS[which][0]))
     counts = tokens.counts[lines]
-    if counts.min() == counts.max() and _ALLOWED[which][min(counts[0] - 1, _MAX_WIDTH)]:
+    if fast and counts.min() == counts.max() and _ALLOWED[which][min(counts[0] - 1, _MAX_WIDTH)]:
         width = int(counts[0]) - 1  # one width: a (lines, numbers) block
         starts, ends = _token_block(tokens, lines, width)
         rows, bad = parse_floats(tokens.buf, starts, ends, finite=True)
@@ -543,7 +545,7 @@ def _slash_count(layout) -> int:
     return sum(int(np.count_nonzero(layout & bit)) for bit in counted)
 
 
-def _faces(tokens: Tokens, path, kind, face_lines):
+def _faces(tokens: Tokens, path, kind, face_lines, fast: bool):
     """Corner structure of the chunk's ``f`` lines.
 
     Returns ``sizes`` ((F,) int64, or an int when all faces have that size),
@@ -554,7 +556,7 @@ def _faces(tokens: Tokens, path, kind, face_lines):
         return 0, [None] * 3, [None] * 3, [None] * 3, 0
     counts = tokens.counts[face_lines]
     width = int(counts[0]) - 1
-    if width > 0 and counts.min() == counts.max():
+    if fast and width > 0 and counts.min() == counts.max():
         start, end, previous_end = _token_block(tokens, face_lines, width, previous=True)
         if _laid_out_alike(tokens.buf, start, end, previous_end):
             layout = _face_layout(tokens.buf, start[0], end[0], previous_end[0])
