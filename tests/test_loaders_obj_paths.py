@@ -55,6 +55,7 @@ BAD_TEXTS += [text for text, _, _ in BAD_OTHER_LINE]
 #: Faces laid out alike, each wrong in a way the corner validator checks, after one that is
 #: wrong in another: the error names the same line on both paths.
 BAD_TEXTS += [
+    SQUARE + "f 1 2\nf 0 2\n",  # fewer than 3 corners, then index 0: once two errors on two lines
     SQUARE + "f 1 2 3\nf 1 0 3\n",
     SQUARE + "f 1 2 3\nf 1 2 9\n",
     SQUARE + "f 1 2 -9\nf 1 2 3\n",  # relative index before the first vertex
