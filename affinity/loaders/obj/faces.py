@@ -227,10 +227,10 @@ def _block_faces(tokens: Tokens, path, kind, face_lines):
             picked = values[:, columns[0] :: step][:, : len(columns)] - 1
         else:
             picked = values[:, columns] - 1
-        if picked.min() == -1:  # an index 0, not seen in the first line
-            return None
         corners[which], relative[which], bounds[which] = _slot_corners(kind, face_lines, face_start,
                                                                        picked.reshape(-1), element)
+        if bounds[which][0] == -1:  # an index 0 (no corner lacks the slot here), not seen in the first line
+            return None
     return size, corners, relative, bounds, _slash_count(layout) * len(face_lines)
 
 
