@@ -16,7 +16,7 @@ from helpers.generated_obj import FIELDS
 from test_loaders_bad_input import BAD_FIFTH_LINE, BAD_OTHER_LINE, SQUARE
 
 from affinity.errors import MeshError
-from affinity.loaders.obj import load_obj
+from affinity.loaders.obj import faces, load_obj
 
 DATA = Path(__file__).parent / "data" / "loaders"
 #: Mutated OBJ files compared (the fuzzer's own mutations of its OBJ seeds).
@@ -93,3 +93,31 @@ def test_fuzzed_files_read_or_fail_alike_on_both_paths(tmp_path):
         path.write_bytes(data)
         outcomes.append(assert_same_outcome(path, chunk_bytes=None if k % 3 else 4096))
     assert 0 < outcomes.count("error") < len(outcomes), "the mutations reach both outcomes"
+
+
+#: Face lines wrong in each of the validator's checks: (the wrong face line, words of the error).
+FACE_ERRORS = [("f 1 0 2", "bad index '0'"), ("f 1 2 x", "bad index 'x'"), ("f 1/1/1/1 2 3", "malformed"),
+               ("f 1 2", "face with 2 corners"), ("f 1/1 2/1 3", "mix the forms")]
+
+
+@pytest.mark.parametrize("fast", [True, False], ids=["fast", "general"])
+@pytest.mark.parametrize("face, words", FACE_ERRORS)
+def test_both_paths_raise_face_errors_through_the_one_validator(tmp_path, monkeypatch, fast, face, words):
+    """Whichever path reads the faces, the error is the one :func:`checked_corners` raised."""
+    raised = []
+    real = faces.checked_corners
+
+    def spied(*args):
+        try:
+            return real(*args)
+        except MeshError as error:
+            raised.append((error.line, error.reason))
+            raise
+
+    monkeypatch.setattr(faces, "checked_corners", spied)
+    path = tmp_path / "bad_face.obj"
+    path.write_text(SQUARE + "vt 0 0\n" + "f 1 2 3\n" * 3 + face + "\n" + "f 2 3 4\n" * 3)
+    with pytest.raises(MeshError) as caught:
+        load_obj(path, fast=fast)
+    assert words in caught.value.reason and caught.value.line == 9
+    assert raised[-1] == (9, caught.value.reason)

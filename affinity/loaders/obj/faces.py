@@ -160,14 +160,13 @@ def checked_corners(tokens: Tokens, path, index, values, bad, layout, line_token
 
 
 def count_back(index: np.ndarray, back: np.ndarray, defined) -> tuple[int, int]:
-    """The one fix-up of relative (negative) OBJ indices: ``index[back] += defined``, in place.
+    """The one fix-up of relative (negative) OBJ indices, in place: ``index[back] += defined``.
 
-    index : (C,) int64 0-based corner indices; a relative index ``-n`` is read as ``-n - 1``
-    and becomes ``defined - n`` once ``defined`` ((len(back),) int64, or an int) counts the
-    elements of its kind defined before the corner, the first included (``1 +`` the count
-    before, as the chunk counts them, then the elements before the chunk at assembly).
-    Returns (min, max) of the fixed indices; a negative one still counts back past what is
-    known so far.
+    index : (C,) int64. A relative index ``-n`` is stored as ``-n - 1`` (as every index, minus
+    one) and names element ``count - n``, ``count`` the elements of its kind defined above its
+    line: the chunk adds ``1 +`` the count within the chunk ((len(back),) int64), the assembly
+    the count before the chunk (an int). Returns (min, max) of ``index[back]``: a negative one
+    counts back past the elements known so far.
     """
     index[back] += defined
     return int(index[back].min()), int(index[back].max())
