@@ -30,7 +30,7 @@ class Mesh:
         Offsets of each face's corners into the corner arrays; ``face_start[0] == 0``.
     corner_vertex : (C,) int64
         0-based index into ``positions`` for every corner.
-    face_line : (F,) int64
+    face_line : (F,) int32 or int64
         1-based source line of every face; 0 where the format has no lines (binary PLY, USD).
     texcoords : (T, 2) float64 or None
     corner_texcoord : (C,) int64 or None
@@ -44,9 +44,10 @@ class Mesh:
     group_names : list of str
         Group/object names; ``face_group`` indexes into it. In a USD stage, one
         group per mesh prim, named by its prim path.
-    face_group : (F,) int32
+    face_group : (F,) int8, int16 or int32
+        The narrowest that holds the index (an OBJ file's faces; other loaders give int32).
     material_names : list of str
-    face_material : (F,) int32
+    face_material : (F,) int8, int16 or int32
         Index into ``material_names``, -1 for faces without ``usemtl``.
     material_textures : dict of str to str
         Material name to its ``map_Kd`` path (resolved against the .mtl file's folder).

@@ -133,7 +133,10 @@ def snap_triangles(tri, orientation, width, height):
         edge_c=dy[pick] * SUB,
         row0=row0[kept],
         row1=row1[kept],
-        size=(0.5 / SUB**2) * np.abs(area[kept]) + (col1 - col0 + 1)[kept],
+        # The area counts what lies off the image too (a triangle reaching into the guard band, a corner just
+        # behind the eye): no more than the image rows and columns it spans are covered.
+        size=np.minimum((0.5 / SUB**2) * np.abs(area[kept]) + (col1 - col0 + 1)[kept],
+                        ((row1 - row0 + 1) * (col1 - col0 + 1))[kept]),
     )
     return triangles, kept
 

@@ -83,7 +83,8 @@ def cli_json(path: Path, *args: str) -> dict:
 
 
 def by_code_and_face(rows) -> dict[tuple[str, int], float]:
-    return {(r["code"], r["face"]): r["value"] for r in rows}
+    """Each finding's texel shift: Q101's value, or its ``shift`` where the visible reading read C."""
+    return {(r["code"], r["face"]): r.get("shift", r["value"]) for r in rows}
 
 
 def test_uv_sphere_gives_the_same_findings_as_its_obj_export_checked_by_the_cli(tmp_path):
@@ -98,9 +99,11 @@ def test_uv_sphere_gives_the_same_findings_as_its_obj_export_checked_by_the_cli(
     in_memory = by_code_and_face(rows)
     document = cli_json(exported)
     assert set(document["findings"][0]) <= set(rows[0])  # every key of a JSON finding, and more
-    assert {rows[0]["unit"], rows[0]["group"]} == {"texels", sphere.name}
-    # Severity by visibility: an error above the documented 2 texels, a warning between 0.5 and 2, as the CLI says.
-    assert all(r["level"] == ("error" if r["value"] > 2.0 else "warning") for r in rows)
+    # The checker beside the export decodes on both sides: Q101 is read through it (C, design.md's visible
+    # reading), the texel shift kept as "shift", and the levels are C's, as the CLI says.
+    assert rows[0]["group"] == sphere.name
+    assert {r["unit"] for r in rows} == {f["unit"] for f in document["findings"]}
+    assert {r["unit"] for r in rows} == {"1/255"} and all("shift" in r for r in rows)
     assert ({(r["face"], r["level"]) for r in rows}
             == {(f["face"], f["level"]) for f in document["findings"]})
     on_file = by_code_and_face(document["findings"])
@@ -120,7 +123,9 @@ def test_texel_unit_follows_the_base_color_image(tmp_path):
     sphere = uv_sphere()
     at_default = {r["face"]: r["value"] for r in findings(sphere, select=["Q101"], thresholds={"Q101": 0})}
     textured(sphere, tmp_path / "checker.png", size=(256, 256))
-    at_256 = {r["face"]: r["value"] for r in findings(sphere, select=["Q101"], thresholds={"Q101": 0})}
+    # Through the image Q101's value is the visible reading; the texel shift it measures is kept as "shift".
+    at_256 = {r["face"]: r.get("shift", r["value"]) for r in findings(sphere, select=["Q101"],
+                                                                       thresholds={"Q101": 0})}
     assert at_default.keys() == at_256.keys()
     faces = sorted(at_default)
     np.testing.assert_allclose([at_256[f] for f in faces], [at_default[f] / 4 for f in faces], rtol=1e-9)

@@ -14,11 +14,12 @@ import json
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
-from helpers.cli import SQUARE, write
+from helpers.cli import SQUARE, TRAPEZOID, write
 
-from affinity.errors import MeshError
+from affinity.errors import MeshError, SkippedFile
 from affinity.loaders import load, text
 from affinity.loaders.regular import RefusedFile, open_regular, read_regular
 
@@ -274,6 +275,23 @@ def test_a_bad_file_in_a_folder_is_one_q901_and_the_others_are_checked(tmp_path)
     assert [(os.path.basename(f["path"]), f["code"]) for f in document["findings"]] == [("trapezoid.obj", "Q101")]
 
 
+@pytest.mark.parametrize("cached", [False, True], ids=["no-cache", "cache"])
+def test_a_fifo_or_device_in_a_folder_is_one_q901_naming_it_and_the_others_are_checked(tmp_path, cached):
+    fifo = special(tmp_path, "pipe.obj", "fifo")
+    device = special(tmp_path, "zero.ply", "device")
+    special(tmp_path, "notes.txt", "fifo")  # not a mesh name: the walk passes it by, as it does a regular .txt
+    write(tmp_path, "trapezoid.obj", TRAPEZOID)
+    result = run("check", "--format", "json", *([] if cached else ["--no-cache"]), str(tmp_path),
+                 cache=tmp_path.parent / "cache" if cached else None)
+    assert result.returncode == 2
+    assert result.stderr.splitlines() == [f"{fifo}:0: Q901 unreadable: {WORDS['fifo']}: not read",
+                                          f"{device}:0: Q901 unreadable: {WORDS['device']}: not read"]
+    document = json.loads(result.stdout)
+    assert sorted(os.path.basename(entry["path"]) for entry in document["files"]) == [
+        "pipe.obj", "trapezoid.obj", "zero.ply"]
+    assert [(os.path.basename(f["path"]), f["code"]) for f in document["findings"]] == [("trapezoid.obj", "Q101")]
+
+
 # -- odd but valid: read as they are ---------------------------------------------------------------
 
 
@@ -296,6 +314,19 @@ def test_one_triangle_faces_and_a_face_of_one_repeated_index(tmp_path):
     assert [(f["code"], f["face"], f["line"]) for f in document["findings"]] == [("Q201", faces, faces + 4)]
 
 
+@pytest.mark.parametrize("names", [127, 128, 40_000])
+def test_group_and_material_tables_hold_every_name_past_a_narrow_type(tmp_path, names):
+    # The tables take the narrowest integer type that holds the names (int8 to 127, then int16, int32):
+    # face k is in group k and material k, and a face before any usemtl has none (-1).
+    faces = "".join(f"g part{k}\nusemtl m{k}\nf 1 2 3\n" for k in range(names))
+    mesh = load(write(tmp_path, "named.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n" + faces))
+    assert mesh.group_names == ["", *(f"part{k}" for k in range(names))]
+    assert mesh.material_names == [f"m{k}" for k in range(names)]
+    assert mesh.face_group.tolist() == list(range(names + 1))
+    assert mesh.face_material.tolist() == list(range(-1, names))
+    assert mesh.face_line.tolist() == [4, *range(7, 3 * names + 5, 3)]
+
+
 @requires_usd
 def test_usd_stage_of_many_empty_prims_is_skipped_and_nested_references_are_read(tmp_path):
     empty = write(tmp_path, "empty.usda", "#usda 1.0\n" + "".join(f'def Xform "p{k}" {{\n}}\n' for k in range(2000)))
@@ -309,6 +340,110 @@ def test_usd_stage_of_many_empty_prims_is_skipped_and_nested_references_are_read
     result = run("check", "--no-cache", "--format", "json", str(tmp_path / "level0.usda"))
     assert result.returncode == 0, result.stderr
     assert json.loads(result.stdout)["files"][0]["quads"] == 1
+
+
+# -- a USD stage without a mesh: skipped from its layers' specs, not composed ---------------------
+
+XFORM_USDA = '#usda 1.0\ndef Xform "top" {\n}\n'
+VARIANT_USDA = """#usda 1.0
+def Xform "top" (
+    variants = {{
+        string look = "{selected}"
+    }}
+    prepend variantSets = "look"
+)
+{{
+    variantSet "look" = {{
+        "bare" {{
+            def Scope "nothing" {{
+            }}
+        }}
+        "{meshed}" {{
+            def Mesh "quad" {{
+                int[] faceVertexCounts = [4]
+                int[] faceVertexIndices = [0, 1, 2, 3]
+                point3f[] points = [(0,0,0), (1,0,0), (1,1,0), (0,1,0)]
+            }}
+        }}
+    }}
+}}
+"""
+
+
+def usd_stages(folder) -> dict[str, object]:
+    """Stages whose meshes hide behind every kind of composition arc, and stages without a mesh."""
+    from pxr import Sdf
+
+    write(folder, "quad.usda", QUAD_USDA)
+    write(folder, "no-mesh.usda", '#usda 1.0\ndef Scope "looks" {\n    def Material "wood" {\n    }\n}\n')
+    arcs = {"sublayer": '#usda 1.0\n(\n    subLayers = [@./{layer}@]\n)\n',
+            "reference": '#usda 1.0\ndef Xform "top" (\n    references = @./{layer}@</quad>\n)\n{{\n}}\n',
+            "payload": '#usda 1.0\ndef Xform "top" (\n    payload = @./{layer}@</quad>\n)\n{{\n}}\n'}
+    stages = {f"{arc} to a mesh": write(folder, f"{arc}.usda", text.format(layer="quad.usda"))
+              for arc, text in arcs.items()}
+    stages |= {f"{arc} to no mesh": write(folder, f"{arc}-none.usda", text.format(layer="no-mesh.usda"))
+               for arc, text in arcs.items()}
+    stages["mesh in the selected variant"] = write(folder, "variant.usda", VARIANT_USDA.format(
+        selected="meshed", meshed="meshed"))
+    stages["mesh in a variant not selected"] = write(folder, "variant-off.usda", VARIANT_USDA.format(
+        selected="bare", meshed="meshed"))
+    write(folder, "variant-layer.usda", VARIANT_USDA.format(selected="meshed", meshed="meshed"))
+    stages["reference to a variant's mesh"] = write(folder, "variant-reference.usda", arcs["reference"].format(
+        layer="variant-layer.usda").replace("</quad>", "</top>"))
+    stages["a mesh class inherited"] = write(folder, "inherits.usda", (
+        '#usda 1.0\nclass Mesh "proto" {\n}\ndef "thing" (\n    inherits = </proto>\n)\n{\n'
+        '    int[] faceVertexCounts = [4]\n    int[] faceVertexIndices = [0, 1, 2, 3]\n'
+        '    point3f[] points = [(0,0,0), (1,0,0), (1,1,0), (0,1,0)]\n}\n'))
+    stages["a type usd-core does not know"] = write(folder, "unknown.usda", '#usda 1.0\ndef Gizmo "g" {\n}\n')
+    stages["a missing reference"] = write(folder, "missing.usda", arcs["reference"].format(layer="gone.usda"))
+    stages["empty prims"] = write(folder, "empty.usda", "#usda 1.0\n" + "".join(
+        f'def Xform "p{k}" {{\n}}\n' for k in range(200)))
+    Sdf.Layer.FindOrOpen(str(stages["empty prims"])).Export(str(folder / "empty.usdc"))
+    stages["empty prims, crate"] = folder / "empty.usdc"
+    stages["the test fixture"] = Path(__file__).parent / "data" / "usd" / "scene.usda"
+    return stages
+
+
+USD_STAGES = ["sublayer to a mesh", "reference to a mesh", "payload to a mesh", "sublayer to no mesh",
+              "reference to no mesh", "payload to no mesh", "mesh in the selected variant",
+              "mesh in a variant not selected", "reference to a variant's mesh", "a mesh class inherited",
+              "a type usd-core does not know", "a missing reference", "empty prims", "empty prims, crate",
+              "the test fixture"]
+
+
+@requires_usd
+@pytest.mark.parametrize("case", USD_STAGES)
+def test_a_stage_is_skipped_as_no_mesh_exactly_when_its_composition_has_no_drawn_mesh(tmp_path, case):
+    from pxr import Usd, UsdGeom
+
+    stage_path = usd_stages(tmp_path)[case]
+    composed = Usd.Stage.Open(str(stage_path), Usd.Stage.LoadAll)  # the truth: usd-core composing it all
+    drawn = [UsdGeom.Imageable(prim) for prim in Usd.PrimRange.Stage(composed, Usd.TraverseInstanceProxies())
+             if prim.IsA(UsdGeom.Mesh)]
+    meshes = [str(prim.GetPath()) for prim in drawn
+              if prim.ComputeVisibility() != "invisible" and prim.ComputePurpose() not in ("guide", "proxy")]
+    try:
+        mesh = load(stage_path)
+    except SkippedFile as skipped:
+        assert skipped.reason == "no-mesh" and meshes == []
+    else:
+        assert mesh.group_names == meshes != []
+
+
+@requires_usd
+@pytest.mark.parametrize("case", ["empty prims", "empty prims, crate", "sublayer to no mesh",
+                                  "reference to no mesh", "payload to no mesh"])
+def test_a_stage_without_a_mesh_spec_is_skipped_without_composing_it(tmp_path, case, monkeypatch):
+    from pxr import Usd
+
+    stage_path = usd_stages(tmp_path)[case]
+
+    def no_composing(*args, **kwargs):
+        raise AssertionError("the stage was composed")
+
+    monkeypatch.setattr(Usd.Stage, "Open", no_composing)
+    with pytest.raises(SkippedFile, match=r"skipped \(no-mesh\)"):
+        load(stage_path)
 
 
 @pytest.mark.skipif(importlib.util.find_spec("pyvista") is None, reason="needs the view extra (pyvista)")

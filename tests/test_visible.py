@@ -17,8 +17,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers.corpus import SHARED_MESHES
 
-TEXTURED = Path(__file__).resolve().parents[2] / "shared" / "meshes" / "textured"
+TEXTURED = SHARED_MESHES / "textured"
 SPOT = TEXTURED / "spot_control_mesh_textured.obj"
 #: Reference samples per texel of a quad's uv extent, per side (at most REFERENCE_CAP per side).
 REFERENCE_PER_TEXEL, REFERENCE_CAP = 3, 320

@@ -60,14 +60,15 @@ def asset_paths(path: str) -> list[str]:
     return [absolute for _, absolute in layer_assets(path)]
 
 
-def regular_layers(path) -> list:
+def regular_layers(path) -> tuple[list, bool]:
     """Every layer the stage at ``path`` composes (its sublayers, references and payloads, and
-    theirs), opened with Sdf after a look at what each is: MeshError naming a layer that is a FIFO,
-    socket or device, which pxr would read without end or wait on forever. A layer that is missing
-    or cannot be opened is left to the stage to report."""
+    theirs), opened with Sdf after a look at what each is, and whether that is all of them: False when
+    a layer is missing or could not be opened (a packaged or resolver path, say), which is left to the
+    stage to report. MeshError naming a layer that is a FIFO, socket or device, which pxr would read
+    without end or wait on forever."""
     from pxr import Sdf, Tf
 
-    layers, todo, seen = [], [os.fspath(path)], set()  # the root as the stage names it: opened once
+    layers, todo, seen, complete = [], [os.fspath(path)], set(), True  # the root as the stage names it: opened once
     while todo:
         layer_path = todo.pop()
         if layer_path in seen:
@@ -75,18 +76,40 @@ def regular_layers(path) -> list:
         seen.add(layer_path)
         try:
             reason = not_regular(os.stat(layer_path).st_mode)
-        except (OSError, ValueError):  # missing, or a packaged or resolver path: the stage's to say
+        except (OSError, ValueError):
+            complete = False
             continue
         if reason is not None:
             raise MeshError(path, 0, f"the layer {layer_path} {reason}")
         try:
             layer = Sdf.Layer.FindOrOpen(layer_path)
         except Tf.ErrorException:
+            layer = None
+        if layer is None:
+            complete = False
             continue
-        if layer is not None:
-            layers.append(layer)
-            todo += [layer.ComputeAbsolutePath(asset) for asset in layer.GetCompositionAssetDependencies()]
-    return layers
+        layers.append(layer)
+        todo += [layer.ComputeAbsolutePath(asset) for asset in layer.GetCompositionAssetDependencies()]
+    return layers, complete
+
+
+def prim_type_names(layer) -> set[str]:
+    """The type names of the prim specs of one Sdf ``layer``, those inside variants included (a
+    variant can define a mesh), without composing anything: one look at each spec's path, O(specs)."""
+    spec_paths = []
+    layer.Traverse(layer.pseudoRoot.path, spec_paths.append)  # a builtin callback: no Python frame per spec
+    prim_at = layer.GetPrimAtPath
+    return {prim_at(spec_path).typeName for spec_path in spec_paths if spec_path.IsPrimPath()} - {""}
+
+
+def may_hold_mesh(type_names: set[str]) -> bool:
+    """Whether a prim of one of ``type_names`` may compose to a ``UsdGeom.Mesh``: a Mesh, a type derived
+    from it, or a type usd-core does not know (a plug-in's schema, or one with ``fallbackPrimTypes``)."""
+    from pxr import Usd, UsdGeom
+
+    mesh = UsdGeom.Mesh._GetStaticTfType()
+    types = (Usd.SchemaRegistry.GetTypeFromSchemaTypeName(name) for name in type_names)
+    return any(schema.isUnknown or schema.IsA(mesh) for schema in types)
 
 
 def geometry_source(prim, time) -> tuple[str, str] | None:

@@ -17,6 +17,7 @@ pre-commit hook names every changed file), the default names do not.
 from __future__ import annotations
 
 import os
+import stat
 from collections.abc import Callable
 from pathlib import Path
 
@@ -89,6 +90,16 @@ def _excluded(settings: Settings, path: str, top: str) -> bool:
             or any(glob_matches(pattern, below) for pattern in settings.default_exclude))
 
 
+def _to_check(path: str) -> bool:
+    """Whether the walk hands ``path`` to the check: a regular file, or a FIFO, socket or device (the
+    loader refuses those with one Q901 line naming them, as when they are named on the command line);
+    not a broken link or a directory."""
+    try:
+        return not stat.S_ISDIR(os.stat(path).st_mode)
+    except (OSError, ValueError):
+        return False
+
+
 def walk(top: str, settings_of: Callable[[str], Settings]) -> list[str]:
     """The mesh files under ``top``, sorted, with excluded folders, environments and git-ignored paths left out.
 
@@ -109,7 +120,7 @@ def walk(top: str, settings_of: Callable[[str], Settings]) -> list[str]:
         dirs[:] = kept
         for name in sorted(files):
             path = str(Path(folder, name))
-            if (os.path.splitext(name)[1].lower() in MESH_SUFFIXES and os.path.isfile(path)
+            if (os.path.splitext(name)[1].lower() in MESH_SUFFIXES and _to_check(path)
                     and not _excluded(settings, path, top) and not rules.ignores(path, False)):
                 found.append(path)
     return sorted(found)
