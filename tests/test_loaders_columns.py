@@ -14,8 +14,7 @@ import numpy as np
 import pytest
 
 from affinity.errors import MeshError
-from affinity.loaders import obj
-from affinity.loaders.obj import load_obj
+from affinity.loaders.obj import alike, load_obj
 
 CHUNK_SIZES = (None, 4096, 300, 61)
 FORMS = {"v": (0,), "v/vt": (0, 1), "v//vn": (0, 2), "v/vt/vn": (0, 1, 2)}
@@ -85,7 +84,7 @@ def _assert_matches(mesh, truth: dict) -> None:
 
 
 def _token_reader_only(monkeypatch) -> None:
-    monkeypatch.setattr(obj, "_alike_part", lambda chunk: None)
+    monkeypatch.setattr(alike, "alike_part", lambda chunk: None)
 
 
 @pytest.mark.parametrize("seed", range(12))
@@ -94,14 +93,14 @@ def test_column_path_matches_python_and_the_token_reader(tmp_path, monkeypatch, 
     path = tmp_path / "alike.obj"
     path.write_bytes(text.encode())
     taken = []
-    real = obj._alike_part
+    real = alike.alike_part
 
     def spied(chunk):  # on the worker threads: return this chunk's part, not whichever was appended last
         part = real(chunk)
         taken.append(part)
         return part
 
-    monkeypatch.setattr(obj, "_alike_part", spied)
+    monkeypatch.setattr(alike, "alike_part", spied)
     meshes = [load_obj(path, chunk_bytes=size) for size in CHUNK_SIZES]
     assert any(part is not None for part in taken), "the column path was never taken"
     _token_reader_only(monkeypatch)

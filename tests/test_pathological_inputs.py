@@ -213,10 +213,10 @@ def test_text_without_line_breaks_stops_the_read_in_the_first_long_line():
 def test_a_face_without_end_stops_at_the_line_cap(monkeypatch):
     monkeypatch.setattr(text, "MAX_LINE_BYTES", 1 << 20)
     endless = Endless(b" 1 2 3", prefix=b"f")
-    from affinity.loaders.obj import _LONG_LINE
+    from affinity.loaders.obj.scan import LONG_LINE
 
     with pytest.raises(MeshError, match=r"a line longer than 1 MiB at offset 0: not a text mesh"):
-        list(text.read_chunks(endless, "face.obj", size=1 << 12, long_line=_LONG_LINE))
+        list(text.read_chunks(endless, "face.obj", size=1 << 12, long_line=LONG_LINE))
     assert endless.read < 4 << 20  # the blocks double: the line cap and at most as much again
 
 

@@ -191,6 +191,9 @@ def named_files(path: str, data=None) -> list[str]:
         from .usdmaterials import mtlx_document_maps
 
         return tile_files(texture_map.path for texture_map in mtlx_document_maps(path, every=True))
-    from .usd import USD_SUFFIXES, asset_paths, texture_asset_paths
+    from .formats import format_named
+    from .usdlayers import asset_paths, texture_asset_paths
 
-    return [*asset_paths(path), *tile_files(texture_asset_paths(path))] if suffix in USD_SUFFIXES else []
+    if suffix not in format_named("usd").suffixes:
+        return []
+    return [*asset_paths(path), *tile_files(texture_asset_paths(path))]
