@@ -237,11 +237,11 @@ def columns(report: FileReport, hits: RuleHits, take: np.ndarray) -> Columns:
     group = names[np.where((groups >= 0) & (groups < len(report.group_names)), groups, -1)].tolist()
     visible = None if hits.visible is None else _visible_fields(hits, take, report.path)
     remarks = [None] * len(take) if visible is None else [read.pop("remark", None) for read in visible]
-    if hits.details is None and visible is None:
-        message = [rule.summary] * len(take)
-    else:
-        details = [None] * len(take) if hits.details is None else [hits.details[i] for i in take.tolist()]
-        message = [": ".join(filter(None, [rule.summary, remark, detail])) for remark, detail in zip(remarks, details)]
+    message = [rule.summary] * len(take)
+    details = None if hits.details is None else list(map(hits.details.__getitem__, take.tolist()))
+    # Remarks are few (a note on one finding, causes on some): only the rows that have one are joined.
+    for row in _remarked(details) | _remarked(remarks):
+        message[row] = ": ".join(filter(None, [rule.summary, remarks[row], None if details is None else details[row]]))
     prim = [g if f >= 0 else None for g, f in zip(group, hits.faces[take].tolist())] if usd else [None] * len(take)
     shared = _shared_geometry(report, hits.code, prim, faces.tolist()) if usd and report.shared else None
     return Columns(
@@ -252,6 +252,13 @@ def columns(report: FileReport, hits: RuleHits, take: np.ndarray) -> Columns:
         value=hits.values[take].tolist(), level=hits.levels()[take].tolist(), group=group, message=message, prim=prim,
         shared=shared, visible=visible if visible is not None and any(visible) else None,
     )
+
+
+def _remarked(remarks: list | None) -> set[int]:
+    """The rows of ``remarks`` that are not None."""
+    if remarks is None or remarks.count(None) == len(remarks):
+        return set()
+    return {row for row, remark in enumerate(remarks) if remark is not None}
 
 
 def _shared_geometry(report: FileReport, code: str, prims: list[str | None],
