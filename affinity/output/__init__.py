@@ -502,11 +502,10 @@ def face_label(f: Finding) -> str:
 def text_lines(c: Columns) -> list[str]:
     """The ruff-style lines ``path:line:col: CODE level name: message (value vs threshold unit) [face F]``
     (design.md); ``path:prim:face N: CODE level ...`` in USD; no ``[face]`` for file-level findings."""
+    lines = face_lines(c)
+    if lines is not None:
+        return lines
     path, code, name = printable(c.path), c.code, c.name
-    if c.unit and c.visible is None and c.prim[0] is None and min(c.face, default=0) >= 0:  # measured mesh faces
-        unit, against = _measured(c)
-        return [f"{path}:{line}:{column}: {code} {level} {name}: {m} ({v:.4g}{unit}{against}) [face {face}]"
-                for line, column, face, level, m, v in zip(c.line, c.column, c.face, c.level, c.message, c.value)]
     described = descriptions(c)
     where = [""] * len(c) if c.shared is None else [authored_where(s) for s in c.shared]
     return [
@@ -515,6 +514,30 @@ def text_lines(c: Columns) -> list[str]:
         for line, column, face, level, prim, text, also in zip(c.line, c.column, c.face, c.level, c.prim, described,
                                                               where)
     ]
+
+
+def face_lines(c: Columns, escape=str) -> list[str] | None:
+    """The text lines of measured findings on mesh faces, their texts (path, name, unit, messages) passed
+    through ``escape`` (XML for JUnit); None for findings whose lines take another shape (read through a
+    texture, in USD, file-level, without a unit). The numbers are converted a column at a time."""
+    if not (c.unit and c.visible is None and c.prim[0] is None and min(c.face, default=0) >= 0):
+        return None
+    unit, against = _measured(c)
+    path, code, name, measured = escape(printable(c.path)), c.code, escape(c.name), escape(unit + against)
+    escaped = {message: escape(message) for message in set(c.message)}
+    return [f"{path}:{line}:{column}: {code} {level} {name}: {escaped[message]} ({value}{measured}) [face {face}]"
+            for line, column, level, message, value, face in zip(
+                int_texts(c.line), int_texts(c.column), c.level, c.message, general_texts(c.value), int_texts(c.face))]
+
+
+def int_texts(numbers: list[int]) -> list[str]:
+    """(n,) ``str`` of each int, converted in one call (a list's text, split)."""
+    return str(numbers)[1:-1].split(", ") if numbers else []
+
+
+def general_texts(values: list[float]) -> list[str]:
+    """(n,) each value as :func:`format_value` writes it (``%.4g``), converted in one call."""
+    return ("%.4g," * len(values) % tuple(values)).split(",")[:-1]
 
 
 def authored_where(shared: dict | None) -> str:
