@@ -17,6 +17,7 @@ import importlib
 import os
 from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -190,6 +191,12 @@ class Columns:
 
     def __len__(self) -> int:
         return len(self.face)
+
+    @cached_property
+    def number_texts(self) -> tuple[list[str], list[str], list[str]]:
+        """``line``, ``column`` and ``face`` as text, (n,) str each, converted a column at a time (once for the
+        formats that write a number twice)."""
+        return int_texts(self.line), int_texts(self.column), int_texts(self.face)
 
     @property
     def plain(self) -> bool:
@@ -527,11 +534,13 @@ def face_lines(c: Columns, escape=str) -> list[str] | None:
     escaped = {message: escape(message) for message in set(c.message)}
     return [f"{path}:{line}:{column}: {code} {level} {name}: {escaped[message]} ({value}{measured}) [face {face}]"
             for line, column, level, message, value, face in zip(
-                int_texts(c.line), int_texts(c.column), c.level, c.message, general_texts(c.value), int_texts(c.face))]
+                *c.number_texts[:2], c.level, c.message, general_texts(c.value), c.number_texts[2])]
 
 
 def int_texts(numbers: list[int]) -> list[str]:
     """(n,) ``str`` of each int, converted in one call (a list's text, split)."""
+    if numbers and numbers.count(numbers[0]) == len(numbers):  # one number (a column of 1s): one conversion
+        return [str(numbers[0])] * len(numbers)
     return str(numbers)[1:-1].split(", ") if numbers else []
 
 

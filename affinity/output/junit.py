@@ -24,7 +24,7 @@ from typing import TextIO
 
 from ..findings import FileReport
 from ..rules import LEVELS, RULES, UNREADABLE
-from . import CheckRun, Columns, Selection, face_lines, int_texts, statistics, text_lines
+from . import CheckRun, Columns, Selection, face_lines, statistics, text_lines
 
 # Characters XML 1.0 cannot carry at all (control characters, lone surrogates from undecodable file names).
 _NOT_XML = re.compile("[^\t\n\r\x20-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
@@ -67,7 +67,7 @@ def _finding_cases(fail_on: str):
             fails = {level: level in failing for level in LEVELS}
             return [f'{case}{face}" file="{path}" line="{line}">{failure}{t}</failure></testcase>\n' if fails[level]
                     else f'{case}{face}" file="{path}" line="{line}"><system-out>{t}</system-out></testcase>\n'
-                    for face, line, level, t in zip(int_texts(c.face), int_texts(c.line), c.level, lines)]
+                    for face, line, level, t in zip(c.number_texts[2], c.number_texts[0], c.level, lines)]
         lines = text_lines(c)
         if _needs_escaping(c):  # numbers never do: only the path, messages, groups and prims can
             lines = list(map(xml_text, lines))
