@@ -63,10 +63,11 @@ def _finding_cases(fail_on: str):
         failure = f'<failure type="{xml_attribute(c.code)}" message="{rule}: {xml_attribute(RULES[c.code].summary)}">'
         lines = face_lines(c, xml_text)
         if lines is not None:  # measured faces of a mesh file: one shape for every case
-            case = f'<testcase classname="{path}" name="{rule} face '
-            fails = {level: level in failing for level in LEVELS}
-            return [f'{case}{face}" file="{path}" line="{line}">{failure}{t}</failure></testcase>\n' if fails[level]
-                    else f'{case}{face}" file="{path}" line="{line}"><system-out>{t}</system-out></testcase>\n'
+            case, where = f'<testcase classname="{path}" name="{rule} face ', f'" file="{path}" line="'
+            opens = {level: f'">{failure}' if level in failing else '"><system-out>' for level in LEVELS}
+            closes = {level: "</failure></testcase>\n" if level in failing else "</system-out></testcase>\n"
+                      for level in LEVELS}
+            return [f"{case}{face}{where}{line}{opens[level]}{t}{closes[level]}"
                     for face, line, level, t in zip(c.number_texts[2], c.number_texts[0], c.level, lines)]
         lines = text_lines(c)
         if _needs_escaping(c):  # numbers never do: only the path, messages, groups and prims can
