@@ -299,7 +299,7 @@ def lint_mesh(mesh: Mesh, settings: Settings, visible: bool = True) -> list[Rule
             taken = [r.code for r in scored if r.attribute in CAUSE_MASKS.get(rule.code, ())]
             found = RuleHits(rule.code, faces, mesh.face_line[faces], values,
                              0.0 if threshold is None else float(threshold), mesh.face_group[faces],
-                             details=_texel_details(settings, rule, faces, grid)
+                             details=_texel_details(settings, rule, faces, values, grid)
                              or _cause_details(rule.code, breaks, taken))
             if reads_textures and rule.code == "Q101":
                 if preparing is not None:
@@ -381,17 +381,19 @@ def _cause_details(code: str, breaks: np.ndarray, taken: list[str]) -> list | No
     return np.where(breaks, detail, None).tolist()
 
 
-def _texel_details(settings: Settings, rule, faces: np.ndarray, grid) -> list | None:
-    """For a rule read in texels: the note on the first finding (``faces`` (n,) in file order) of a quad
-    whose texture size was assumed (``grid``, :func:`quad_texel_grid`), None elsewhere; None altogether when
-    every size is known."""
+def _texel_details(settings: Settings, rule, faces: np.ndarray, values: np.ndarray, grid) -> list | None:
+    """For a rule read in texels: the note on the worst finding (``faces``, ``values`` (n,), in file order)
+    of a quad whose texture size was assumed (``grid``, :func:`quad_texel_grid`), None elsewhere; None
+    altogether when every size is known. The worst, because every output shows it first (text and the
+    capped formats order by severity) and keeps it under any cap or ``--level``."""
     if rule.unit_for(settings.measure) != "texels" or grid is None:
         return None
     assumed = np.flatnonzero(grid.assumed[faces])
     if not len(assumed):
         return None
+    badness = values[assumed] if rule.worst == "lowest" else -values[assumed]
     details = [None] * len(faces)
-    details[assumed[0]] = assumed_texture_note(settings.texture_size)
+    details[assumed[np.lexsort((faces[assumed], badness))[0]]] = assumed_texture_note(settings.texture_size)
     return details
 
 

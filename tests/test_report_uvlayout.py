@@ -68,3 +68,54 @@ def test_place_faces_caps_every_closeup_and_no_two_share_a_face(tmp_path):
         places = [set(map(int, found.split(","))) for found in re.findall(r'data-place="([^"]*)"', html.read_text())]
         assert len(places) >= 2 and all(len(place) <= most for place in places)
         assert sum(map(len, places)) == len(set().union(*places))  # no face in two close-ups
+
+
+def test_the_layout_marks_only_the_faces_the_uv_rules_flag(tmp_path):
+    """Three quads apart in uv: a trapezoid with square uv (Q101), a square with affine uv and a colour saddle
+    (Q102: fixed in the colours, not in the UV editor) and a clean square. In the report's picture, read back
+    from its PNG, only the Q101 face is in the flag colour; the colour-flagged face looks like the clean one."""
+    import base64
+    import io
+    import json
+    import re
+    import subprocess
+    import sys
+
+    from PIL import Image
+
+    corners = [[(-1, 0), (1, 0), (0.15, 1), (-0.15, 1)], [(3, 0), (5, 0), (5, 2), (3, 2)],
+               [(6, 0), (8, 0), (8, 2), (6, 2)]]
+    uv_squares = [(0.05, 0.3), (0.4, 0.6), (0.7, 0.9)]
+    colours = [["0.5 0.5 0.5"] * 4, ["1 0 0", "0 0 0", "1 0 0", "0 0 0"], ["0.5 0.5 0.5"] * 4]
+    lines = []
+    for k, (quad, (lo, hi), rgb) in enumerate(zip(corners, uv_squares, colours)):
+        lines += [f"v {x} {y} 0 {c}" for (x, y), c in zip(quad, rgb)]
+        lines += [f"vt {u} {v}" for u, v in [(lo, lo), (hi, lo), (hi, hi), (lo, hi)]]
+        lines.append("f " + " ".join(f"{4 * k + i}/{4 * k + i}" for i in range(1, 5)))
+    path = tmp_path / "three.obj"
+    path.write_text("\n".join(lines) + "\n")
+
+    def cli(*args):
+        return subprocess.run([sys.executable, "-m", "affinity.cli", *args], capture_output=True, text=True,
+                              timeout=300, cwd=tmp_path)
+
+    findings = json.loads(cli("check", "--format", "json", str(path)).stdout)["findings"]
+    faces = {code: {f["face"] for f in findings if f["code"] == code} for code in ("Q101", "Q102")}
+    assert faces == {"Q101": {0}, "Q102": {1}}, "the fixture flags what it says"
+    done = cli("report", "-q", str(path), "-o", str(tmp_path / "report.html"))
+    assert done.returncode == 0, done.stderr
+    figure = re.search(r'<figure data-view="uv-layout".*?</figure>', (tmp_path / "report.html").read_text(), re.S)
+    size = int(re.search(r'<svg class="uv-layout"[^>]* width="(\d+)"', figure[0])[1])
+    encoded = re.search(r'<image href="data:image/png;base64,([^"]+)"', figure[0])[1]
+    picture = np.asarray(Image.open(io.BytesIO(base64.b64decode(encoded))).convert("RGB"), dtype=int)
+    assert picture.shape == (size, size, 3)
+
+    def pixel(u, v):  # the uv square [0, 1]^2 fills the picture, v up
+        return picture[int((1 - v) * size), int(u * size)]
+
+    uv_flagged, colour_flagged, clean, empty = pixel(0.12, 0.12), pixel(0.45, 0.45), pixel(0.75, 0.75), pixel(
+        0.95, 0.05)
+    assert (colour_flagged == clean).all(), "a colour finding does not mark the face in texture space"
+    assert (clean != empty).any(), "the clean face is drawn"
+    red, green, blue = uv_flagged
+    assert red > green + 40 and blue > green + 40, f"the Q101 face is in the flag colour (magenta): {uv_flagged}"

@@ -17,6 +17,7 @@ import importlib
 import os
 from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -191,6 +192,12 @@ class Columns:
     def __len__(self) -> int:
         return len(self.face)
 
+    @cached_property
+    def number_texts(self) -> tuple[list[str], list[str], list[str]]:
+        """``line``, ``column`` and ``face`` as text, (n,) str each, converted a column at a time (once for the
+        formats that write a number twice)."""
+        return int_texts(self.line), int_texts(self.column), int_texts(self.face)
+
     @property
     def plain(self) -> bool:
         """Whether every finding has the shared unit and threshold and no USD sharing (the fast formats' case)."""
@@ -237,11 +244,11 @@ def columns(report: FileReport, hits: RuleHits, take: np.ndarray) -> Columns:
     group = names[np.where((groups >= 0) & (groups < len(report.group_names)), groups, -1)].tolist()
     visible = None if hits.visible is None else _visible_fields(hits, take, report.path)
     remarks = [None] * len(take) if visible is None else [read.pop("remark", None) for read in visible]
-    if hits.details is None and visible is None:
-        message = [rule.summary] * len(take)
-    else:
-        details = [None] * len(take) if hits.details is None else [hits.details[i] for i in take.tolist()]
-        message = [": ".join(filter(None, [rule.summary, remark, detail])) for remark, detail in zip(remarks, details)]
+    message = [rule.summary] * len(take)
+    details = None if hits.details is None else list(map(hits.details.__getitem__, take.tolist()))
+    # Remarks are few (a note on one finding, causes on some): only the rows that have one are joined.
+    for row in _remarked(details) | _remarked(remarks):
+        message[row] = ": ".join(filter(None, [rule.summary, remarks[row], None if details is None else details[row]]))
     prim = [g if f >= 0 else None for g, f in zip(group, hits.faces[take].tolist())] if usd else [None] * len(take)
     shared = _shared_geometry(report, hits.code, prim, faces.tolist()) if usd and report.shared else None
     return Columns(
@@ -252,6 +259,13 @@ def columns(report: FileReport, hits: RuleHits, take: np.ndarray) -> Columns:
         value=hits.values[take].tolist(), level=hits.levels()[take].tolist(), group=group, message=message, prim=prim,
         shared=shared, visible=visible if visible is not None and any(visible) else None,
     )
+
+
+def _remarked(remarks: list | None) -> set[int]:
+    """The rows of ``remarks`` that are not None."""
+    if remarks is None or remarks.count(None) == len(remarks):
+        return set()
+    return {row for row, remark in enumerate(remarks) if remark is not None}
 
 
 def _shared_geometry(report: FileReport, code: str, prims: list[str | None],
@@ -495,11 +509,10 @@ def face_label(f: Finding) -> str:
 def text_lines(c: Columns) -> list[str]:
     """The ruff-style lines ``path:line:col: CODE level name: message (value vs threshold unit) [face F]``
     (design.md); ``path:prim:face N: CODE level ...`` in USD; no ``[face]`` for file-level findings."""
+    lines = face_lines(c)
+    if lines is not None:
+        return lines
     path, code, name = printable(c.path), c.code, c.name
-    if c.unit and c.visible is None and c.prim[0] is None and min(c.face, default=0) >= 0:  # measured mesh faces
-        unit, against = _measured(c)
-        return [f"{path}:{line}:{column}: {code} {level} {name}: {m} ({v:.4g}{unit}{against}) [face {face}]"
-                for line, column, face, level, m, v in zip(c.line, c.column, c.face, c.level, c.message, c.value)]
     described = descriptions(c)
     where = [""] * len(c) if c.shared is None else [authored_where(s) for s in c.shared]
     return [
@@ -508,6 +521,32 @@ def text_lines(c: Columns) -> list[str]:
         for line, column, face, level, prim, text, also in zip(c.line, c.column, c.face, c.level, c.prim, described,
                                                               where)
     ]
+
+
+def face_lines(c: Columns, escape=str) -> list[str] | None:
+    """The text lines of measured findings on mesh faces, their texts (path, name, unit, messages) passed
+    through ``escape`` (XML for JUnit); None for findings whose lines take another shape (read through a
+    texture, in USD, file-level, without a unit). The numbers are converted a column at a time."""
+    if not (c.unit and c.visible is None and c.prim[0] is None and min(c.face, default=0) >= 0):
+        return None
+    unit, against = _measured(c)
+    path, code, name, measured = escape(printable(c.path)), c.code, escape(c.name), escape(unit + against)
+    escaped = {message: escape(message) for message in set(c.message)}
+    return [f"{path}:{line}:{column}: {code} {level} {name}: {escaped[message]} ({value}{measured}) [face {face}]"
+            for line, column, level, message, value, face in zip(
+                *c.number_texts[:2], c.level, c.message, general_texts(c.value), c.number_texts[2])]
+
+
+def int_texts(numbers: list[int]) -> list[str]:
+    """(n,) ``str`` of each int, converted in one call (a list's text, split)."""
+    if numbers and numbers.count(numbers[0]) == len(numbers):  # one number (a column of 1s): one conversion
+        return [str(numbers[0])] * len(numbers)
+    return str(numbers)[1:-1].split(", ") if numbers else []
+
+
+def general_texts(values: list[float]) -> list[str]:
+    """(n,) each value as :func:`format_value` writes it (``%.4g``), converted in one call."""
+    return ("%.4g," * len(values) % tuple(values)).split(",")[:-1]
 
 
 def authored_where(shared: dict | None) -> str:

@@ -82,25 +82,39 @@ def _finding_rows(settings):
         if not c.plain:  # geometry several prims reference, values read through a texture: whole findings
             extra = {} if (measure := settings.measure_of(c.code)) is None else {"measure": measure}
             return [encode({**finding_dict(f), **extra}, separators=(",", ":")) for f in c.findings()]
-        head = f'{{"path":{encode(c.path)},"line":'
-        rule = f',"code":{encode(c.code)},"name":{encode(c.name)},"face":'
+        head = f'{{"path":{encode(c.path)},"line":'.replace("%", "%%")
+        rule = f',"code":{encode(c.code)},"name":{encode(c.name)},"face":'.replace("%", "%%")
         unit = f',"threshold":{encode(c.threshold)},"unit":{encode(c.unit)},"level":"'
         measure = settings.measure_of(c.code)
         tail = "}" if measure is None else f',"measure":{encode(measure)}}}'
-        # What follows the value depends on a few texts only (level, group, message, prim): each written once,
-        # looked up by the level alone where the others are the same for every finding (the usual case).
-        shared = len(set(c.group)) == len(set(c.message)) == len(set(c.prim)) == 1
-        texts = c.level if shared else list(zip(c.level, c.group, c.message, c.prim))
-        ends = {key: unit + _after_level(*((key, c.group[0], c.message[0], c.prim[0]) if shared else key)) + tail
-                for key in set(texts)}
+        ends = _ends(c, unit, tail)
+        # One '%'-format a row, the constant parts joined in the template; the values' repr is json's.
         if set(c.column) == {1} and math.isfinite(sum(c.value)):  # faces on source lines, finite values
-            rule = ',"column":1' + rule
-            return [f"{head}{line}{rule}{face},\"value\":{value!r}{ends[key]}"
-                    for line, face, value, key in zip(c.line, c.face, c.value, texts)]
-        return [f'{head}{line},"column":{column}{rule}{face},"value":{value}{ends[key]}'
-                for line, column, face, value, key in zip(c.line, c.column, c.face, map(encode, c.value), texts)]
+            template = f'{head}%d,"column":1{rule}%d,"value":%r%s'
+            return [template % row for row in zip(c.line, c.face, c.value, ends)]
+        template = f'{head}%d,"column":%d{rule}%d,"value":%s%s'
+        return [template % row for row in zip(c.line, c.column, c.face, map(encode, c.value), ends)]
 
     return rows
+
+
+def _ends(c: Columns, unit: str, tail: str) -> list[str]:
+    """Each finding's JSON from its threshold to its end: a few texts (level, group, message, prim), each
+    encoded once; the rows whose group, message or prim differ from the first row's looked up one by one."""
+    first = (c.group[0], c.message[0], c.prim[0])
+    by_level = {level: unit + _after_level(level, *first) + tail for level in set(c.level)}
+    ends = list(map(by_level.__getitem__, c.level))
+    differ = set()
+    for column, common in zip((c.group, c.message, c.prim), first):
+        if column.count(common) != len(column):
+            differ.update(row for row, text in enumerate(column) if text != common)
+    known: dict[tuple, str] = {}
+    for row in sorted(differ):
+        key = (c.level[row], c.group[row], c.message[row], c.prim[row])
+        if key not in known:
+            known[key] = unit + _after_level(*key) + tail
+        ends[row] = known[key]
+    return ends
 
 
 def _after_level(level: str, group: str, message: str, prim: str | None) -> str:

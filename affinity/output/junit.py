@@ -24,7 +24,7 @@ from typing import TextIO
 
 from ..findings import FileReport
 from ..rules import LEVELS, RULES, UNREADABLE
-from . import CheckRun, Columns, Selection, statistics, text_lines
+from . import CheckRun, Columns, Selection, face_lines, statistics, text_lines
 
 # Characters XML 1.0 cannot carry at all (control characters, lone surrogates from undecodable file names).
 _NOT_XML = re.compile("[^\t\n\r\x20-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
@@ -60,16 +60,18 @@ def _finding_cases(fail_on: str):
     def cases(c: Columns) -> list[str]:
         path = xml_attribute(c.path)
         rule = f"{xml_attribute(c.code)} {xml_attribute(c.name)}"
+        failure = f'<failure type="{xml_attribute(c.code)}" message="{rule}: {xml_attribute(RULES[c.code].summary)}">'
+        lines = face_lines(c, xml_text)
+        if lines is not None:  # measured faces of a mesh file: one shape for every case
+            case, where = f'<testcase classname="{path}" name="{rule} face ', f'" file="{path}" line="'
+            opens = {level: f'">{failure}' if level in failing else '"><system-out>' for level in LEVELS}
+            closes = {level: "</failure></testcase>\n" if level in failing else "</system-out></testcase>\n"
+                      for level in LEVELS}
+            return [f"{case}{face}{where}{line}{opens[level]}{t}{closes[level]}"
+                    for face, line, level, t in zip(c.number_texts[2], c.number_texts[0], c.level, lines)]
         lines = text_lines(c)
         if _needs_escaping(c):  # numbers never do: only the path, messages, groups and prims can
             lines = list(map(xml_text, lines))
-        failure = f'<failure type="{xml_attribute(c.code)}" message="{rule}: {xml_attribute(RULES[c.code].summary)}">'
-        if c.prim[0] is None and min(c.face, default=0) >= 0:  # faces of a mesh file: one shape for every case
-            case = f'<testcase classname="{path}" name="{rule} face '
-            return [f'{case}{face}" file="{path}" line="{line}">{failure}{t}</failure></testcase>\n'
-                    if level in failing else
-                    f'{case}{face}" file="{path}" line="{line}"><system-out>{t}</system-out></testcase>\n'
-                    for face, line, level, t in zip(c.face, c.line, c.level, lines)]
         names = [rule if face < 0 else f"{rule} face {face}" if prim is None
                  else f"{rule} {xml_attribute(prim)} face {face}" for face, prim in zip(c.face, c.prim)]
         return [f'<testcase classname="{path}" name="{name}" file="{path}" line="{line}">'

@@ -145,7 +145,9 @@ PRIM = ',"prim":'
 def _result_rows(location: dict, rule_index: dict[str, int]):
     """The SARIF results of a :class:`Columns` as JSON text, each with its fingerprint (from its ``ordinals``,
     :func:`_ordinals`); the pieces every result of a rule shares are encoded once."""
-    encode, compact = json.dumps, (",", ":")
+    encode = json.dumps
+    # One encoder for every result (json.dumps with options builds a new encoder a call: most of the time here).
+    compact = json.JSONEncoder(separators=(",", ":")).encode
 
     def rows(c: Columns, ordinals: np.ndarray) -> list[str]:
         head = f'{{"ruleId":{encode(c.code)},"ruleIndex":{rule_index[c.code]},"level":"'
@@ -160,13 +162,12 @@ def _result_rows(location: dict, rule_index: dict[str, int]):
                 located["logicalLocations"] = [logical]
             identity = fingerprint(c.code, location["uri"], group, value, ordinal)
             if where is not None or read:  # shared geometry, or C read through a texture: a result of its own
-                results.append(encode(_rich_result(c, located, where, read, identity, rule_index[c.code], face,
-                                                   value, level, group, prim, f"{text}, {label}" if label else text),
-                                      separators=compact))
+                results.append(compact(_rich_result(c, located, where, read, identity, rule_index[c.code], face,
+                                                    value, level, group, prim, f"{text}, {label}" if label else text)))
                 continue
             results.append(
                 f'{head}{sarif_level(level)}","message":{{"text":{encode(f"{text}, {label}" if label else text)}}},'
-                f'"locations":[{encode(located, separators=compact)}],'
+                f'"locations":[{compact(located)}],'
                 f'"partialFingerprints":{{"{FINGERPRINT}":"{identity}"}},'
                 f'"properties":{{"name":{encode(c.name)},"face":{face},"value":{encode(value)}{shared}{level}",'
                 f'"group":{encode(group)}{"" if prim is None else PRIM + encode(prim)}}}}}')
