@@ -11,9 +11,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import test_fuzz as fuzz
+from helpers.bad_obj import BAD_FIFTH_LINE, BAD_OTHER_LINE, SQUARE
+from helpers.fuzzing import MUTATIONS, seed_files
 from helpers.generated_obj import FIELDS
-from test_loaders_bad_input import BAD_FIFTH_LINE, BAD_OTHER_LINE, SQUARE
 
 from affinity.errors import MeshError
 from affinity.loaders.obj import faces, load_obj
@@ -83,11 +83,11 @@ def test_fixtures_read_alike_on_both_paths(path):
 
 def test_fuzzed_files_read_or_fail_alike_on_both_paths(tmp_path):
     rng = random.Random(39)
-    obj_seeds = [(suffix, data) for suffix, data in fuzz.seed_files(rng) if suffix == ".obj"]
+    obj_seeds = [(suffix, data) for suffix, data in seed_files(rng) if suffix == ".obj"]
     outcomes = []
     for k in range(MUTATED):
         data = obj_seeds[k % len(obj_seeds)][1]
-        for step in [fuzz.MUTATIONS[k % len(fuzz.MUTATIONS)], rng.choice(fuzz.MUTATIONS)][: 1 + k % 2]:
+        for step in [MUTATIONS[k % len(MUTATIONS)], rng.choice(MUTATIONS)][: 1 + k % 2]:
             data = step(rng, data) if data else data
         path = tmp_path / f"fuzz_{k:04d}.obj"
         path.write_bytes(data)

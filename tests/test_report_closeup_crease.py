@@ -4,15 +4,13 @@ reversed, each uv or colour close-up's split and exact panels differ by at least
 
 from __future__ import annotations
 
-import base64
-import io
 import subprocess
 import sys
-from html.parser import HTMLParser
 from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers.closeup_panels import Closeups, decode_panel
 from helpers.corpus import SHARED_MESHES
 
 from affinity.draw.shading import FLAG_COLOUR
@@ -26,31 +24,7 @@ CHANGED_STEP = 8
 SPAN = 3
 
 
-class Closeups(HTMLParser):
-    """Every close-up figure's rule, face and panel sources by what they show (``split``, ``exact``, ...)."""
 
-    def __init__(self):
-        super().__init__()
-        self.figures: list[dict] = []
-        self._current: dict | None = None
-
-    def handle_starttag(self, tag, attrs):
-        attrs = dict(attrs)
-        if tag == "figure" and "data-face" in attrs:
-            self._current = {"rule": attrs["data-rule"], "face": int(attrs["data-face"]), "images": {}}
-            self.figures.append(self._current)
-        elif tag == "img" and self._current is not None:
-            self._current["images"][attrs.get("alt", "").split(",")[0]] = attrs["src"]  # alt "split, face F"
-
-    def handle_endtag(self, tag):
-        if tag == "figure":
-            self._current = None
-
-
-def _decode(src: str) -> np.ndarray:
-    from PIL import Image
-
-    return np.asarray(Image.open(io.BytesIO(base64.b64decode(src.split(",", 1)[1]))).convert("RGB")).astype(int)
 
 
 def _widest_block(changed: np.ndarray) -> bool:
@@ -92,7 +66,7 @@ def test_closeups_show_a_crease_at_least_3_pixels_across(mesh, tmp_path):
     figures = [figure for figure in parser.figures if figure["rule"] in CREASE_RULES]
     assert figures  # every shared mesh has a uv or colour finding with a close-up
     for figure in figures:
-        split, exact = _decode(figure["images"]["split"]), _decode(figure["images"]["exact"])
+        split, exact = decode_panel(figure["images"]["split"]), decode_panel(figure["images"]["exact"])
         rows, columns = np.nonzero((split == flag).all(axis=-1))  # the place's outline
         box = (slice(rows.min(), rows.max() + 1), slice(columns.min(), columns.max() + 1))
         changed = np.abs(split - exact).max(axis=-1) >= CHANGED_STEP

@@ -9,8 +9,8 @@ import sys
 
 import numpy as np
 import pytest
+from helpers.closeup_panels import Closeups, decode_panel
 from helpers.corpus import SHARED_MESHES
-from test_report_closeup_crease import Closeups, _decode
 
 from affinity.draw.fold import DIAGONAL_INK
 from affinity.draw.shading import FLAG_COLOUR
@@ -84,5 +84,5 @@ def test_every_fold_closeup_of_a_shared_mesh_shows_the_step(name, tmp_path):
     folds = [figure for figure in parser.figures if figure["rule"] in FOLD_RULES]
     assert folds  # each of these meshes has Q202 findings with a close-up
     for figure in folds:
-        step, pairs = step_across_diagonal(_decode(figure["images"]["split"]))
+        step, pairs = step_across_diagonal(decode_panel(figure["images"]["split"]))
         assert pairs >= 3 and step >= VISIBLE_STEP, (name, figure["face"], step, pairs)

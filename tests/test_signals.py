@@ -38,10 +38,11 @@ def write_grid(path: Path, side: int = SIDE, seed: int = 0) -> None:
 
 @pytest.fixture(scope="module")
 def big_meshes(tmp_path_factory) -> Path:
-    """Six copies of the grid: enough work for two workers to be busy for seconds."""
+    """Sixteen copies of the grid (copies, not links: a file under two names is checked once): work for two
+    workers for a few seconds (a 90,000-quad grid takes some 0.1 s to check)."""
     folder = tmp_path_factory.mktemp("big")
     write_grid(folder / "grid0.obj")
-    for copy in range(1, 6):
+    for copy in range(1, 16):
         shutil.copyfile(folder / "grid0.obj", folder / f"grid{copy}.obj")
     return folder
 
@@ -97,7 +98,7 @@ def test_no_process_of_a_two_job_run_outlives_a_signal(big_meshes, tmp_path, sig
     try:
         assert wait_for(lambda: len(children(run.pid)) == 2, 60), "the two workers never started"
         workers = children(run.pid)
-        time.sleep(0.3)  # both inside a check
+        time.sleep(0.05)  # both inside a check
         assert all(map(alive, workers)) and not temporaries(tmp_path)  # still checking
         os.kill(run.pid, signum)
         run.wait(timeout=5)
