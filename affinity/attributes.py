@@ -4,10 +4,10 @@ What a quad can carry besides its positions (texture coordinates, vertex
 colours, normals) is described here once: the :class:`~affinity.mesh.Mesh`
 fields that hold it, its width, its unit, the note a report gives when a mesh
 lacks it, the name every command uses for it (``render --show``, ``view
---attribute``), and how a difference of two values reads in that unit. Which
-rules score an attribute is read from the rule registry
-(:func:`scoring_rules`), so a new rule on an attribute is found without
-touching this table. Imports nothing at load (the command line reads the
+--attribute``), and how a difference of two values reads in that unit
+(:func:`pixel_error`). Which rules score an attribute is the rule registry's
+(:func:`affinity.rules.scoring_rules`: a rule names its attribute), so a new
+rule on an attribute is found without touching this table. Imports nothing at load (the command line reads the
 names); the measures are imported when a difference is taken.
 """
 
@@ -117,8 +117,19 @@ def canonical_name(text: str) -> str:
         return text
 
 
-def scoring_rules(field: str) -> list[str]:
-    """Codes of the scored rules (``Rule.scored``) on the attribute ``field``, in code order."""
-    from .rules import RULES
+def pixel_error(values: np.ndarray, reference: np.ndarray, attribute: str, texture_size) -> np.ndarray:
+    """Error of interpolated attributes against a reference's, in the lint's units.
 
-    return [code for code, rule in RULES.items() if rule.scored and rule.attribute == field]
+    Parameters
+    ----------
+    values, reference : (N, K) float64, the attribute at N pixels
+    attribute : the Mesh field they come from: ``"texcoords"``, ``"colors"`` or ``"normals"``
+        (a key of :data:`ATTRIBUTES`)
+    texture_size : (width, height) in texels, for texture coordinates
+
+    Returns
+    -------
+    (N,) float64: |du, dv| in texels, |d rgb| in 1/255 steps, or the angle
+    between the two normals in degrees (the attribute's ``difference``).
+    """
+    return ATTRIBUTES[attribute].difference(values, reference, texture_size)

@@ -228,19 +228,6 @@ def settle(hits: list[RuleHits], settings, group_names: list[str], inline=()) ->
     return settled
 
 
-def mesh_report(path: str, mesh, settings, inline=()) -> FileReport:
-    """The report of the file at ``path`` whose mesh is ``mesh``: its findings (lint, then :func:`settle`
-    with ``settings`` and the ``inline`` ignores, then :func:`share_authored_geometry`), counts, groups,
-    and for a USD stage its prims, metadata and the loader's notes."""
-    from .lint import lint_mesh
-
-    hits, shared = share_authored_geometry(settle(lint_mesh(mesh, settings), settings, list(mesh.group_names), inline),
-                                           mesh)
-    return FileReport(path, counts=mesh.counts(), hits=hits, shared=shared, group_names=list(mesh.group_names),
-                      prim_face_start=mesh.prim_face_start, up_axis=mesh.up_axis,
-                      meters_per_unit=mesh.meters_per_unit, notes=list(mesh.notes))
-
-
 def share_authored_geometry(hits: list[RuleHits], mesh) -> tuple[list[RuleHits], list[dict]]:
     """Findings of a USD stage reported once where the geometry is authored.
 

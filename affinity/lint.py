@@ -18,12 +18,12 @@ from functools import cached_property
 
 import numpy as np
 
-from .attributes import ATTRIBUTES, attribute_named, scoring_rules
-from .findings import RuleHits
+from .attributes import ATTRIBUTES, attribute_named
+from .findings import FileReport, RuleHits, settle, share_authored_geometry
 from .geometry import PlanarQuads, planar_quads_by_component, squared_lengths
 from .measures import split_error_by_component, split_scale
 from .mesh import Mesh
-from .rules import RULES, resolve_codes
+from .rules import RULES, resolve_codes, scoring_rules
 from .settings import Settings
 
 #: Quads measured together. Whole-mesh temporaries of a million quads spill out
@@ -310,6 +310,17 @@ def lint_mesh(mesh: Mesh, settings: Settings, visible: bool = True) -> list[Rule
         preparing.join()
     order = {code: i for i, code in enumerate(RULES)}
     return sorted(hits, key=lambda h: order[h.code])
+
+
+def mesh_report(path: str, mesh, settings, inline=()) -> FileReport:
+    """The report of the file at ``path`` whose mesh is ``mesh``: its findings (lint, then :func:`settle`
+    with ``settings`` and the ``inline`` ignores, then :func:`share_authored_geometry`), counts, groups,
+    and for a USD stage its prims, metadata and the loader's notes."""
+    hits, shared = share_authored_geometry(settle(lint_mesh(mesh, settings), settings, list(mesh.group_names), inline),
+                                           mesh)
+    return FileReport(path, counts=mesh.counts(), hits=hits, shared=shared, group_names=list(mesh.group_names),
+                      prim_face_start=mesh.prim_face_start, up_axis=mesh.up_axis,
+                      meters_per_unit=mesh.meters_per_unit, notes=list(mesh.notes))
 
 
 #: Cause rule -> the attributes whose scored rules (Q101-Q103) it takes over (:class:`Unmeasurable`).

@@ -352,22 +352,3 @@ def normal_degrees(m: np.ndarray, normals: np.ndarray) -> np.ndarray:
     mean_normal = lengths(normals[:, 0] + normals[:, 1] + normals[:, 2] + normals[:, 3]) / 4
     return np.degrees(np.arctan2(lengths(m), mean_normal))
 
-
-def pixel_error(values: np.ndarray, reference: np.ndarray, attribute: str, texture_size) -> np.ndarray:
-    """Error of interpolated attributes against a reference's, in the lint's units.
-
-    Parameters
-    ----------
-    values, reference : (N, K) float64, the attribute at N pixels
-    attribute : the Mesh field they come from: ``"texcoords"``, ``"colors"`` or ``"normals"``
-        (a key of :data:`affinity.attributes.ATTRIBUTES`)
-    texture_size : (width, height) in texels, for texture coordinates
-
-    Returns
-    -------
-    (N,) float64: |du, dv| in texels, |d rgb| in 1/255 steps, or the angle
-    between the two normals in degrees (the attribute's ``difference``).
-    """
-    from .attributes import ATTRIBUTES  # the registry reads this module's units
-
-    return ATTRIBUTES[attribute].difference(values, reference, texture_size)

@@ -1,7 +1,8 @@
-"""The package graph is the layer map of design.md, and affinity/ stays small at its top.
+"""The package graph is the layer map of design.md, the module graph has no cycle, and affinity/
+stays small at its top.
 
-Imports are read with ``ast`` from every module, lazy ones inside functions included,
-so an upward import cannot hide in a function body.
+Imports are read with ``ast`` from every module, lazy ones inside functions included (and those
+under ``TYPE_CHECKING``), so an upward import or a cycle cannot hide in a function body.
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ ROOT = Path(__file__).resolve().parents[1]
 LAYERS = {
     "render": 0,
     "affinity.draw": 2, "affinity.pipeline": 2,
-    "affinity.study": 3, "affinity.view": 3, "affinity.stability": 3, "affinity.blender": 3,
+    "affinity.study": 3, "affinity.stability": 3, "affinity.blender": 3,
     "affinity.report": 4,
     "affinity.commands": 5,
     "affinity.cli": 6,
@@ -27,11 +28,11 @@ LAYERS = {
 CORE = 1
 #: Layers whose packages sit side by side: one may not import the other.
 SIDE_BY_SIDE = {2, 3}
-MAX_TOP_LEVEL_MODULES = 13
+MAX_TOP_LEVEL_MODULES = 12
 
 
-def module_name(path: Path) -> str:
-    parts = list(path.relative_to(ROOT).with_suffix("").parts)
+def module_name(path: Path, root: Path = ROOT) -> str:
+    parts = list(path.relative_to(root).with_suffix("").parts)
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
@@ -55,17 +56,23 @@ def imported_modules(path: Path, module: str | None = None) -> list[tuple[int, s
     ``module`` is the file's dotted name (default: from its place under ROOT).
     """
     module = module or module_name(path)
-    package = module.split(".") if path.name == "__init__.py" else module.split(".")[:-1]
-    found = []
-    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
-        if isinstance(node, ast.Import):
-            found += [(node.lineno, alias.name) for alias in node.names]
-        elif isinstance(node, ast.ImportFrom):
-            base = package[: len(package) - node.level + 1] if node.level else []
-            target = ".".join([*base, *([node.module] if node.module else [])])
-            # "from . import lint" imports the module affinity.lint
-            found += [(node.lineno, target if node.module else f"{target}.{alias.name}") for alias in node.names]
+    found = [entry for node in ast.walk(ast.parse(path.read_text(encoding="utf-8")))
+             if isinstance(node, (ast.Import, ast.ImportFrom)) for entry in statement_imports(node, module, path)]
     return [(line, name) for line, name in found if name.split(".")[0] in ("affinity", "render")]
+
+
+def statement_imports(node: ast.Import | ast.ImportFrom, module: str, path: Path) -> list[tuple[int, str]]:
+    """(line, absolute module) of one import statement of the file ``path`` (dotted name ``module``),
+    relative ones resolved: ``from X import a, b`` gives (line, X) once, ``from . import lint`` the
+    module ``package.lint``."""
+    if isinstance(node, ast.Import):
+        return [(node.lineno, alias.name) for alias in node.names]
+    package = module.split(".") if path.name == "__init__.py" else module.split(".")[:-1]
+    base = package[: len(package) - node.level + 1] if node.level else []
+    target = ".".join([*base, *([node.module] if node.module else [])])
+    if node.module is None:
+        return [(node.lineno, f"{target}.{alias.name}") for alias in node.names]
+    return [(node.lineno, target)]
 
 
 def wrong_imports(path: Path, module: str | None = None) -> list[str]:
@@ -85,6 +92,69 @@ def project_modules() -> list[Path]:
     return sorted([*(ROOT / "affinity").rglob("*.py"), *(ROOT / "render").rglob("*.py")])
 
 
+def module_graph(paths: list[Path], root: Path = ROOT) -> dict[str, set[str]]:
+    """Module -> the modules among ``paths`` (files under ``root``) it imports. ``from package
+    import name`` points at the module ``package.name`` where there is one (a submodule), else at
+    ``package`` (its ``__init__``, which defines or imports the name)."""
+    names = {module_name(path, root): path for path in paths}
+    graph = {}
+    for name, path in names.items():
+        targets = set()
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if not isinstance(node, (ast.Import, ast.ImportFrom)):
+                continue
+            for _, target in statement_imports(node, name, path):
+                if isinstance(node, ast.ImportFrom) and node.module is None:  # from . import name
+                    targets.add(target if target in names else target.rpartition(".")[0])
+                elif isinstance(node, ast.ImportFrom):
+                    submodules = {f"{target}.{alias.name}" for alias in node.names} & names.keys()
+                    targets |= {target} if len(submodules) < len(node.names) else set()
+                    targets |= submodules
+                else:
+                    targets.add(target)
+        graph[name] = {target for target in targets if target in names and target != name}
+    return graph
+
+
+def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The strongly connected components of more than one module (and the modules importing
+    themselves), each sorted: Tarjan's algorithm, iterative so a deep graph cannot overflow."""
+    index, low, on_stack, stack, found = {}, {}, set(), [], []
+    for root in sorted(graph):
+        if root in index:
+            continue
+        work = [(root, iter(sorted(graph[root])))]
+        index[root] = low[root] = len(index)
+        stack.append(root)
+        on_stack.add(root)
+        while work:
+            node, successors = work[-1]
+            for successor in successors:
+                if successor not in index:
+                    index[successor] = low[successor] = len(index)
+                    stack.append(successor)
+                    on_stack.add(successor)
+                    work.append((successor, iter(sorted(graph[successor]))))
+                    break
+                if successor in on_stack:
+                    low[node] = min(low[node], index[successor])
+            else:
+                work.pop()
+                if work:
+                    low[work[-1][0]] = min(low[work[-1][0]], low[node])
+                if low[node] == index[node]:
+                    component = []
+                    while True:
+                        member = stack.pop()
+                        on_stack.discard(member)
+                        component.append(member)
+                        if member == node:
+                            break
+                    if len(component) > 1 or node in graph[node]:
+                        found.append(sorted(component))
+    return sorted(found)
+
+
 def test_no_import_points_up_the_layers():
     wrong = [line for path in project_modules() for line in wrong_imports(path)]
     assert not wrong, "\n".join(wrong)
@@ -101,6 +171,40 @@ def test_the_layer_check_sees_lazy_and_relative_imports(tmp_path):
         "measures.py:2: affinity.draw.drawing imports affinity.pipeline.check, side by side with it"]
     source.write_text("def f():\n    from ..lint import lint_mesh\n    import render\n")
     assert wrong_imports(source, "affinity.draw.drawing") == []
+
+
+def test_no_module_imports_itself_back():
+    """No cycle in the module graph of affinity/ and render/, lazy imports included: each module can
+    be read, tested and moved with only what it imports below it."""
+    graph = module_graph(project_modules())
+    found = cycles(graph)
+    assert not found, "\n".join(
+        "cycle: " + "; ".join(f"{m} imports {', '.join(sorted(graph[m] & set(c)))}" for m in c) for c in found)
+
+
+def test_the_cycle_check_sees_lazy_and_relative_imports(tmp_path):
+    """The graph and Tarjan's components on a package the test writes: a lazy import closing a
+    cycle of three, a module importing its package's __init__, and an acyclic part."""
+    package = tmp_path / "pkg"
+    package.mkdir()
+    files = {
+        "__init__.py": "from .a import f\n",
+        "a.py": "from . import b\n",
+        "b.py": "def g():\n    from .c import h\n",
+        "c.py": "import pkg.a\nfrom pkg import d\n",
+        "d.py": "from . import f\n",  # the package's __init__, which imports a: d -> pkg -> a -> b -> c -> d
+        "e.py": "from .d import x\n",
+    }
+    for name, text in files.items():
+        (package / name).write_text(text)
+    graph = module_graph(sorted(package.glob("*.py")), tmp_path)
+    assert graph["pkg.c"] == {"pkg.a", "pkg.d"} and graph["pkg.d"] == {"pkg"} and graph["pkg.b"] == {"pkg.c"}
+    assert cycles(graph) == [["pkg", "pkg.a", "pkg.b", "pkg.c", "pkg.d"]]
+    (package / "d.py").write_text("x = 1\n")
+    (package / "b.py").write_text("x = 1\n")
+    graph = module_graph(sorted(package.glob("*.py")), tmp_path)
+    assert cycles(graph) == []
+    assert cycles({"a": {"a"}}) == [["a"]]
 
 
 def test_render_knows_nothing_of_affinity():

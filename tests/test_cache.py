@@ -310,7 +310,7 @@ def named_libraries(text: bytes) -> list[str]:
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(lines=st.lists(st.sampled_from(_LINES), max_size=30), newline=st.booleans())
 def test_the_cache_and_the_loader_read_the_libraries_the_obj_rule_names(tmp_path, lines, newline):
-    from affinity.loaders.resources import obj_resources
+    from affinity.loaders.references import obj_resources
 
     text = b"\n".join(lines) + b"\n" * newline
     path = tmp_path / "mesh.obj"

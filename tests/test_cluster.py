@@ -18,7 +18,7 @@ from helpers.cli import run
 from helpers.quads import SQUARE, UNIT_UV, quad_obj, trapezoid
 
 from affinity.pipeline import cluster as cluster_module
-from affinity.pipeline.check import check_files
+from affinity.pipeline.check import check_file, check_files
 from affinity.settings import Settings
 
 pytest.importorskip("distributed")
@@ -106,7 +106,7 @@ def test_a_lost_worker_costs_only_its_tasks(client, assets):
 
 def test_a_path_the_worker_cannot_see_is_unreadable_with_the_reason(client, tmp_path):
     missing = tmp_path / "only-on-the-client" / "crate.obj"
-    [(index, report)] = list(cluster_module.check_on_cluster(client, [(str(missing), Settings())]))
+    [(index, report)] = list(cluster_module.check_on_cluster(client, [(str(missing), Settings())], check_file))
     assert index == 0 and report.path == str(missing)
     assert "not found on the Dask worker" in report.error and "shared storage" in report.error
     assert report.transient  # a mount problem, not the file's result: never cached
@@ -121,7 +121,7 @@ def test_a_worker_that_cannot_see_the_file_leaves_no_cache_entry(tmp_path):
     mesh.write_text(quad_obj([(trapezoid(0.5), UNIT_UV)]))
     cache = ResultCache(str(tmp_path / "cache"), tool="t")
     key = cache.key(str(mesh), Settings())
-    unseen = cluster_module._check_on_worker(str(tmp_path / "elsewhere.obj"), str(mesh), Settings(), None)
+    unseen = cluster_module._check_on_worker(check_file, str(tmp_path / "elsewhere.obj"), str(mesh), Settings(), None)
     cache.put(key, unseen)
     assert cache.get(key) is None
     cache.put(key, FileReport(str(mesh), counts={"faces": 1}))
@@ -136,9 +136,9 @@ def test_cached_files_are_not_submitted(client, assets, tmp_path, monkeypatch, a
     submitted = []
     real = cluster_module.check_on_cluster
 
-    def counting(dask_client, todo, usd=None):
+    def counting(dask_client, todo, check, usd=None):
         submitted.append(len(todo))
-        return real(dask_client, todo, usd)
+        return real(dask_client, todo, check, usd)
 
     monkeypatch.setattr(cluster_module, "check_on_cluster", counting)
     runs, connections = [], []

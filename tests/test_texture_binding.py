@@ -220,7 +220,7 @@ def test_the_result_cache_follows_usd_and_materialx_textures(tmp_path):
     pytest.importorskip("pxr")
     from PIL import Image
 
-    from affinity.loaders.resources import named_files
+    from affinity.loaders.references import named_files
 
     udim_tiles(tmp_path)
     (tmp_path / "maps" / "normals").mkdir(parents=True)

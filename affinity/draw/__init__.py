@@ -5,7 +5,8 @@
 - :mod:`.quads`: the mesh as the renderer's quads (triangles and n-gons fanned);
 - :mod:`.routing`: the hybrid's per-quad choice between ``split`` and ``mvc``;
 - :mod:`.shading`: per-corner inputs, pixel colours, the shared palette;
-- :mod:`.texture`, :mod:`.png`: images in and out.
+- :mod:`.texture`, :mod:`.png`: images in and out;
+- :mod:`.view`: the 3-D view of ``affinity view`` and the report's overview (pyvista, the ``view`` extra).
 
 ``render`` (the rasterizer) knows nothing of meshes; this package is where meshes
 meet it. Heavy imports (``render``, Pillow) happen inside the functions.

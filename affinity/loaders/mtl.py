@@ -7,12 +7,10 @@ Which statements name texture maps is the resource registry's
 from __future__ import annotations
 
 import os
-from typing import TYPE_CHECKING
-
-if TYPE_CHECKING:
-    from .texturemaps import TextureMap
 
 from .regular import SIDE_FILE_BUDGET, read_regular
+from .resources import ROLES, roles_named_in
+from .texturemaps import TextureMap
 
 #: ``map_Kd`` options with a fixed number of arguments.
 _FIXED_ARGUMENTS = {
@@ -40,9 +38,6 @@ def map_statements(path) -> list[tuple[str, str, TextureMap]]:
     (None for a role that names none), its file resolved against the .mtl's folder, and the statement's
     ``-s`` scale and ``-o`` offset of u and v (w is not used by a 2-D texture). A missing or unreadable
     file gives an empty list."""
-    from .resources import ROLES, roles_named_in
-    from .texturemaps import TextureMap
-
     try:
         text = read_regular(path, SIDE_FILE_BUDGET).decode("utf-8", "replace")
     except OSError:
@@ -113,3 +108,18 @@ def _is_number(word: str) -> bool:
     except ValueError:
         return False
     return True
+
+
+def obj_material_maps(resources: list) -> dict[str, list[TextureMap]]:
+    """Material -> its texture maps, from an OBJ's ``mtllib`` resources (``Mesh.resources``): the first
+    library defining a material wins, within a library its last statement of each role (as a renderer
+    reads them)."""
+    maps: dict[str, list[TextureMap]] = {}
+    for library in (r for r in resources if r.role == "mtllib"):
+        own: dict[str, dict[str, TextureMap]] = {}
+        for role, material, texture in map_statements(library.path):
+            if texture.role is not None:
+                own.setdefault(material, {})[role] = texture
+        for material, by_statement in own.items():
+            maps.setdefault(material, list(by_statement.values()))
+    return maps

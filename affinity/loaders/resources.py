@@ -6,9 +6,10 @@ sublayers, references and payloads. Each kind is one :class:`ResourceRole`
 in :data:`ROLES`; the loaders list what a file references as
 :class:`Resource` records (``Mesh.resources``), and the result cache's
 dependency hash (:mod:`affinity.pipeline.cache`) and Q902 missing-resource
-(:mod:`affinity.rules.file`) read the same functions here, so a new texture
-role is one :func:`register_role` call: the MTL reader then reads its
-statement, the cache hashes its files and Q902 reports them missing.
+(:mod:`affinity.rules.file`) read the same roles, so a new texture role is one
+:func:`register_role` call: the MTL reader then reads its statement, the cache
+hashes its files (:mod:`.references`) and Q902 reports them missing. This
+module imports none of the readers: they read it.
 """
 
 from __future__ import annotations
@@ -141,59 +142,3 @@ def mtllib_statements(data) -> list[tuple[int, str]]:
         if len(words) > 1:
             found.append((line, os.fsdecode(b" ".join(words[1:]))))
     return found
-
-
-def obj_resources(path: str, data) -> list[Resource]:
-    """What the OBJ file ``path`` with bytes ``data`` references: its material libraries and,
-    for each readable one, the texture maps of every role named in MTL files; each file once
-    (its first mention), libraries resolved against the OBJ's folder."""
-    from .mtl import material_maps
-
-    folder = os.path.dirname(os.fspath(path))
-    resources, seen = [], set()
-    for line, name in mtllib_statements(data):
-        library = os.path.normpath(os.path.join(folder, name))
-        if library in seen:
-            continue
-        seen.add(library)
-        resources.append(Resource(role="mtllib", name=name, path=library, line=line))
-        for role, material, texture_name, texture in material_maps(library):
-            if (role, texture) not in seen:
-                seen.add((role, texture))
-                resources.append(Resource(role=role, name=texture_name, path=texture, line=line, library=name,
-                                          material=material))
-    return resources
-
-
-def named_files(path: str, data=None) -> list[str]:
-    """The files the file at ``path`` names itself (one level down, each once, in order):
-    an OBJ's material libraries (from its bytes ``data``; read when None), an MTL file's
-    texture maps of every role named in MTL files, a USD layer's sublayers, references and
-    payloads and the files of its asset-valued attributes (textures; none without ``pxr``), a
-    MaterialX document's image files. A UDIM texture names its tiles on disk. Other files name
-    none. Paths are normalised, not made absolute."""
-    suffix = os.path.splitext(path)[1].lower()
-    if suffix == ".obj":
-        if data is None:
-            from .regular import read_regular
-
-            data = read_regular(path)
-        folder = os.path.dirname(path)
-        return list(dict.fromkeys(os.path.normpath(os.path.join(folder, name))
-                                  for _, name in mtllib_statements(data)))
-    from .texturemaps import tile_files
-
-    if suffix == ".mtl":
-        from .mtl import material_maps
-
-        return tile_files(texture for *_, texture in material_maps(path))
-    if suffix == ".mtlx":
-        from .usdmaterials import mtlx_document_maps
-
-        return tile_files(texture_map.path for texture_map in mtlx_document_maps(path, every=True))
-    from .formats import format_named
-    from .usdlayers import asset_paths, texture_asset_paths
-
-    if suffix not in format_named("usd").suffixes:
-        return []
-    return [*asset_paths(path), *tile_files(texture_asset_paths(path))]

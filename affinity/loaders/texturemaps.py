@@ -2,7 +2,7 @@
 
 Each loader lists, per material, the texture maps the material reads through the
 mesh's uv: :class:`TextureMap` records in ``Mesh.material_maps``. An OBJ reads
-them from its MTL libraries (:func:`obj_material_maps`), a USD stage from
+them from its MTL libraries (:func:`affinity.loaders.mtl.obj_material_maps`), a USD stage from
 UsdPreviewSurface and MaterialX networks (:mod:`affinity.loaders.usdmaterials`).
 A map's path may hold a UDIM token (``<UDIM>``, ``%(UDIM)d``): each tile is then
 its own file and size (:func:`udim_tiles`, :func:`udim_tile_of`).
@@ -90,19 +90,3 @@ def udim_tile_of(uv: np.ndarray) -> np.ndarray:
     centre = np.floor(uv.mean(axis=1))
     return (1001 + centre[:, 0] + 10 * centre[:, 1]).astype(np.int64)
 
-
-def obj_material_maps(resources: list) -> dict[str, list[TextureMap]]:
-    """Material -> its texture maps, from an OBJ's ``mtllib`` resources (``Mesh.resources``): the first
-    library defining a material wins, within a library its last statement of each role (as a renderer
-    reads them)."""
-    from .mtl import map_statements
-
-    maps: dict[str, list[TextureMap]] = {}
-    for library in (r for r in resources if r.role == "mtllib"):
-        own: dict[str, dict[str, TextureMap]] = {}
-        for role, material, texture in map_statements(library.path):
-            if texture.role is not None:
-                own.setdefault(material, {})[role] = texture
-        for material, by_statement in own.items():
-            maps.setdefault(material, list(by_statement.values()))
-    return maps

@@ -520,9 +520,9 @@ def _readers() -> str:
 
 def _hash_file(path: str, data: bytes | None = None) -> tuple[str, list[str]]:
     """The content hash of ``path`` (of its bytes ``data`` when given) and the absolute paths of
-    the files it names (:func:`affinity.loaders.resources.named_files`)."""
+    the files it names (:func:`affinity.loaders.references.named_files`)."""
     from ..loaders import reads_whole
-    from ..loaders.resources import named_files
+    from ..loaders.references import named_files
 
     if data is None and reads_whole(path):  # its references are read from the bytes: read them once
         with open(path, "rb") as fh:

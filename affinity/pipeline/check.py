@@ -14,7 +14,7 @@ from contextlib import AbstractContextManager, nullcontext
 from functools import partial
 
 from ..errors import MeshError, SkippedFile
-from ..findings import FileReport, mesh_report
+from ..findings import FileReport
 from ..mesh import Mesh
 from ..settings import Settings
 
@@ -32,6 +32,7 @@ def check_file(path: str, settings: Settings, usd=None, source: bytes | None = N
 def load_and_check(path: str, settings: Settings, usd=None,
                    source: bytes | None = None) -> tuple[FileReport, Mesh | None]:
     """:func:`check_file`, also handing back the loaded mesh (None when it could not be read)."""
+    from ..lint import mesh_report
     from ..loaders import load, reads_whole
 
     try:
@@ -128,7 +129,7 @@ def check_files(
         if client is not None:
             from .cluster import check_on_cluster
 
-            fresh = check_on_cluster(client, [tasks[i] for i in todo], usd)
+            fresh = check_on_cluster(client, [tasks[i] for i in todo], check_file, usd)
         else:
             fresh = enumerate(_check_here([tasks[i] for i in todo], jobs, usd))
         reports = [None] * len(tasks)

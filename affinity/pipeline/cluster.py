@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import os
 import uuid
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
 from ..errors import UsageError
@@ -94,8 +94,13 @@ def dashboard_link(client) -> str | None:
     return client.dashboard_link if "dashboard" in services else None
 
 
-def check_on_cluster(client, tasks: list[tuple[str, Settings]], usd=None) -> Iterator[tuple[int, FileReport]]:
-    """``(task index, report)`` for every task, as the cluster finishes them; each task exactly once."""
+def check_on_cluster(client, tasks: list[tuple[str, Settings]], check: Callable[..., FileReport],
+                     usd=None) -> Iterator[tuple[int, FileReport]]:
+    """``(task index, report)`` for every task, as the cluster finishes them; each task exactly once.
+
+    ``check(path, settings, usd) -> FileReport`` checks one file on a worker
+    (:func:`affinity.pipeline.check.check_file`, sent by reference: the workers import it).
+    """
     from distributed import as_completed
 
     def size(path: str) -> int:
@@ -110,7 +115,7 @@ def check_on_cluster(client, tasks: list[tuple[str, Settings]], usd=None) -> Ite
     futures = {}
     for rank, j in enumerate(biggest_first):
         path, settings = tasks[j]
-        future = client.submit(_check_on_worker, os.path.abspath(path), path, settings, usd,
+        future = client.submit(_check_on_worker, check, os.path.abspath(path), path, settings, usd,
                                key=f"affinity-check-{run}-{j}", priority=len(tasks) - rank)
         futures[future] = j
     for future, result in as_completed(futures, with_results=True, raise_errors=False):
@@ -122,16 +127,15 @@ def check_on_cluster(client, tasks: list[tuple[str, Settings]], usd=None) -> Ite
         future.release()
 
 
-def _check_on_worker(absolute: str, given: str, settings: Settings, usd) -> FileReport:
-    """A worker's task: check the file at ``absolute``; the report names it ``given`` as the client does."""
-    from .check import check_file
-
+def _check_on_worker(check: Callable[..., FileReport], absolute: str, given: str, settings: Settings,
+                     usd) -> FileReport:
+    """A worker's task: ``check`` the file at ``absolute``; the report names it ``given`` as the client does."""
     if not os.path.exists(absolute):
         import socket
 
         return FileReport(given, error=f"not found on the Dask worker on {socket.gethostname()} "
                                        f"(is the shared storage mounted there at {os.path.dirname(absolute)}?)",
                           transient=True)
-    report = check_file(absolute, settings, usd)
+    report = check(absolute, settings, usd)
     report.path = given
     return report

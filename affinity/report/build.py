@@ -221,7 +221,7 @@ def _render(result: MeshResult, texture: np.ndarray | None, step: StepTimer) -> 
 
 
 def _overview(result: MeshResult, step: StepTimer) -> None:
-    from ..view import INSTALL_HINT, overview_image, pyvista_installed
+    from ..draw.view import INSTALL_HINT, overview_image, pyvista_installed
 
     if result.overview_note:  # left out already, and why
         return

@@ -269,6 +269,7 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
     """Draw one place (see the module docstring); ``texture`` is ``--texture``, overriding map_Kd."""
     import os
 
+    from ..attributes import pixel_error
     from ..draw.closeup import face_subset, outline
     from ..draw.drawing import RenderOptions, render_mesh
     from ..draw.shading import OVERLAY_TINT
@@ -283,7 +284,6 @@ def closeup(mesh: Mesh, place: Place, settings: Settings, size: int, pixel_toler
         sample_bilinear,
     )
     from ..loaders.imagesize import image_size
-    from ..measures import pixel_error
 
     view, framed_faces = _framed_view(mesh, place)
     sub = face_subset(mesh, view.drawn)

@@ -19,9 +19,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..attributes import ATTRIBUTE_NAMES, ATTRIBUTES, scoring_rules
+from ..attributes import ATTRIBUTE_NAMES, ATTRIBUTES
 from ..mesh import Mesh
-from ..rules import LEVELS, RULES
+from ..rules import LEVELS, RULES, scoring_rules
 from .build import MeshResult
 
 #: Render quads the view embeds at most (about 100 bytes of page each, all attributes).

@@ -290,8 +290,8 @@ def _errors_against_exact(result: MeshResult) -> dict | None:
     (the split may show another quad at a concave or bow-tie one); None for plain shading."""
     if result.shown is None:
         return None
+    from ..attributes import pixel_error
     from ..loaders.imagesize import image_size
-    from ..measures import pixel_error
 
     exact = result.renders["exact"].frame
     texture_size = image_size(result.mesh.texture_path()) or (result.settings.texture_size,) * 2
@@ -490,7 +490,7 @@ def overview_section(result: MeshResult) -> Section:
     title = "3-D overview"
     if result.overview is None:
         return leave_out("overview", title, result.overview_note)
-    from ..view import score_range
+    from ..draw.view import score_range
 
     scores = result.scores.get(result.shown)
     bar = ""

@@ -15,7 +15,7 @@ read :data:`RULES`.
 from . import affinity, file, shape, texture  # noqa: F401  each registers its rules
 from .docs import SECTIONS, rule_page, rules_table, threshold_text, with_unit
 from .file import UNREADABLE
-from .registry import LEVELS, RULES, Rule, page_fields, register, resolve_codes, rule, unregister
+from .registry import LEVELS, RULES, Rule, page_fields, register, resolve_codes, rule, scoring_rules, unregister
 
 
 def find_rule(key: str) -> Rule | None:
@@ -28,4 +28,4 @@ def find_rule(key: str) -> Rule | None:
 
 
 __all__ = ["LEVELS", "RULES", "SECTIONS", "UNREADABLE", "Rule", "find_rule", "page_fields", "register",
-           "resolve_codes", "rule", "rule_page", "rules_table", "threshold_text", "unregister", "with_unit"]
+           "resolve_codes", "rule", "rule_page", "rules_table", "scoring_rules", "threshold_text", "unregister", "with_unit"]

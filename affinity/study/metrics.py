@@ -4,7 +4,7 @@ All functions are vectorised over pixels (and over quads for the crease) and
 work on the pixels that both renders cover.
 
 - :func:`error_summary` — RMS, 99th percentile and maximum of a per-pixel error
-  (``affinity.measures.pixel_error`` gives it in the lint's units:
+  (``affinity.attributes.pixel_error`` gives it in the lint's units:
   texels for uv, 1/255 steps for colours).
 - :func:`psnr` and :func:`ssim` — of the textured images, in [0, 1] RGB.
   SSIM is Wang, Bovik, Sheikh & Simoncelli 2004 (eq. 13, Gaussian window

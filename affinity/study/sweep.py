@@ -254,7 +254,7 @@ def _compared(scene, settings, frame, reference):
     """Pixels where both show the same quad (H, W) bool and the per-pixel error (N,) of ``frame``
     against ``reference`` there. (Split and the quad-filling methods may show different quads at a
     pixel of a concave or bow-tie quad: that is coverage, not interpolation, and is left out.)"""
-    from ..measures import pixel_error
+    from ..attributes import pixel_error
     from ..rules import RULES
 
     both = (frame.face >= 0) & (frame.face == reference.face)
@@ -266,7 +266,7 @@ def _compared(scene, settings, frame, reference):
 def _errors(scene, settings, frame, exact, image, exact_image, clip, density) -> dict:
     """Attribute error (and, given the texture density (H, W), in screen pixels), PSNR, SSIM
     against exact, and the crease of ``frame``."""
-    from ..measures import pixel_error
+    from ..attributes import pixel_error
     from ..rules import RULES
 
     both, error = _compared(scene, settings, frame, exact)

@@ -51,7 +51,7 @@ def check_stage(stage, time: float | None = None) -> StageCheck:
     """Lint every drawn mesh prim of ``stage`` (at ``time``; None: the earliest sample, as ``affinity check``)."""
     from ..config import file_settings
     from ..errors import MeshError, SkippedFile
-    from ..findings import mesh_report
+    from ..lint import mesh_report
     from ..loaders.usd import UsdOptions, load_stage
     from ..output import file_findings
 

@@ -37,8 +37,8 @@ import numpy as np
 from ...errors import MeshError
 from ...mesh import Mesh
 from ..numbers import PAD
+from ..references import obj_resources
 from ..regular import read_regular
-from ..resources import obj_resources
 from ..text import BufferReader, NotText, read_chunks, tokenize
 from . import alike
 from .assembly import Assembly

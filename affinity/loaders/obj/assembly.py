@@ -13,7 +13,7 @@ import numpy as np
 from ...errors import MeshError
 from ...mesh import Mesh
 from ..faces import check_indices, color_note
-from ..texturemaps import obj_material_maps
+from ..mtl import obj_material_maps
 from .faces import count_back
 from .scan import ELEMENT_OF_SLOT, SLOT_NAMES, VN, VT, WIDTHS, Part, V
 

@@ -11,10 +11,10 @@ import importlib.util
 
 import numpy as np
 
-from .draw.framing import UP_AXES
-from .draw.shading import FLAG_COLOUR
-from .lint import QuadScores
-from .mesh import Mesh
+from ..lint import QuadScores
+from ..mesh import Mesh
+from .framing import UP_AXES
+from .shading import FLAG_COLOUR
 
 INSTALL_HINT = "pip install 'quad-affinity[view]'"
 SURFACE_GREY = "#d1d5db"
@@ -98,7 +98,7 @@ def build_scene(plotter, mesh: Mesh, scores: QuadScores | None, scalar_bar: bool
 def place_camera(plotter, mesh: Mesh, camera: tuple | None, up: str | None, size: tuple[int, int]) -> None:
     """``camera`` (eye, target, vertical fov) as in ``RenderOptions``; None frames the whole mesh from its
     broad side with its up axis (``affinity.draw.framing.overview_camera``, the report's view)."""
-    from .draw.framing import overview_camera, up_axis_of
+    from .framing import overview_camera, up_axis_of
 
     up = up_axis_of(mesh, up)
     eye, target, fov = camera or overview_camera(mesh, size[0], size[1], up)
