@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from fnmatch import fnmatchcase
 
 import numpy as np
@@ -194,8 +194,8 @@ def _matches(code: str, prefixes: list[str]) -> bool:
 
 
 def settle(hits: list[RuleHits], settings, group_names: list[str], inline=()) -> list[RuleHits]:
-    """Give lint's ``hits`` their level, visibility threshold and unit from ``settings`` and drop the
-    suppressed ones.
+    """Lint's ``hits`` with their level, visibility threshold and unit from ``settings``, the suppressed
+    ones dropped: new records, ``hits`` are left as they are.
 
     Suppressed are the findings in a group that a ``path::group`` per-file
     ignore names (``settings.group_ignores``: glob over ``group_names``) and the
@@ -204,15 +204,13 @@ def settle(hits: list[RuleHits], settings, group_names: list[str], inline=()) ->
     """
     from .rules import RULES
 
+    limits = settings.visible_limits
     settled = []
     for h in hits:
-        rule = RULES[h.code]
-        h.level, h.unit = settings.level(h.code), h.unit or rule.unit_for(settings.measure)
-        h.error_above = settings.error_above(h.code)
-        if h.visible is not None:
-            limits = settings.visible_limits
-            h.visible.limits = (limits.error, limits.warning, limits.min_shift)
-            h.visible.fixed = h.code in settings.levels
+        visible = h.visible and replace(h.visible, limits=(limits.error, limits.warning, limits.min_shift),
+                                        fixed=h.code in settings.levels)
+        h = replace(h, level=settings.level(h.code), unit=h.unit or RULES[h.code].unit_for(settings.measure),
+                    error_above=settings.error_above(h.code), visible=visible)
         silenced = np.zeros(len(h), dtype=bool)
         groups = [i for i, name in enumerate(group_names)
                   if any(fnmatchcase(name, glob) and _matches(h.code, codes) for glob, codes in settings.group_ignores)]
@@ -272,16 +270,19 @@ def share_authored_geometry(hits: list[RuleHits], mesh) -> tuple[list[RuleHits],
         keep.sort()
         out = h.subset(keep)
         out.faces, out.groups = faces[keep], groups[keep]
-        _record_prim_values(h, faces, prim, owner, starts, members, entry_of)
+        for o, values in prim_values(h, faces, prim, owner, starts, members).items():
+            entry_of[o]["values"][h.code] = values
         merged.append(out)
     return merged, shared
 
 
-def _record_prim_values(h: RuleHits, faces, prim, owner, starts, members, entry_of) -> None:
-    """Into each shared entry's ``values``: the faces of rule ``h`` whose prims measured differently.
+def prim_values(h: RuleHits, faces, prim, owner, starts, members) -> dict[int, list]:
+    """First prim of a shared mesh -> the faces of rule ``h`` whose prims measured differently there, as
+    :attr:`FileReport.shared` keeps them: ``[face within the prim, [value per prim, None where none]]``.
 
     One (faces of the mesh, its prims) table per shared mesh with findings, NaN where a prim has none.
     """
+    found = {}
     rows = np.flatnonzero(np.isin(owner[prim], list(members)) & (h.faces >= 0))
     rows = rows[np.argsort(owner[prim[rows]], kind="stable")]
     for chunk in np.split(rows, np.flatnonzero(np.diff(owner[prim[rows]])) + 1) if len(rows) else []:
@@ -292,8 +293,8 @@ def _record_prim_values(h: RuleHits, faces, prim, owner, starts, members, entry_
         agree = np.isclose(table, table[:, :1], rtol=1e-6, atol=0, equal_nan=True).all(axis=1)
         differ = np.flatnonzero(~np.isnan(table).all(axis=1) & ~agree)
         if len(differ):
-            entry_of[o]["values"][h.code] = [
-                [int(face), [None if np.isnan(v) else float(v) for v in table[face]]] for face in differ]
+            found[o] = [[int(face), [None if np.isnan(v) else float(v) for v in table[face]]] for face in differ]
+    return found
 
 
 def report_to_bytes(report: FileReport) -> bytes:

@@ -304,7 +304,7 @@ def lint_mesh(mesh: Mesh, settings: Settings, visible: bool = True) -> list[Rule
             if reads_textures and rule.code == "Q101":
                 if preparing is not None:
                     preparing.join()
-                _read_visible(mesh, settings, found)
+                found = _read_visible(mesh, settings, found)
             hits.append(found)
     if preparing is not None:  # no Q101 finding read it: the decode is not left running into the next file
         preparing.join()
@@ -415,23 +415,24 @@ def _prepare_textures(mesh: Mesh):
     return prepare_textures(mesh)
 
 
-def _read_visible(mesh: Mesh, settings: Settings, hits: RuleHits) -> None:
-    """Q101's ``hits`` read through the textures their quads bind: C replaces the shift as the value where
-    a texture decodes (the shift kept in ``hits.visible``); a texture that does not gives a note."""
+def _read_visible(mesh: Mesh, settings: Settings, hits: RuleHits) -> RuleHits:
+    """Q101's ``hits`` read through the textures their quads bind, as new hits: C replaces the shift as the
+    value where a texture decodes (the shift kept in ``visible``); a texture that does not gives a note."""
     from .textures.reading import visible_reading
 
     found = visible_reading(mesh, settings, hits.faces, hits.values)
     if found is None:
-        return
+        return hits
     columns, notes = found
     read = np.isfinite(columns.values)
     if read.any():
-        hits.values = np.where(read, columns.values, hits.values)
-        hits.visible = columns
+        hits = replace(hits, values=np.where(read, columns.values, hits.values), visible=columns)
     if notes:
-        hits.details = hits.details or [None] * len(hits)
+        details = list(hits.details or [None] * len(hits))
         for row, note in notes.items():
-            hits.details[row] = "; ".join(filter(None, [hits.details[row], note]))
+            details[row] = "; ".join(filter(None, [details[row], note]))
+        hits = replace(hits, details=details)
+    return hits
 
 
 def quad_uv_error(mesh: Mesh, diagonal: str = "02") -> tuple[np.ndarray, np.ndarray]:

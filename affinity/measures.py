@@ -211,22 +211,24 @@ def split_error_by_component(quads: PlanarQuads, attrs: np.ndarray, diagonal: st
     E = residual_by_component(quads.areas.T, attrs)
     E *= split_scale(quads, diagonal, measure) if scale is None else scale
     if measure == "error":
-        _cap_at_extent(quads, attrs, E)
+        folded, factor = _extent_caps(quads, attrs, E)
+        E[:, folded] *= factor
     return E
 
 
-def _cap_at_extent(quads: PlanarQuads, attrs: np.ndarray, E: np.ndarray) -> None:
-    """Scale E (K, Q) down, in place, to the attribute's corner extent on quads with a
-    reflex corner (concave, bow-tie), where the closed form is only an upper bound."""
+def _extent_caps(quads: PlanarQuads, attrs: np.ndarray, E: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The quads with a reflex corner (concave, bow-tie), where the closed form is only an upper
+    bound, (n,) int64, and the factors (n,) float64 in (0, 1] that scale their E (K, Q) down to the
+    attribute's corner extent (the largest distance between two corner values)."""
     folded = np.flatnonzero(quads.reflex.any(axis=1))
     if len(folded) == 0:
-        return
+        return folded, np.ones(0)
     a = attrs[:, :, folded]
     extent = np.zeros(len(folded))
     for i, j in ((0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)):
         np.maximum(extent, np.sqrt(squared_lengths(a[:, i] - a[:, j])), out=extent)
     length = np.sqrt(squared_lengths(E[:, folded]))
-    E[:, folded] *= np.divide(extent, length, out=np.ones_like(length), where=length > extent)
+    return folded, np.divide(extent, length, out=np.ones_like(length), where=length > extent)
 
 
 def _diagonal_scale(quads: PlanarQuads, diagonal: str, measure: str) -> np.ndarray:

@@ -258,3 +258,58 @@ def test_no_private_name_is_imported_across_modules():
                 private += [f"{path.relative_to(ROOT)}:{node.lineno}: {alias.name}" for alias in node.names
                             if alias.name.startswith("_") and alias.name != "__version__"]
     assert not private, "\n".join(private)
+
+
+#: The modules a lint runs through, from the mesh's tables to the settled findings.
+LINT_PATH = ["affinity/lint.py", "affinity/findings.py", "affinity/measures.py", "affinity/geometry.py",
+             "affinity/attributes.py", "affinity/rules/*.py", "affinity/textures/reading.py"]
+
+
+def mutators(source: str) -> list[str]:
+    """``name:line`` of each function in ``source`` that writes into one of its arguments or the items
+    a loop takes from one (an attribute or item assignment, in-place arithmetic, ``append``/``update``/...),
+    whether or not it also returns something. A parameter named ``out`` is NumPy's convention for a
+    caller's buffer, and is not counted."""
+    found = []
+    for function in ast.walk(ast.parse(source)):
+        if not isinstance(function, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            continue
+        arguments = {a.arg for a in [*function.args.posonlyargs, *function.args.args, *function.args.kwonlyargs]}
+        arguments -= {"self", "cls", "out"}
+        arguments |= {name.id for node in ast.walk(function)  # for h in hits: each h is the caller's
+                      if isinstance(node, ast.For) and isinstance(node.iter, ast.Name) and node.iter.id in arguments
+                      for name in ast.walk(node.target) if isinstance(name, ast.Name)}
+        for node in ast.walk(function):
+            targets = node.targets if isinstance(node, ast.Assign) else [
+                node.target] if isinstance(node, (ast.AugAssign, ast.AnnAssign)) else []
+            written = [element for target in targets
+                       for element in (target.elts if isinstance(target, ast.Tuple) else [target])
+                       if isinstance(element, (ast.Attribute, ast.Subscript))]
+            if (isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute)
+                    and node.func.attr in ("append", "extend", "update", "setdefault", "insert", "add", "clear")):
+                written.append(node.func)
+            for target in written:
+                while isinstance(target, (ast.Attribute, ast.Subscript)):
+                    target = target.value
+                if isinstance(target, ast.Name) and target.id in arguments:
+                    found.append(f"{function.name}:{node.lineno}")
+                    break
+    return list(dict.fromkeys(found))
+
+
+def test_no_function_on_the_lint_path_writes_into_its_input():
+    """A caller reads what a lint step computed from what it returns, and its own values stay as they were
+    (issue 39: settle set its input hits' levels, the visible reading rewrote Q101's hits in place)."""
+    found = [f"{path.relative_to(ROOT)}:{where}" for pattern in LINT_PATH for path in sorted(ROOT.glob(pattern))
+             for where in mutators(path.read_text(encoding="utf-8"))]
+    assert not found, "\n".join(found)
+
+
+def test_the_mutation_check_sees_writes_into_arguments():
+    source = ("def settle(hits, settings):\n    for h in hits:\n        h.level = 1\n    return hits\n"
+              "def cap(E, folded):\n    E[:, folded] *= 2\n"
+              "def note(details, row):\n    details.append(row)\n"
+              "def fresh(hits):\n    out = list(hits)\n    out[0] = None\n    return out\n"
+              "def kernel(table, out):\n    out[:] = table\n"
+              "def local(hits):\n    copy = dict(hits)\n    copy[hits[0]] = 1\n")
+    assert mutators(source) == ["settle:3", "cap:6", "note:8"]
