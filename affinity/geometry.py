@@ -384,36 +384,43 @@ def zero_area(quads: PlanarQuads, threshold: float) -> np.ndarray:
     return (np.abs(doubled) <= quads.rounding) | (np.abs(_relative(doubled / 2, quads.size)) <= threshold)
 
 
-def nonplanarity(corners: np.ndarray) -> np.ndarray:
-    """Warp: distance between the two diagonals relative to their mean length.
+def _fold(C: np.ndarray, sides: np.ndarray, a: int, b: int) -> np.ndarray:
+    """(Q,) float64 degrees between the normals C_a, C_b (3, Q) of two triangles of a split,
+    each taken on the side of the quad's normal: ``sides`` (4, Q) holds sign(C_i . n).
 
-    w = |(p1 - p0) . n| / (|n| (|p2 - p0| + |p3 - p1|) / 2),  n = (p2 - p0) x (p3 - p1).
-
-    This is the absolute value of libigl's ``igl.quad_planarity`` (which keeps the
-    sign of the triple product, and guards |n| by an absolute 1e-8). Where the
-    diagonals are parallel (|n| <= ``DEGENERATE_AREA`` |p2 - p0| |p3 - p1|) the quad
-    lies in a plane and w = 0.
-
-    Parameters
-    ----------
-    corners : (Q, 4, 3) float64
-
-    Returns
-    -------
-    (Q,) float64, 0 for planar quads.
+    On the quad normal's side (n = d02 x d13) a flat concave or self-crossing quad, whose
+    wrong split overlaps itself, folds nothing (that is Q203's and Q204's). A triangle
+    without area has no normal and folds nothing either: that quad is Q201's.
     """
-    p = by_component(corners)
-    d02, d13 = p[:, 2] - p[:, 0], p[:, 3] - p[:, 1]
-    normal = np.empty_like(d02)
-    for d in range(3):
-        u, v = (d + 1) % 3, (d + 2) % 3
-        normal[d] = d02[u] * d13[v] - d02[v] * d13[u]
-    length02, length13 = np.sqrt(squared_lengths(d02)), np.sqrt(squared_lengths(d13))
-    parallel = np.sqrt(squared_lengths(normal)) <= DEGENERATE_AREA * length02 * length13
-    e0 = p[:, 1] - p[:, 0]
-    distance = np.abs(e0[0] * normal[0] + e0[1] * normal[1] + e0[2] * normal[2])
-    denominator = np.sqrt(squared_lengths(normal)) * (length02 + length13) / 2
-    return np.divide(distance, denominator, out=np.zeros_like(distance), where=~parallel)
+    side = sides[a] * sides[b]  # the angle between s_a C_a and s_b C_b, s = +-1 or 0
+    sine = np.sqrt(squared_lengths(cross_by_component(C[:, a], C[:, b])))
+    sine *= np.abs(side)
+    cosine = dot_by_component(C[:, a], C[:, b])
+    cosine *= side
+    cosine += 0.0  # a zeroed normal gives -0: atan2(0, -0) would be 180
+    return np.degrees(np.arctan2(sine, cosine))
+
+
+def fold_degrees(quads: PlanarQuads, diagonal: str) -> np.ndarray:
+    """(Q,) float64 fold angle in degrees of 3-D quads (PlanarQuads of Q quads).
+
+    The angle between the normals of the two triangles of the split along 0-2
+    (triangles 012 and 023, opposite corners 3 and 1) or 1-3 (123 and 130, opposite
+    corners 0 and 2), as the dihedral angle of the split surface: 0 for a planar
+    quad (see :func:`_fold`), atan2(|n1 x n2|, n1 . n2). ``diagonal`` is the
+    setting: ``"02"``, ``"13"``, ``"both"`` (the worse of the two) or
+    ``"shortest"`` (the diagonal shorter in 3-D).
+    """
+    C = quads.vector_areas
+    sides = np.sign(dot_by_component(C, quads.normals[:, None]))
+    if diagonal == "02":
+        return _fold(C, sides, 3, 1)
+    if diagonal == "13":
+        return _fold(C, sides, 0, 2)
+    fold02, fold13 = _fold(C, sides, 3, 1), _fold(C, sides, 0, 2)
+    if diagonal == "shortest":
+        return np.where(quads.diagonals[:, 0] <= quads.diagonals[:, 1], fold02, fold13)
+    return np.maximum(fold02, fold13, out=fold02)
 
 
 def is_bowtie(quads: PlanarQuads) -> np.ndarray:

@@ -2,11 +2,12 @@
 
 Quad rules apply to quads only: triangles are always affine and have no
 diagonal to split along, and n-gons are fanned by whoever renders them, so
-neither is measured (both are still counted by the mesh). Each quad rule's check
+neither is measured (both are still counted by the mesh). Every check is
+``check(context) -> Measured`` (:mod:`affinity.rules.registry`): a quad rule's
 runs on batches of quads (:class:`QuadBatch`), which compute what several rules
-share once; mesh rules (Q205) look at the whole mesh. Which side of its
-threshold a rule flags is the rule's ``flags``; rules without a threshold
-report 0 as their threshold.
+share once; a mesh rule's (Q205, Q902) on the whole mesh (:class:`WholeMesh`).
+Checks measure; lint compares their values with the thresholds, on the side the
+rule's ``flags`` names; rules without a threshold report 0 as their threshold.
 """
 
 from __future__ import annotations
@@ -115,9 +116,10 @@ def _unit_length(table: np.ndarray, out: np.ndarray) -> None:
 
 
 class QuadBatch:
-    """A batch of a mesh's quads, with what several rules share computed once, on demand.
+    """A batch of a mesh's quads, with what several rules share computed once, on demand: the context
+    of a quad rule's check (``check(batch) -> Measured``, :mod:`affinity.rules.registry`).
 
-    What a rule's check reads: ``faces`` (Q,) int64 face indices in file order,
+    What a rule's check reads: ``mesh``, ``faces`` (Q,) int64 face indices in file order,
     ``corners`` (4, Q) corner indices, ``settings``, ``texture_size`` (w, h)
     texels, (2,) for all quads or (Q, 2) per quad (:meth:`texel_size`),
     ``planar`` (the quads in their own planes), ``uv`` and
@@ -135,6 +137,10 @@ class QuadBatch:
 
     def __len__(self) -> int:
         return len(self.faces)
+
+    @property
+    def mesh(self) -> Mesh:
+        return self.tables.mesh
 
     def corner_indices(self, name: str) -> np.ndarray | None:
         """(4, Q) int64 indices into table ``name`` at the batch's corners; taken once per
@@ -186,6 +192,20 @@ class QuadBatch:
     @cached_property
     def uv_planar(self) -> PlanarQuads:
         return planar_quads_by_component(self.uv[1])
+
+
+@dataclass(frozen=True)
+class WholeMesh:
+    """The context of a mesh rule's check (``check(context) -> Measured``, :mod:`affinity.rules.registry`):
+    the ``mesh`` and the ``settings``; its one face is the file itself, -1 (Q205, Q902)."""
+
+    mesh: Mesh
+    settings: Settings
+
+    @property
+    def faces(self) -> np.ndarray:
+        """(1,) int64: the file, as face -1."""
+        return np.array([-1])
 
 
 def texture_grid(mesh: Mesh, settings: Settings) -> tuple[tuple[int, int], bool]:
@@ -259,12 +279,13 @@ def lint_mesh(mesh: Mesh, settings: Settings, visible: bool = True) -> list[Rule
                       and mesh.texcoords is not None and (mesh.material_maps or mesh.material_textures))
     preparing = _prepare_textures(mesh) if reads_textures else None
     hits = []
-    for rule in enabled:
-        found = rule.check(mesh, settings) if rule.scope == "mesh" else None
-        if found is not None:
-            faces, lines, values, *details = found  # a mesh rule may add one detail per finding
-            hits.append(RuleHits(rule.code, faces, lines, values, 0.0, np.zeros(len(faces), dtype=np.int32),
-                                 details=details[0] if details else None))
+    whole = WholeMesh(mesh, settings)
+    for rule in (rule for rule in enabled if rule.scope == "mesh"):
+        found = rule.check(whole)
+        if len(found.values):
+            faces = whole.faces[found.rows]
+            hits.append(RuleHits(rule.code, faces, mesh.face_line[faces] if found.lines is None else found.lines,
+                                 found.values, 0.0, np.zeros(len(faces), dtype=np.int32), details=found.details))
     quad_rules = [rule for rule in enabled if rule.scope == "quad"]
     thresholds = {rule.code: settings.threshold(rule.code) if rule.has_threshold else None for rule in quad_rules}
 
@@ -274,8 +295,8 @@ def lint_mesh(mesh: Mesh, settings: Settings, visible: bool = True) -> list[Rule
         found = {}
         causes = Unmeasurable(batch)
         for rule in quad_rules:
-            rows, values = rule.check(batch)
-            rows = np.arange(len(batch))[rows]
+            measured = rule.check(batch)
+            rows, values = np.arange(len(batch))[measured.rows], measured.values
             threshold = thresholds[rule.code]
             if threshold is not None:
                 flagged = rule.flagged(values, threshold)
@@ -363,8 +384,8 @@ class Unmeasurable:
 
         collapsed = np.zeros(len(self.batch), dtype=bool)
         if self.batch.tables.tables.get("texcoords") is not None:
-            rows, area = uv_degenerate(self.batch)
-            collapsed[rows] = RULES["Q301"].flagged(area, self.batch.settings.threshold("Q301"))
+            area = uv_degenerate(self.batch)
+            collapsed[area.rows] = RULES["Q301"].flagged(area.values, self.batch.settings.threshold("Q301"))
         return collapsed
 
     def masked(self, rule) -> np.ndarray:

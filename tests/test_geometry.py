@@ -1,4 +1,4 @@
-"""Quad shape measures: own plane, warp (against libigl), degenerate, concave, bow-tie, UV area."""
+"""Quad shape measures: own plane, fold (against libigl), degenerate, concave, bow-tie, UV area."""
 
 import numpy as np
 import pytest
@@ -6,10 +6,10 @@ import pytest
 from affinity.geometry import (
     DEGENERATE_AREA,
     degeneracy,
+    fold_degrees,
     folded_fraction,
     interior_angles,
     is_bowtie,
-    nonplanarity,
     planar_quads,
     plane_coordinates,
     quad_normals,
@@ -61,31 +61,42 @@ def test_normal_follows_the_winding_also_for_quads_facing_sideways():
 
 
 @pytest.mark.parametrize("scale", [1e-6, 1.0, 1e6])
-def test_warp_agrees_with_libigl_quad_planarity(scale):
+@pytest.mark.parametrize("diagonal", ["02", "13", "both", "shortest"])
+def test_fold_agrees_with_the_angle_between_libigls_triangle_normals(scale, diagonal):
+    """Q202's measure (what ``affinity check`` runs) against libigl: per_face_normals of the split's two
+    triangles, 012 and 023 along 0-2, 123 and 130 along 1-3, and the angle between them."""
     igl = pytest.importorskip("igl")
     rng = np.random.default_rng(2)
     base = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], float)
-    corners = (base + rng.normal(scale=0.2, size=(200, 4, 3))) * scale
-    reference = igl.quad_planarity(corners.reshape(-1, 3), np.arange(800).reshape(-1, 4))
-    if scale < 1:  # libigl guards its denominator with an absolute 1e-8 and gives 0
-        assert (reference == 0).all()
-    else:
-        np.testing.assert_allclose(nonplanarity(corners), np.abs(reference), rtol=1e-9)
-    np.testing.assert_allclose(nonplanarity(corners), nonplanarity(corners / scale), rtol=1e-9)
+    corners = (base + rng.normal(scale=0.12, size=(300, 4, 3))) * scale
+    triangles = {"02": [[0, 1, 2], [0, 2, 3]], "13": [[1, 2, 3], [1, 3, 0]]}
+    angle = {}
+    for split, (first, second) in triangles.items():
+        faces = np.arange(1200).reshape(-1, 4)
+        both = np.concatenate([faces[:, first], faces[:, second]])
+        normals = igl.per_face_normals(corners.reshape(-1, 3), both, np.array([0.0, 0.0, 1.0]))
+        n1, n2 = normals[:300], normals[300:]
+        angle[split] = np.degrees(np.arccos(np.clip(np.einsum("qd,qd->q", n1, n2), -1, 1)))
+        assert (n1[:, 2] > 0).all() and (n2[:, 2] > 0).all(), "every triangle faces up: no quad folds over"
+    lengths = np.linalg.norm(corners[:, [2, 3]] - corners[:, [0, 1]], axis=2)
+    expected = {"02": angle["02"], "13": angle["13"], "both": np.maximum(angle["02"], angle["13"]),
+                "shortest": np.where(lengths[:, 0] <= lengths[:, 1], angle["02"], angle["13"])}[diagonal]
+    np.testing.assert_allclose(fold_degrees(planar_quads(corners), diagonal), expected, rtol=1e-6, atol=1e-6)
 
 
-def test_warp_of_a_lifted_corner_is_the_diagonals_distance_over_their_mean_length():
-    h = 0.3
-    corners = lift(SQUARE)
-    corners[0, 2, 2] = h  # unit square with corner 2 lifted
-    p0, p1, p2, p3 = corners[0]
-    # closest points of the two diagonal lines p0 + s (p2 - p0) and p1 + t (p3 - p1)
-    (s, t), *_ = np.linalg.lstsq(np.column_stack([p2 - p0, p1 - p3]), p1 - p0, rcond=None)
-    distance = np.linalg.norm(p0 + s * (p2 - p0) - p1 - t * (p3 - p1))
-    expected = distance / ((np.linalg.norm(p2 - p0) + np.linalg.norm(p3 - p1)) / 2)
-    np.testing.assert_allclose(nonplanarity(corners), [expected])
-    assert 0 < expected < h
-    assert nonplanarity(lift(SQUARE, np.eye(3)[[2, 0, 1]]))[0] == 0
+def test_fold_of_a_lifted_corner_is_the_closed_form():
+    """The unit square with corner 2 lifted by h: along 0-2 the triangle normals are (0, -h, 1) and
+    (-h, 0, 1), cos = 1 / (1 + h^2); along 1-3 they are (-h, -h, 1) and (0, 0, 1), cos = 1 / sqrt(1 + 2 h^2)."""
+    h = np.array([0.0, 1e-3, 0.3, 1.0, 4.0])
+    corners = np.repeat(lift(SQUARE), len(h), axis=0)
+    corners[:, 2, 2] = h
+    along_02 = np.degrees(np.arccos(1 / (1 + h**2)))
+    along_13 = np.degrees(np.arccos(1 / np.sqrt(1 + 2 * h**2)))
+    quads = planar_quads(corners)
+    np.testing.assert_allclose(fold_degrees(quads, "02"), along_02, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(fold_degrees(quads, "13"), along_13, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(fold_degrees(quads, "both"), along_02, rtol=1e-9, atol=1e-9)  # 0-2 is the worse
+    assert fold_degrees(quads, "both")[3] == pytest.approx(60.0)  # Q202's page: the corner lifted by 1
 
 
 @pytest.mark.parametrize("scale", [1e-6, 1.0, 1e6])

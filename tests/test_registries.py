@@ -30,7 +30,7 @@ from affinity.output import FORMATS
 from affinity.pipeline import check as check_module
 from affinity.pipeline.cache import ResultCache
 from affinity.pipeline.check import check_file, check_files
-from affinity.rules import RULES, rule, unregister
+from affinity.rules import RULES, Measured, rule, unregister
 from affinity.settings import Settings
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -186,11 +186,11 @@ def q104():
         How to fix:
             Re-UV the quad as a parallelogram.
         """
-        size = _normal_map_size(quads.tables.mesh)
+        size = _normal_map_size(quads.mesh)
         rows, uv = quads.uv
         if size is None:
-            return np.zeros(0, dtype=np.int64), np.zeros(0)
-        return rows, texels(quads.split_error(rows, uv).T, size)
+            return Measured.nothing()
+        return Measured(rows, texels(quads.split_error(rows, uv).T, size))
 
     try:
         yield RULES["Q104"]

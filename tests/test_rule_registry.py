@@ -11,7 +11,7 @@ import pytest
 from affinity import cli
 from affinity.lint import lint_mesh
 from affinity.loaders import load
-from affinity.rules import RULES, Rule, register, rules_table, unregister
+from affinity.rules import RULES, Measured, Rule, register, rules_table, unregister
 from affinity.settings import Settings
 
 
@@ -41,9 +41,9 @@ def test_each_rules_example_triggers_that_rule_and_only_it(code, tmp_path, monke
     assert "\n".join(lines) + "\n" == rule.example_output
 
 
-def count_corners(quads) -> tuple:
+def count_corners(quads) -> Measured:
     """A synthetic measure: the number of corners of every quad (always 4)."""
-    return slice(None), np.full(len(quads), 4.0)
+    return Measured(slice(None), np.full(len(quads), 4.0))
 
 
 @pytest.fixture
@@ -83,3 +83,27 @@ def test_a_rule_registered_at_run_time_is_everywhere(synthetic_rule, tmp_path, m
 def test_a_code_registers_once(synthetic_rule):
     with pytest.raises(ValueError, match="Q999"):
         register(synthetic_rule)
+
+
+def test_the_registry_shows_how_to_add_a_rule_with_code_that_works(tmp_path, monkeypatch, capsys):
+    """The module docstring of affinity/rules/registry.py, run as it is, registers a rule whose page's
+    example (a 2 by 1 rectangle: longest edge 2, closed form) prints the page's Prints line."""
+    import textwrap
+
+    from affinity.rules import registry
+
+    source = textwrap.dedent(registry.__doc__.split("::\n", 1)[1].split("\nCodes never change")[0])
+    namespace: dict = {}
+    exec(compile(source, "affinity/rules/registry.py docstring", "exec"), namespace)
+    try:
+        rule = RULES["Q999"]
+        assert rule.check is namespace["long_edge"] and rule.name == "long-edge"
+        (tmp_path / "example.obj").write_text(rule.example)
+        monkeypatch.chdir(tmp_path)
+        status, out, err = check(["check", "--select", "Q999", "--fail-on", "warning", "example.obj"], capsys)
+        assert status == 1, err
+        assert [line for line in out.splitlines() if not line.startswith("Found ")] == rule.example_output.splitlines()
+        assert "(2 vs 1 units)" in rule.example_output
+    finally:
+        unregister("Q999")
+    assert "Q999" not in RULES

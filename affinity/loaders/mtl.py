@@ -65,12 +65,6 @@ def map_statements(path) -> list[tuple[str, str, TextureMap]]:
     return maps
 
 
-def read_material_textures(path) -> dict[str, str]:
-    """Material name -> ``map_Kd`` path (resolved against the .mtl's folder; the last statement
-    of a material wins). A missing or unreadable file gives an empty dict."""
-    return {material: texture for role, material, _, texture in material_maps(path) if role == "map_Kd"}
-
-
 def texture_file_name(arguments: list[str]) -> str:
     """The file name of a ``map_Kd`` statement after its options.
 

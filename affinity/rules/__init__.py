@@ -6,8 +6,9 @@
 - :mod:`.texture`: Q301-Q302, the quad in texture space;
 - :mod:`.docs`: a rule's page and the README's table, from the registry.
 
-A rule is its check decorated with ``@rule(code=..., name=..., ...)``; the check's
-docstring is the rule's page (:func:`.registry.page_fields`). Adding a rule touches
+A rule is its check decorated with ``@rule(code=..., name=..., ...)``, one signature for
+all, ``check(context) -> Measured`` (:mod:`.registry`); the check's docstring is the
+rule's page (:func:`.registry.page_fields`). Adding a rule touches
 its module only: lint, the report, SARIF, ``affinity rules`` and the README table
 read :data:`RULES`.
 """
@@ -15,7 +16,18 @@ read :data:`RULES`.
 from . import affinity, file, shape, texture  # noqa: F401  each registers its rules
 from .docs import SECTIONS, rule_page, rules_table, threshold_text, with_unit
 from .file import UNREADABLE
-from .registry import LEVELS, RULES, Rule, page_fields, register, resolve_codes, rule, scoring_rules, unregister
+from .registry import (
+    LEVELS,
+    RULES,
+    Measured,
+    Rule,
+    page_fields,
+    register,
+    resolve_codes,
+    rule,
+    scoring_rules,
+    unregister,
+)
 
 
 def find_rule(key: str) -> Rule | None:
@@ -27,5 +39,5 @@ def find_rule(key: str) -> Rule | None:
     return None
 
 
-__all__ = ["LEVELS", "RULES", "SECTIONS", "UNREADABLE", "Rule", "find_rule", "page_fields", "register",
+__all__ = ["LEVELS", "RULES", "SECTIONS", "UNREADABLE", "Measured", "Rule", "find_rule", "page_fields", "register",
            "resolve_codes", "rule", "rule_page", "rules_table", "scoring_rules", "threshold_text", "unregister", "with_unit"]

@@ -4,9 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..geometry import squared_lengths
 from ..measures import barycentric_score, color_steps, normal_degrees, texels
-from .registry import rule
+from .registry import Measured, rule
 
 #: The paper's own tolerance for its dimensionless barycentric reading.
 BARYCENTRIC_TOLERANCE = 0.01
@@ -29,7 +28,7 @@ REFERENCES = (
 
 @rule(code="Q101", name="uv-disaffine", unit="texels", default_threshold=0.5, visible_threshold=2.0, attribute="texcoords", scored=True,
       readings={"barycentric": ("barycentric score", BARYCENTRIC_TOLERANCE)}, why=CREASE, references=REFERENCES)
-def uv_disaffinity(quads) -> tuple:
+def uv_disaffinity(quads) -> Measured:
     """Texture coordinates are not an affine image of the positions.
 
     What it does:
@@ -79,13 +78,13 @@ def uv_disaffinity(quads) -> tuple:
     rows, uv = quads.uv
     diagonal = quads.settings.diagonal
     if quads.settings.measure == "barycentric":
-        return rows, barycentric_score(quads.planar.take(rows), quads.uv_planar, diagonal)
-    return rows, texels(quads.split_error(rows, uv).T, quads.texel_size(rows))
+        return Measured(rows, barycentric_score(quads.planar.take(rows), quads.uv_planar, diagonal))
+    return Measured(rows, texels(quads.split_error(rows, uv).T, quads.texel_size(rows)))
 
 
 @rule(code="Q102", name="color-disaffine", unit="1/255", default_threshold=2.0, visible_threshold=8.0, attribute="colors", scored=True,
       why=CREASE, references=REFERENCES)
-def color_disaffinity(quads) -> tuple:
+def color_disaffinity(quads) -> Measured:
     """Vertex colours are not an affine image of the positions.
 
     What it does:
@@ -112,12 +111,12 @@ def color_disaffinity(quads) -> tuple:
         makes every tool draw the same one.
     """
     rows, colors = quads.complete("colors")
-    return rows, color_steps(quads.split_error(rows, colors).T)
+    return Measured(rows, color_steps(quads.split_error(rows, colors).T))
 
 
 @rule(code="Q103", name="normal-disaffine", unit="degrees", default_threshold=2.0, visible_threshold=8.0, attribute="normals", scored=True,
       why=CREASE, references=REFERENCES)
-def normal_disaffinity(quads) -> tuple:
+def normal_disaffinity(quads) -> Measured:
     """Normals are not an affine image of the positions.
 
     What it does:
@@ -149,15 +148,4 @@ def normal_disaffinity(quads) -> tuple:
         only makes every tool shade the same one.
     """
     rows, unit = quads.complete("normals")  # unit length already (see affinity.lint.CornerTables.gather)
-    m = quads.split_error(rows, unit)
-    # The angle atan2(|m|, |mean normal|) exceeds the threshold only where
-    # |m| > tan(threshold) |mean normal|: the arctangent is taken for those only.
-    threshold = quads.settings.threshold("Q103")
-    picked = slice(None)
-    if 0 <= threshold < 89:  # a negative threshold (every value wanted) picks every quad
-        m_length = np.sqrt(squared_lengths(m))
-        mean_length = np.sqrt(squared_lengths(unit.sum(axis=1))) / 4
-        picked = np.flatnonzero(m_length >= mean_length * (np.tan(np.radians(threshold)) * (1 - 1e-9)))
-    rows = np.arange(len(quads))[rows][picked]
-    degrees = normal_degrees(m.T[picked], np.transpose(unit, (2, 1, 0))[picked])
-    return rows, degrees
+    return Measured(rows, normal_degrees(quads.split_error(rows, unit).T, np.transpose(unit, (2, 1, 0))))

@@ -6,7 +6,7 @@ import os
 
 import numpy as np
 
-from .registry import RULES, Rule, page_fields, rule
+from .registry import RULES, Measured, Rule, page_fields, rule
 
 FORMATS = (
     "The file formats read: Wavefront OBJ (Appendix B1 of the Advanced Visualizer manual, v/vt/vn/f), "
@@ -15,7 +15,7 @@ FORMATS = (
 
 
 @rule(code="Q205", name="no-faces", unit="vertices", scope="mesh", references=FORMATS)
-def no_faces(mesh, settings) -> tuple | None:
+def no_faces(context) -> Measured:
     """The mesh has vertices but no faces.
 
     What it does:
@@ -38,9 +38,10 @@ def no_faces(mesh, settings) -> tuple | None:
     How to fix:
         Re-export the mesh with faces enabled in the exporter's geometry options.
     """
+    mesh = context.mesh
     if mesh.n_faces or not len(mesh.positions):
-        return None
-    return np.array([-1]), np.array([1]), np.array([float(len(mesh.positions))])
+        return Measured.nothing()
+    return Measured(np.array([0]), np.array([float(len(mesh.positions))]), lines=np.array([1]))
 
 
 def unusable_resource(path: str, image: bool) -> str | None:
@@ -68,7 +69,7 @@ def unusable_resource(path: str, image: bool) -> str | None:
 
 @rule(code="Q902", name="missing-resource", level="info", scope="mesh",
       references="Wavefront OBJ and MTL (Advanced Visualizer manual, Appendix B1 and B2: mtllib, map_Kd).")
-def missing_resources(mesh, settings) -> tuple | None:
+def missing_resources(context) -> Measured:
     """An mtllib or map_Kd named by the file cannot be found or read.
 
     What it does:
@@ -102,10 +103,11 @@ def missing_resources(mesh, settings) -> tuple | None:
     # roles), each looked at once; a USD stage's layers are pxr's to compose, and their
     # changes reach the cache, but a missing one is not a finding (Q902 is about OBJ and MTL). A finding sits on the line that pulls the file in
     # (face -1); its detail names the resource and, where the texel unit would have come
-    # from that texture, the texture-size used instead. Returns (faces, lines, values, details) or None.
+    # from that texture, the texture-size used instead.
     from ..loaders.resources import ROLES
     from ..output.names import printable  # names come from the file: never send its control characters
 
+    mesh, settings = context.mesh, context.settings
     folder = os.path.dirname(mesh.path)
     texels = mesh.texcoords is not None and "Q101" in RULES
     used = mesh.texture_path()
@@ -128,10 +130,8 @@ def missing_resources(mesh, settings) -> tuple | None:
             shown = os.path.relpath(resource.path, folder) if folder else resource.path
             details.append(f"{role.statement} {printable(shown)} (in {printable(resource.library)}) {problem}"
                            + (fallback if texels and resource.path == used else ""))
-    if not lines:
-        return None
     n = len(lines)
-    return np.full(n, -1), np.array(lines, dtype=np.int64), np.zeros(n), details
+    return Measured(np.zeros(n, dtype=np.int64), np.zeros(n), lines=np.array(lines, dtype=np.int64), details=details)
 
 
 UNREADABLE_PAGE = """File cannot be parsed.

@@ -4,26 +4,45 @@ Lint (:mod:`affinity.lint`), the report, routing by lint, the SARIF rule
 descriptions, ``affinity rules``/``affinity rule`` and the README's rule table all
 read :data:`RULES`; nothing else lists rules. A rule is its check, decorated with
 its facts; the check's docstring is the rule's page (as ruff keeps a rule's doc
-and check in one file)::
+and check in one file).
 
-    @rule(code="Q999", name="my-rule", unit="texels", default_threshold=1.0)
-    def my_check(quads):
-        '''What a finding means, as one line.
+Every check has one signature, ``check(context) -> Measured``: the context holds
+the ``mesh``, the ``settings`` and the ``faces`` the check measures (a batch of
+the mesh's quads for a rule of scope ``"quad"``, with what several rules share
+computed once: :class:`affinity.lint.QuadBatch`; the file itself, face -1, for
+a rule of scope ``"mesh"``: :class:`affinity.lint.WholeMesh`), and the check
+returns its values on some of those faces (:class:`Measured`). A check measures;
+it never reads its own threshold: lint compares the values with it. Adding a
+rule is one decorated function (tests/test_rule_registry.py runs this one)::
+
+    import numpy as np
+
+    from affinity.rules import Measured, rule
+
+
+    @rule(code="Q999", name="long-edge", unit="units", default_threshold=1.0)
+    def long_edge(context) -> Measured:
+        '''A quad has an edge longer than the threshold.
 
         What it does:
-            ...
+            Measures each quad's longest edge, in the mesh's units.
         Why it matters:
-            ...
+            A long edge spans many texels.
         Example:
+            # a 2 by 1 rectangle
             v 0 0 0
-            ...
+            v 2 0 0
+            v 2 1 0
+            v 0 1 0
+            f 1 2 3 4
         Prints:
-            example.obj:5:1: Q999 warning my-rule: ...
+            example.obj:6:1: Q999 warning long-edge: a quad has an edge longer than the threshold (2 vs 1 units) [face 0]
         References:
-            ...
+            None: an example.
         How to fix:
-            ...
+            Subdivide the quad.
         '''
+        return Measured(slice(None), np.asarray(context.planar.size))
 
 Codes never change; names are kebab-case.
 """
@@ -36,6 +55,30 @@ from dataclasses import dataclass, field
 import numpy as np
 
 LEVELS = ("error", "warning", "info")
+
+
+@dataclass(frozen=True)
+class Measured:
+    """What every check returns: its values on some of its context's faces.
+
+    Attributes
+    ----------
+    rows : (n,) int64 positions in ``context.faces``, or a slice (every face of the context)
+    values : (n,) float64 in the rule's unit, whatever the threshold (lint compares them with it)
+    lines : (n,) int64 source line of each value where it is not its face's (a finding on the file,
+        face -1, sits on the statement that caused it: Q902's ``mtllib`` line); None: the faces' lines
+    details : one remark per value, said after the rule's summary (Q902 names the resource); None: none
+    """
+
+    rows: np.ndarray | slice
+    values: np.ndarray
+    lines: np.ndarray | None = None
+    details: list[str | None] | None = None
+
+    @classmethod
+    def nothing(cls) -> Measured:
+        """No value: the check found nothing to measure."""
+        return cls(np.zeros(0, dtype=np.int64), np.zeros(0))
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -64,10 +107,10 @@ class Rule:
         asymmetric glyph in texture space (a symmetric pattern looks the same mirrored)
     folding : a finding is the split folding along its diagonal: its report close-up draws the shaded surface,
         lit across the fold, with the diagonal (texture lines are affine on either triangle and show no fold)
-    scope : ``"quad"``: ``check(quads) -> (rows, values)`` over a batch of quads
-        (``affinity.lint.QuadBatch``; ``rows`` index the batch, a slice for all);
-        ``"mesh"``: ``check(mesh, settings) -> (faces, lines, values)`` or None
-    check : the measure, vectorized
+    scope : the faces a check's context holds: ``"quad"``, a batch of the mesh's quads
+        (:class:`affinity.lint.QuadBatch`); ``"mesh"``, the file itself as face -1
+        (:class:`affinity.lint.WholeMesh`: Q205, Q902)
+    check : ``check(context) -> Measured``, the measure, vectorized over the context's faces
     what, why, fix : the page's *What it does*, *Why it matters*, *How to fix*
     example : a 4- to 8-line OBJ that triggers this rule and no other
     example_output : the text lines ``affinity check`` prints for ``example``

@@ -4,17 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..geometry import (
-    PlanarQuads,
-    cross_by_component,
-    degeneracy,
-    dot_by_component,
-    folded_fraction,
-    interior_angles,
-    is_bowtie,
-    squared_lengths,
-)
-from .registry import rule
+from ..geometry import degeneracy, fold_degrees, folded_fraction, interior_angles, is_bowtie
+from .registry import Measured, rule
 
 REFERENCES = ("Bloomenthal 2022, §3.4 (nonplanar and degenerate quads); "
               "Hormann & Tarini 2004, §4 (concave and self-crossing quads).")
@@ -22,7 +13,7 @@ REFERENCES = ("Bloomenthal 2022, §3.4 (nonplanar and degenerate quads); "
 
 @rule(code="Q201", name="degenerate-quad", unit="relative area", default_threshold=1e-9, flags="at-or-below",
       worst="lowest", references=REFERENCES)
-def degenerate(quads) -> tuple:
+def degenerate(quads) -> Measured:
     """Zero area, collapsed edge or repeated corner.
 
     What it does:
@@ -54,51 +45,12 @@ def degenerate(quads) -> tuple:
         is dissolved (Blender: Mesh > Clean Up > Degenerate Dissolve), and its
         neighbours' attributes are then measured as usual.
     """
-    return slice(None), degeneracy(quads.planar)
-
-
-def _fold(C: np.ndarray, sides: np.ndarray, a: int, b: int) -> np.ndarray:
-    """(Q,) float64 degrees between the normals C_a, C_b (3, Q) of two triangles of a split,
-    each taken on the side of the quad's normal: ``sides`` (4, Q) holds sign(C_i . n).
-
-    On the quad normal's side (n = d02 x d13) a flat concave or self-crossing quad, whose
-    wrong split overlaps itself, folds nothing (that is Q203's and Q204's). A triangle
-    without area has no normal and folds nothing either: that quad is Q201's.
-    """
-    side = sides[a] * sides[b]  # the angle between s_a C_a and s_b C_b, s = +-1 or 0
-    sine = np.sqrt(squared_lengths(cross_by_component(C[:, a], C[:, b])))
-    sine *= np.abs(side)
-    cosine = dot_by_component(C[:, a], C[:, b])
-    cosine *= side
-    cosine += 0.0  # a zeroed normal gives -0: atan2(0, -0) would be 180
-    return np.degrees(np.arctan2(sine, cosine))
-
-
-def fold_degrees(quads: PlanarQuads, diagonal: str) -> np.ndarray:
-    """(Q,) float64 fold angle in degrees of 3-D quads (PlanarQuads of Q quads).
-
-    The angle between the normals of the two triangles of the split along 0-2
-    (triangles 012 and 023, opposite corners 3 and 1) or 1-3 (123 and 130, opposite
-    corners 0 and 2), as the dihedral angle of the split surface: 0 for a planar
-    quad (see :func:`_fold`), atan2(|n1 x n2|, n1 . n2). ``diagonal`` is the
-    setting: ``"02"``, ``"13"``, ``"both"`` (the worse of the two) or
-    ``"shortest"`` (the diagonal shorter in 3-D).
-    """
-    C = quads.vector_areas
-    sides = np.sign(dot_by_component(C, quads.normals[:, None]))
-    if diagonal == "02":
-        return _fold(C, sides, 3, 1)
-    if diagonal == "13":
-        return _fold(C, sides, 0, 2)
-    fold02, fold13 = _fold(C, sides, 3, 1), _fold(C, sides, 0, 2)
-    if diagonal == "shortest":
-        return np.where(quads.diagonals[:, 0] <= quads.diagonals[:, 1], fold02, fold13)
-    return np.maximum(fold02, fold13, out=fold02)
+    return Measured(slice(None), degeneracy(quads.planar))
 
 
 @rule(code="Q202", name="nonplanar-quad", unit="degrees", default_threshold=45.0, folding=True,
       references=REFERENCES)
-def nonplanar(quads) -> tuple:
+def nonplanar(quads) -> Measured:
     """The split folds: the two triangles meet at an angle along the diagonal.
 
     What it does:
@@ -130,11 +82,11 @@ def nonplanar(quads) -> tuple:
         Flatten the quad (Blender: Mesh > Clean Up > Make Planar Faces), subdivide
         it, or triangulate it along the intended diagonal.
     """
-    return slice(None), fold_degrees(quads.planar, quads.settings.diagonal)
+    return Measured(slice(None), fold_degrees(quads.planar, quads.settings.diagonal))
 
 
 @rule(code="Q203", name="concave-quad", level="info", unit="degrees", default_threshold=180.0, references=REFERENCES)
-def concave(quads) -> tuple:
+def concave(quads) -> Measured:
     """One corner is reflex.
 
     What it does:
@@ -170,12 +122,12 @@ def concave(quads) -> tuple:
         candidates &= (planar.areas < -0.5 * planar.tolerance[:, None]).any(axis=1)
     rows = np.flatnonzero(candidates)
     if len(rows) == 0:
-        return rows, np.zeros(0)
-    return rows, interior_angles(planar.take(rows)).max(axis=1)
+        return Measured.nothing()
+    return Measured(rows, interior_angles(planar.take(rows)).max(axis=1))
 
 
 @rule(code="Q204", name="bowtie-quad", level="error", unit="folded fraction", references=REFERENCES)
-def bowtie(quads) -> tuple:
+def bowtie(quads) -> Measured:
     """The quad crosses itself.
 
     What it does:
@@ -203,4 +155,4 @@ def bowtie(quads) -> tuple:
         (Blender: select the four vertices, F).
     """
     rows = np.flatnonzero(is_bowtie(quads.planar))
-    return rows, folded_fraction(quads.planar.take(rows))
+    return Measured(rows, folded_fraction(quads.planar.take(rows)))

@@ -5,12 +5,12 @@ from __future__ import annotations
 import numpy as np
 
 from ..geometry import relative_signed_area
-from .registry import rule
+from .registry import Measured, rule
 
 
 @rule(code="Q301", name="uv-degenerate", unit="relative area", default_threshold=1e-9, flags="at-or-below",
       worst="lowest", attribute="texcoords")
-def uv_degenerate(quads) -> tuple:
+def uv_degenerate(quads) -> Measured:
     """Zero area in texture space.
 
     What it does:
@@ -43,12 +43,12 @@ def uv_degenerate(quads) -> tuple:
         it, UV > Unwrap); the texture no longer smears over it, and Q101 then
         measures its affinity.
     """
-    return quads.uv[0], np.abs(relative_signed_area(quads.uv_planar))
+    return Measured(quads.uv[0], np.abs(relative_signed_area(quads.uv_planar)))
 
 
 @rule(code="Q302", name="uv-flipped", level="info", unit="relative area", worst="lowest", attribute="texcoords",
       mirroring=True)
-def uv_flipped(quads) -> tuple:
+def uv_flipped(quads) -> Measured:
     """Texture orientation reversed against the surface.
 
     What it does:
@@ -88,4 +88,4 @@ def uv_flipped(quads) -> tuple:
     rows = np.arange(len(quads))[quads.uv[0]]
     area = relative_signed_area(quads.uv_planar)
     flipped = area < -quads.settings.threshold("Q301")
-    return rows[flipped], area[flipped]
+    return Measured(rows[flipped], area[flipped])

@@ -34,8 +34,3 @@ FAMILIES = (
     Family("UvLayout", ("Q301", "Q302"), False,
            "quad-affinity Q301-Q302: quads with no area in texture space, or mirrored against the surface."),
 )
-
-
-def family_of(code: str) -> Family:
-    """The family that runs rule ``code``."""
-    return next(family for family in FAMILIES if code in family.codes)
