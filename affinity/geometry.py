@@ -70,29 +70,8 @@ def by_component(corners: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(np.transpose(np.asarray(corners, dtype=np.float64), (2, 1, 0)))
 
 
-# Corner-major helpers: ``p`` is (4, Q, D), p[k] the k-th corner of every quad.
-_NEXT, _PREVIOUS = [1, 2, 3, 0], [3, 0, 1, 2]
 #: C_{k-2}, the corner turn at corner k, for k = 0..3 (component-major; see :func:`_opposite_areas`).
 _CORNER_TURN_AT = [2, 3, 0, 1]
-
-
-def _diagonals_parallel(n: np.ndarray, d02: np.ndarray, d13: np.ndarray) -> np.ndarray:
-    """(Q,) bool: |d02 x d13| is at most the degenerate tolerance times |d02| |d13|
-    (the diagonals are parallel, or one of them has collapsed)."""
-    return lengths(n) <= DEGENERATE_AREA * lengths(d02) * lengths(d13)
-
-
-def _normals(p: np.ndarray) -> np.ndarray:
-    """(Q, 3) quad normals of 3-D corners; see ``quad_normals``."""
-    d02, d13 = p[2] - p[0], p[3] - p[1]
-    normals = np.cross(d02, d13)
-    weak = _diagonals_parallel(normals, d02, d13)
-    if weak.any():
-        quads = p[:, weak]
-        corner_normals = np.cross(quads - quads[_PREVIOUS], quads[_NEXT] - quads)
-        largest = lengths(corner_normals).argmax(axis=0)
-        normals[weak] = corner_normals[largest, np.arange(quads.shape[1])]
-    return normals
 
 
 def _orthonormal_basis(normal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -110,9 +89,10 @@ def _orthonormal_basis(normal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return e1, e2
 
 
-def _plane_coordinates(p: np.ndarray) -> np.ndarray:
-    """(4, Q, 2) in-plane coordinates of 3-D corners; see ``plane_coordinates``."""
-    e1, e2 = _orthonormal_basis(_unit(_normals(p)))
+def _in_plane(p: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """(4, Q, 2) in-plane coordinates of 3-D corners ``p`` (4, Q, 3) in the planes of unit ``normals``
+    (Q, 3); see ``plane_coordinates``."""
+    e1, e2 = _orthonormal_basis(normals)
     # Offsets from corner 0 first, so coordinates far from the origin keep their digits.
     offsets = p - p[0]
     xy = np.stack([_dot(offsets, e1), _dot(offsets, e2)], axis=2)
@@ -137,7 +117,7 @@ def quad_normals(corners: np.ndarray) -> np.ndarray:
     -------
     (Q, 3) float64, not normalized.
     """
-    return _normals(_corner_major(corners))
+    return planar_quads(corners).plane_normals.T
 
 
 def plane_coordinates(corners: np.ndarray) -> np.ndarray:
@@ -158,7 +138,7 @@ def plane_coordinates(corners: np.ndarray) -> np.ndarray:
     (Q, 4, 2) float64 in-plane coordinates, centroid at the origin; lengths and
     angles are preserved for planar quads.
     """
-    return np.moveaxis(_plane_coordinates(_corner_major(corners)), 0, 1)
+    return planar_quads(corners).xy
 
 
 # Component-major helpers: ``p`` is (D, 4, Q), p[d, k] component d of corner k.
@@ -246,7 +226,17 @@ class PlanarQuads:
         """(Q, 4, 2) float64 in-plane corners: ``plane_coordinates`` of 3-D corners,
         2-D corners as they are."""
         corners = np.transpose(self.components, (2, 1, 0))
-        return plane_coordinates(corners) if len(self.components) == 3 else corners
+        if len(self.components) == 2:
+            return corners
+        return np.moveaxis(_in_plane(_corner_major(corners), _unit(self.plane_normals.T)), 0, 1)
+
+    @cached_property
+    def plane_normals(self) -> np.ndarray | None:
+        """(3, Q) float64 normals of the quads' own planes (:func:`quad_normals`): :attr:`normals`, the
+        largest corner normal standing in where the diagonals are parallel; None for 2-D corners."""
+        if self.normals is None:
+            return None
+        return _with_stand_ins(self.vector_areas, self.normals, self.diagonals)
 
     @cached_property
     def valid(self) -> np.ndarray:
@@ -314,19 +304,27 @@ def planar_quads_by_component(p: np.ndarray) -> PlanarQuads:
         return PlanarQuads(C.T, size, diagonals, p)
     # d02 x d13 = c_0 + c_2 (c_k = C_{k-1} the corner turns): twice the vector area.
     normals = C[:, 3] + C[:, 1]
-    normal_length = np.sqrt(squared_lengths(normals))
+    plane = _with_stand_ins(C, normals, diagonals)
+    plane_length = np.sqrt(squared_lengths(plane))
     # T_i = C_i . n / |n|; a zero normal (all corners collinear) leaves T_i = C_i . n = 0.
-    areas = dot_by_component(C, normals[:, None])
-    np.divide(areas, normal_length, out=areas, where=normal_length > 0)
-    parallel = np.flatnonzero(normal_length <= DEGENERATE_AREA * diagonals[:, 0] * diagonals[:, 1])
-    if len(parallel):  # the largest corner normal stands in (see quad_normals)
-        corner = C[:, _CORNER_TURN_AT][:, :, parallel]  # the normal at corner k is C_{k-2}
-        largest = squared_lengths(corner).argmax(axis=0)
-        unit = corner[:, largest, np.arange(len(parallel))]
-        length = np.sqrt(squared_lengths(unit))
-        np.divide(unit, length, out=unit, where=length > 0)
-        areas[:, parallel] = dot_by_component(C[:, :, parallel], unit[:, None])
+    areas = dot_by_component(C, plane[:, None])
+    np.divide(areas, plane_length, out=areas, where=plane_length > 0)
     return PlanarQuads(areas.T, size, diagonals, p, normals, C)
+
+
+def _with_stand_ins(C: np.ndarray, normals: np.ndarray, diagonals: np.ndarray) -> np.ndarray:
+    """(3, Q) float64 plane normals: ``normals`` (3, Q), d02 x d13, where the diagonals (lengths (Q, 2)) are
+    not parallel; where they are (|d02 x d13| <= DEGENERATE_AREA |d02| |d13|: a symmetric bow-tie, a
+    collapsed diagonal) the largest corner normal C_{k-2} of the vector areas C (3, 4, Q) stands in.
+    ``normals`` itself when no quad needs a stand-in, else a new array."""
+    parallel = np.flatnonzero(np.sqrt(squared_lengths(normals)) <= DEGENERATE_AREA * diagonals[:, 0] * diagonals[:, 1])
+    if not len(parallel):
+        return normals
+    corner = C[:, _CORNER_TURN_AT][:, :, parallel]  # the normal at corner k is C_{k-2}
+    largest = squared_lengths(corner).argmax(axis=0)
+    plane = normals.copy()
+    plane[:, parallel] = corner[:, largest, np.arange(len(parallel))]
+    return plane
 
 
 def _relative(area: np.ndarray, size: np.ndarray) -> np.ndarray:

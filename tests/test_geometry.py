@@ -60,28 +60,24 @@ def test_normal_follows_the_winding_also_for_quads_facing_sideways():
     assert (planar_quads(wall).areas > 0).all()
 
 
-@pytest.mark.parametrize("scale", [1e-6, 1.0, 1e6])
-@pytest.mark.parametrize("diagonal", ["02", "13", "both", "shortest"])
-def test_fold_agrees_with_the_angle_between_libigls_triangle_normals(scale, diagonal):
-    """Q202's measure (what ``affinity check`` runs) against libigl: per_face_normals of the split's two
-    triangles, 012 and 023 along 0-2, 123 and 130 along 1-3, and the angle between them."""
-    igl = pytest.importorskip("igl")
-    rng = np.random.default_rng(2)
-    base = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], float)
-    corners = (base + rng.normal(scale=0.12, size=(300, 4, 3))) * scale
-    triangles = {"02": [[0, 1, 2], [0, 2, 3]], "13": [[1, 2, 3], [1, 3, 0]]}
-    angle = {}
-    for split, (first, second) in triangles.items():
-        faces = np.arange(1200).reshape(-1, 4)
-        both = np.concatenate([faces[:, first], faces[:, second]])
-        normals = igl.per_face_normals(corners.reshape(-1, 3), both, np.array([0.0, 0.0, 1.0]))
-        n1, n2 = normals[:300], normals[300:]
-        angle[split] = np.degrees(np.arccos(np.clip(np.einsum("qd,qd->q", n1, n2), -1, 1)))
-        assert (n1[:, 2] > 0).all() and (n2[:, 2] > 0).all(), "every triangle faces up: no quad folds over"
-    lengths = np.linalg.norm(corners[:, [2, 3]] - corners[:, [0, 1]], axis=2)
-    expected = {"02": angle["02"], "13": angle["13"], "both": np.maximum(angle["02"], angle["13"]),
-                "shortest": np.where(lengths[:, 0] <= lengths[:, 1], angle["02"], angle["13"])}[diagonal]
-    np.testing.assert_allclose(fold_degrees(planar_quads(corners), diagonal), expected, rtol=1e-6, atol=1e-6)
+def test_quad_normal_is_the_diagonals_cross_product_and_a_corner_normal_where_they_are_parallel():
+    """One quad normal (issue 39): d02 x d13 (numpy's cross product as the reference), and where the
+    diagonals are parallel (a symmetric bow-tie: its lobes cancel) the largest corner normal
+    (p_k - p_k-1) x (p_k+1 - p_k); the in-plane coordinates use the same normal."""
+    rng = np.random.default_rng(39)
+    corners = rng.normal(size=(200, 4, 3))
+    np.testing.assert_allclose(quad_normals(corners),
+                               np.cross(corners[:, 2] - corners[:, 0], corners[:, 3] - corners[:, 1]), rtol=1e-12,
+                               atol=1e-12)
+    bowtie = lift(np.array([[0, 0], [2, 1], [2, 0], [0, 1]], float)) @ np.array([[1, 0, 0], [0, 0, 1], [0, 1, 0.0]])
+    p = bowtie[0]
+    assert np.linalg.norm(np.cross(p[2] - p[0], p[3] - p[1])) < 1e-12  # parallel diagonals
+    corner_normals = [np.cross(p[k] - p[k - 1], p[(k + 1) % 4] - p[k]) for k in range(4)]
+    expected = max(corner_normals, key=np.linalg.norm)
+    np.testing.assert_allclose(quad_normals(bowtie), [expected], atol=1e-12)
+    xy = plane_coordinates(bowtie)[0]
+    distances = np.linalg.norm(p[:, None] - p[None], axis=-1)
+    np.testing.assert_allclose(np.linalg.norm(xy[:, None] - xy[None], axis=-1), distances, atol=1e-12)
 
 
 def test_fold_of_a_lifted_corner_is_the_closed_form():
@@ -169,9 +165,11 @@ def test_an_area_within_rounding_of_zero_is_degenerate():
     assert far.rounding[0] < 1e-5 and degeneracy(square)[0] == pytest.approx(0.5)
 
 
-@pytest.mark.parametrize("diagonal", ["02", "13", "both"])
-def test_q202_fold_angle_agrees_with_libigl_face_normals(diagonal):
-    """The value Q202 reports is the angle between libigl's normals of the split's two triangles."""
+@pytest.mark.parametrize("scale", [1e-6, 1.0, 1e6])
+@pytest.mark.parametrize("diagonal", ["02", "13", "both", "shortest"])
+def test_q202_fold_angle_agrees_with_libigl_face_normals(diagonal, scale):
+    """The value Q202 reports (geometry.fold_degrees, what affinity check runs) is the angle between
+    libigl's normals of the split's two triangles, at any scale."""
     igl = pytest.importorskip("igl")
     from affinity.lint import lint_mesh
     from affinity.mesh import mesh_from_polygons
@@ -184,7 +182,7 @@ def test_q202_fold_angle_agrees_with_libigl_face_normals(diagonal):
     normal = np.cross(corners[:, 2] - corners[:, 0], corners[:, 3] - corners[:, 1])
     edges = np.roll(corners, -1, axis=1) - corners
     turns = np.einsum("qck,qk->qc", np.cross(edges, np.roll(edges, -1, axis=1)), normal)
-    corners = corners[(turns > 0).all(axis=1)][:300]
+    corners = corners[(turns > 0).all(axis=1)][:300] * scale
     mesh = mesh_from_polygons("random", corners.reshape(-1, 3), np.arange(1200).reshape(-1, 4))
     (hits,) = lint_mesh(mesh, Settings(select=["Q202"], thresholds={"Q202": -1.0}, diagonal=diagonal))
     assert hits.faces.tolist() == list(range(300))
@@ -195,5 +193,7 @@ def test_q202_fold_angle_agrees_with_libigl_face_normals(diagonal):
         return np.degrees(np.arccos(np.clip((normals[:, 0] * normals[:, 1]).sum(axis=1), -1, 1)))
 
     folds = {"02": fold([[0, 1, 2], [0, 2, 3]]), "13": fold([[1, 2, 3], [1, 3, 0]])}
-    expected = np.maximum(folds["02"], folds["13"]) if diagonal == "both" else folds[diagonal]
+    lengths = np.linalg.norm(corners[:, [2, 3]] - corners[:, [0, 1]], axis=2)
+    expected = {**folds, "both": np.maximum(folds["02"], folds["13"]),
+                "shortest": np.where(lengths[:, 0] <= lengths[:, 1], folds["02"], folds["13"])}[diagonal]
     np.testing.assert_allclose(hits.values, expected, atol=1e-6)

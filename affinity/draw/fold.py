@@ -26,9 +26,10 @@ DIAGONAL_INK = np.array([0.05, 0.35, 0.85], dtype=np.float32)
 def triangle_normals(corners: np.ndarray) -> np.ndarray:
     """(Q, 2, 3) float64 unit normals of the split triangles (0, 1, 2) and (0, 2, 3) of quads ``corners``
     (Q, 4, 3); zero for a triangle without area."""
-    p = np.asarray(corners, dtype=np.float64)
-    normals = np.stack([np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]),
-                        np.cross(p[:, 2] - p[:, 0], p[:, 3] - p[:, 0])], axis=1)
+    from ..geometry import planar_quads
+
+    # The doubled vector areas C_3, C_1 of the triangles opposite corners 3 and 1, as Q202 measures the fold.
+    normals = np.transpose(planar_quads(corners).vector_areas[:, [3, 1]], (2, 1, 0))
     length = np.linalg.norm(normals, axis=-1, keepdims=True)
     return np.divide(normals, length, out=np.zeros_like(normals), where=length > 0)
 
