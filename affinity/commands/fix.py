@@ -218,11 +218,13 @@ def plan_entry(path: str, mesh, plan) -> dict:
 def write_text(entry: dict, dry_run: bool, out, quiet: bool = False) -> None:
     """The text of one file: a line per refined and per left quad (``path:line:col: ... [face F]``; not when
     ``quiet``), then what was (or would be) done."""
+    from ..rules import number_text
+
     path = entry["path"]
     verb = "would refine" if dry_run else "refined"
     for r in [] if quiet else entry["refine"]:
-        out.write(f"{r['where']}: {verb} n={r['n']}: {r['code']} {r['before']:.4g} -> {r['after']:.4g} "
-                  f"{r['unit']} [face {r['face']}]\n")
+        change = f"{number_text(r['before'])} -> {number_text(r['after'])}"
+        out.write(f"{r['where']}: {verb} n={r['n']}: {r['code']} {change} {r['unit']} [face {r['face']}]\n")
     for r in [] if quiet else entry["left"]:
         why = "needs more than --max-refine: re-UV it" if r["reason"] == "over-cap" else "not refined"
         out.write(f"{r['where']}: left ({r['reason']}): {why} [face {r['face']}]\n")

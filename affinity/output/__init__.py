@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..findings import FileReport, RuleHits
-from ..rules import LEVELS, RULES, with_unit
+from ..rules import LEVELS, RULES, number_text, number_texts, with_unit
 from ..settings import Settings
 from .names import printable
 
@@ -304,7 +304,7 @@ def _visible_fields(hits: RuleHits, take: np.ndarray, path: str) -> list[dict]:
 def visible_remark(role: str, texture: str, shift: float) -> str:
     """What a finding read through a texture says after its rule's summary: which texture and how far the
     split shifts it."""
-    return f"the split shifts the {role} texture {texture} by {format_value(shift)} texels"
+    return f"the split shifts the {role} texture {texture} by {number_text(shift)} texels"
 
 
 def badness(hits: RuleHits) -> np.ndarray:
@@ -459,18 +459,13 @@ def rule_counts(reports: list[FileReport]) -> dict[str, int]:
     return {code: n for code, n in counts.items() if n}
 
 
-def format_value(value: float) -> str:
-    """A measured value for humans: 4 significant digits, no exponent for everyday sizes."""
-    return f"{value:.4g}"
-
-
 def _measured(c: Columns) -> tuple[str, str]:
     """What follows a value in a description: its unit (``" texels"``, ``"/255"``) where there is no threshold,
     else ``" vs 0.5 texels"``."""
     unit = with_unit("", c.unit)  # what follows the number: " texels", "/255"
     if c.threshold is None:
         return unit, ""
-    return "", f" vs {format_value(c.threshold)}{unit}"
+    return "", f" vs {number_text(c.threshold)}{unit}"
 
 
 def descriptions(c: Columns) -> list[str]:
@@ -482,15 +477,15 @@ def descriptions(c: Columns) -> list[str]:
         return list(c.message)
     if c.visible is None:
         unit, against = _measured(c)
-        return [f"{m} ({v:.4g}{unit}{against})" for m, v in zip(c.message, c.value)]
+        return [f"{m} ({v}{unit}{against})" for m, v in zip(c.message, number_texts(c.value))]
     return [_described(m, v, read.get("bound"), read.get("threshold", c.threshold), read.get("unit", c.unit))
             for m, v, read in zip(c.message, c.value, c.visible)]
 
 
 def _described(message: str, value: float, bound: str | None, threshold: float | None, unit: str) -> str:
     """One finding's message with its measurement: ``... (>=12 vs 8/255)`` for a value known only as a bound."""
-    value_text = {"at least": ">=", "at most": "<="}.get(bound, "") + format_value(value)
-    measured = value_text if threshold is None else f"{value_text} vs {format_value(threshold)}"
+    value_text = {"at least": ">=", "at most": "<="}.get(bound, "") + number_text(value)
+    measured = value_text if threshold is None else f"{value_text} vs {number_text(threshold)}"
     return f"{message} ({with_unit(measured, unit)})"
 
 
@@ -534,7 +529,7 @@ def face_lines(c: Columns, escape=str) -> list[str] | None:
     escaped = {message: escape(message) for message in set(c.message)}
     return [f"{path}:{line}:{column}: {code} {level} {name}: {escaped[message]} ({value}{measured}) [face {face}]"
             for line, column, level, message, value, face in zip(
-                *c.number_texts[:2], c.level, c.message, general_texts(c.value), c.number_texts[2])]
+                *c.number_texts[:2], c.level, c.message, number_texts(c.value), c.number_texts[2])]
 
 
 def int_texts(numbers: list[int]) -> list[str]:
@@ -544,11 +539,6 @@ def int_texts(numbers: list[int]) -> list[str]:
     return str(numbers)[1:-1].split(", ") if numbers else []
 
 
-def general_texts(values: list[float]) -> list[str]:
-    """(n,) each value as :func:`format_value` writes it (``%.4g``), converted in one call."""
-    return ("%.4g," * len(values) % tuple(values)).split(",")[:-1]
-
-
 def authored_where(shared: dict | None) -> str:
     """`` [authored in LAYER:/prim, referenced by /a (3.2), /b (1.1)]`` for a finding on geometry several
     prims reference (``shared``: its :data:`SHARED_FIELDS`; each prim's own value where they differ); ``""``
@@ -556,7 +546,7 @@ def authored_where(shared: dict | None) -> str:
     if shared is None:
         return ""
     values = shared["prim_values"]
-    prims = ", ".join(p if values is None else f"{p} ({'-' if v is None else format_value(v)})"
+    prims = ", ".join(p if values is None else f"{p} ({'-' if v is None else number_text(v)})"
                       for p, v in zip(shared["prims"], values or shared["prims"]))
     layer = printable(working_relative(shared["layer"]) or shared["layer"])
     return f" [authored in {layer}:{shared['layer_prim']}, referenced by {prims}]"

@@ -16,7 +16,7 @@ import numpy as np
 
 from ..attributes import ATTRIBUTE_NAMES, ATTRIBUTES
 from ..findings import FileReport
-from ..rules import LEVELS, RULES, resolve_codes, with_unit
+from ..rules import LEVELS, RULES, number_text, resolve_codes, with_unit
 from ..study.run import PACKAGE_TABLE
 from .build import MeshResult, ReportRun
 from .images import data_uri, heat_bar, heatmap_uri, image_uri, png_bytes
@@ -60,7 +60,7 @@ def leave_out(key: str, title: str, reason: str) -> Section:
 
 def number(value: float) -> str:
     """Three significant digits; infinity as the sign."""
-    return "∞" if value == np.inf else f"{value:.3g}"
+    return "∞" if value == np.inf else number_text(value, digits=3)
 
 
 def _threshold_text(code: str, threshold: float | None, settings) -> str:

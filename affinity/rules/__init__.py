@@ -14,7 +14,7 @@ read :data:`RULES`.
 """
 
 from . import affinity, file, shape, texture  # noqa: F401  each registers its rules
-from .docs import SECTIONS, rule_page, rules_table, threshold_text, with_unit
+from .docs import SECTIONS, number_text, number_texts, rule_page, rules_table, threshold_text, with_unit
 from .file import UNREADABLE
 from .registry import (
     LEVELS,
@@ -39,5 +39,6 @@ def find_rule(key: str) -> Rule | None:
     return None
 
 
-__all__ = ["LEVELS", "RULES", "SECTIONS", "UNREADABLE", "Measured", "Rule", "find_rule", "page_fields", "register",
+__all__ = ["LEVELS", "RULES", "SECTIONS", "UNREADABLE", "Measured", "Rule", "find_rule", "number_text", "number_texts",
+           "page_fields", "register",
            "resolve_codes", "rule", "rule_page", "rules_table", "scoring_rules", "threshold_text", "unregister", "with_unit"]

@@ -24,14 +24,36 @@ SECTIONS = (
 
 def threshold_text(rule: Rule) -> str:
     """``"0.5 texels"``, or ``""`` for a rule without a threshold."""
-    return "" if rule.default_threshold is None else with_unit(f"{rule.default_threshold:g}", rule.unit)
+    return "" if rule.default_threshold is None else with_unit(number_text(rule.default_threshold), rule.unit)
 
 
 def level_text(rule: Rule) -> str:
     """``"warning"``, or ``"warning; error above 2 texels"`` for a rule with a visibility threshold."""
     if rule.visible_threshold is None:
         return rule.level
-    return f"{rule.level}; error above {with_unit(f'{rule.visible_threshold:g}', rule.unit)}"
+    return f"{rule.level}; error above {with_unit(number_text(rule.visible_threshold), rule.unit)}"
+
+
+#: Significant digits of a measured number for people: findings, rule pages, the report, ``affinity fix``.
+DIGITS = 4
+
+
+def number_text(value: float, digits: int = DIGITS) -> str:
+    """A measured number for people: ``digits`` significant digits, no exponent for everyday sizes.
+
+    >>> number_text(175.6854), number_text(2.0), number_text(1e-9), number_text(0.12345, digits=3)
+    ('175.7', '2', '1e-09', '0.123')
+    """
+    return f"{value:.{digits}g}"
+
+
+def number_texts(values: list[float], digits: int = DIGITS) -> list[str]:
+    """(n,) :func:`number_text` of each of ``values``, converted in one call (a million findings' values).
+
+    >>> number_texts([175.6854, 2.0, 1e-9])
+    ['175.7', '2', '1e-09']
+    """
+    return (f"%.{digits}g," * len(values) % tuple(values)).split(",")[:-1]
 
 
 def with_unit(number: str, unit: str) -> str:
