@@ -219,6 +219,36 @@ def test_next_walks_the_flagged_faces_worst_first():
     assert values[seen[0]] == q101[0]["value"] and len(set(seen)) == 3
 
 
+def test_results_row_gives_the_worst_value_in_the_registrys_unit_under_every_reading():
+    """Issue 39: the row's unit was blank under the barycentric reading, where the rule registry names one."""
+    from affinity.rules import RULES, with_unit
+    from affinity.settings import MEASURES
+
+    uv_sphere()
+    props = bpy.context.scene.affinity
+    for measure in MEASURES:
+        props.measure = measure
+        assert bpy.ops.affinity.check() == {"FINISHED"}
+        (row,) = props.results
+        unit = RULES[row.code].unit_for(measure)
+        assert unit and row.unit == unit, measure
+        assert addon.worst_text(row) == with_unit(f"{row.worst:.4g}", unit)  # as affinity check writes it
+
+
+def test_results_row_gives_the_visible_readings_unit_where_a_texture_was_read(tmp_path):
+    """Through a Base Color image Q101's values are C in 1/255 steps (the CLI's JSON says so): the row
+    showed them as texels."""
+    sphere = uv_sphere()
+    textured(sphere, tmp_path / "checker.png")
+    rows = findings(sphere)
+    assert {r["unit"] for r in rows} == {"1/255"}
+    bpy.ops.affinity.check()
+    (row,) = bpy.context.scene.affinity.results
+    assert row.worst in {r["value"] for r in rows}
+    assert row.unit == "1/255"
+    assert addon.worst_text(row) == f"{row.worst:.4g}/255"
+
+
 def test_check_lints_every_selected_mesh_object():
     with_uv = uv_sphere()
     without_uv = uv_sphere()
