@@ -216,7 +216,7 @@ def test_the_headline_setting_and_its_words_follow_the_registries(color_rows, mo
 
     from affinity.attributes import ATTRIBUTES, scoring_rules
     from affinity.rules import RULES
-    from affinity.study.tables import headline_hybrid, summary_markdown
+    from affinity.study.tables import error_label, headline_hybrid, summary_markdown
 
     (code,) = scoring_rules("colors")
     scene = color_rows[0]["scene"]
@@ -224,6 +224,7 @@ def test_the_headline_setting_and_its_words_follow_the_registries(color_rows, mo
     monkeypatch.setitem(RULES, code, replace(RULES[code], default_threshold=4.0))
     monkeypatch.setitem(ATTRIBUTES, "colors", replace(ATTRIBUTES["colors"], label="tint"))
     assert headline_hybrid(color_rows, scene)["setting"] == 4.0
+    assert error_label(color_rows[0]["unit"]) == "RMS tint error (1/255)"  # the charts' axis
     summary = summary_markdown(color_rows, {"cpu": "test"}, ["# study"])
     assert f"0.5 px tolerance, by view; tint by lint: the {code} threshold, 4/255)" in summary
     split = next(row for row in color_rows if row["method"] == "split")

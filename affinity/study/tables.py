@@ -9,7 +9,7 @@ import csv
 import math
 
 from ..atomic import atomic_write
-from ..attributes import ATTRIBUTES, scoring_rules
+from ..attributes import ATTRIBUTES, Attribute, scoring_rules
 from ..rules import RULES, threshold_text, with_unit
 from .sweep import COLUMNS
 
@@ -28,10 +28,20 @@ def _pixel_tolerance() -> float:
     return RenderOptions.pixel_tolerance
 
 
+def attribute_in(unit: str) -> Attribute:
+    """The attribute whose errors are measured in ``unit`` (a row's ``unit``; each attribute has its own)."""
+    (attribute,) = [attribute for attribute in ATTRIBUTES.values() if attribute.unit == unit]
+    return attribute
+
+
+def error_label(unit: str) -> str:
+    """What an axis of RMS errors in ``unit`` is called: ``"RMS uv error (texels)"``."""
+    return f"RMS {attribute_in(unit).label} error ({unit})"
+
+
 def _lint_rule(unit: str):
-    """The first scored rule of the attribute whose unit is ``unit``."""
-    (field,) = [field for field, attribute in ATTRIBUTES.items() if attribute.unit == unit]
-    return RULES[scoring_rules(field)[0]]
+    """The first scored rule of the attribute whose errors are in ``unit``."""
+    return RULES[scoring_rules(attribute_in(unit).field)[0]]
 
 
 def write_csv(rows: list[dict], path: str) -> None:
