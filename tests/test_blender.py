@@ -163,29 +163,58 @@ def test_world_matrix_is_applied():
 def test_corner_colour_attribute_is_linted(corner_colors, flagged):
     bpy.ops.mesh.primitive_plane_add(size=1)
     plane = bpy.context.object
+    paint_corners(plane, corner_colors)
+    codes = {r["code"] for r in findings(plane)}
+    assert ("Q102" in codes) is flagged
+
+
+def paint_corners(plane, corner_colors):
+    """A corner colour attribute on the unit plane: ``corner_colors`` at (0,0) (1,0) (1,1) (0,1)."""
     color = plane.data.color_attributes.new("Col", "BYTE_COLOR", "CORNER")
     plane.data.color_attributes.active_color = color
-    # Corner colours by the corner's position: (0,0) (1,0) (1,1) (0,1) of the unit square.
     order = {(-1, -1): 0, (1, -1): 1, (1, 1): 2, (-1, 1): 3}
     rgba = []
     for loop in plane.data.loops:
         co = plane.data.vertices[loop.vertex_index].co
         rgba.extend([*corner_colors[order[int(np.sign(co.x)), int(np.sign(co.y))]], 1.0])
     color.data.foreach_set("color_srgb", rgba)
-    codes = {r["code"] for r in findings(plane)}
-    assert ("Q102" in codes) is flagged
+
+
+def tilt_one_corner_normal(plane):
+    """Custom split normals on the plane: the first corner's tilted 40 degrees, the others straight up."""
+    tilted = np.array([np.sin(np.radians(40)), 0, np.cos(np.radians(40))])
+    plane.data.normals_split_custom_set([tilted if i == 0 else np.array([0, 0, 1.0])
+                                         for i in range(len(plane.data.loops))])
 
 
 def test_custom_split_normals_are_linted():
     bpy.ops.mesh.primitive_plane_add(size=1)
     plane = bpy.context.object
     assert "Q103" not in {r["code"] for r in findings(plane)}
-    tilted = np.array([np.sin(np.radians(40)), 0, np.cos(np.radians(40))])
-    normals = [tilted if i == 0 else np.array([0, 0, 1.0]) for i in range(len(plane.data.loops))]
-    plane.data.normals_split_custom_set(normals)
+    tilt_one_corner_normal(plane)
     assert plane.data.has_custom_normals
     q103 = [r for r in findings(plane) if r["code"] == "Q103"]
     assert [r["face"] for r in q103] == [0] and q103[0]["unit"] == "degrees"
+
+
+def test_every_attributes_row_reads_in_the_attribute_registrys_unit():
+    from affinity.attributes import ATTRIBUTES
+    from affinity.rules import RULES
+
+    bpy.ops.mesh.primitive_plane_add(size=1)
+    plane = bpy.context.object
+    paint_corners(plane, [(0, 0, 1), (1, 0, 0), (0, 1, 0), (0, 0, 0)])  # creases: the Q102 page's square
+    tilt_one_corner_normal(plane)
+    plane.data.uv_layers[0].data.foreach_set("uv", [0.0, 0.0, 1.0, 0.0, 0.5, 1.0, 0.0, 1.0])  # not affine
+    expected = {r["code"]: (r["value"], r["unit"]) for r in findings(plane)}
+    assert bpy.ops.affinity.check() == {"FINISHED"}
+    rows = bpy.context.scene.affinity.results
+    assert {RULES[row.code].attribute for row in rows} == set(ATTRIBUTES)
+    for row in rows:
+        unit = ATTRIBUTES[RULES[row.code].attribute].unit
+        assert row.unit == unit == expected[row.code][1]
+        assert row.worst == pytest.approx(expected[row.code][0], rel=1e-6)
+        assert addon.worst_text(row).endswith("/255" if unit == "1/255" else f" {unit}")
 
 
 def test_check_operator_selects_exactly_the_flagged_faces():
