@@ -78,3 +78,13 @@ def test_sarif_help_carries_use_instead(tmp_path):
     for code, rule in rules.items():
         assert "### Use instead" in rule["help"]["markdown"] and "\nUse instead\n" in rule["help"]["text"], code
         assert PAGES[code].use_instead.splitlines()[1] in rule["help"]["markdown"]
+
+
+def test_missing_resource_is_also_fixed_by_shipping_the_library(tmp_path):
+    """Q902's first fix needs a second file, so its *Use instead* shows the third (no library line); the
+    first one is checked here: the example unchanged, with the library it names beside it."""
+    (tmp_path / "missing.mtl").write_text("newmtl grey\nKd 0.5 0.5 0.5\n")
+    result = lint(tmp_path, RULES["Q902"].example)
+    assert result.returncode == 0 and "No findings" in result.stdout, result.stdout + result.stderr
+    (tmp_path / "missing.mtl").unlink()
+    assert lint(tmp_path, RULES["Q902"].example).returncode == 1

@@ -105,15 +105,16 @@ def missing_resources(mesh, settings) -> tuple | None:
         example.obj:2:1: Q902 info missing-resource: an mtllib or map_Kd named by the file cannot be found or read: mtllib missing.mtl not found
 
     Use instead:
-        # the same mesh naming no library it lacks (or ship missing.mtl beside it)
+        # the same mesh without the line naming a library it does not need (one file cannot ship one)
         v 0 0 0
         v 1 0 0
         v 1 1 0
         f 1 2 3
 
     How to fix:
-        Add the file next to the mesh (git lfs pull for LFS pointers), or fix the
-        name in the mtllib or map_Kd line.
+        Add the file next to the mesh (git lfs pull for LFS pointers), fix the
+        name in the mtllib or map_Kd line, or, where the mesh needs no material,
+        drop the line (re-export without materials).
     """
     # The files the loader found referenced (``mesh.resources``, the resource registry's
     # roles), each looked at once; a USD stage's layers are pxr's to compose, and their
