@@ -69,15 +69,15 @@ def uv_disaffinity(quads) -> tuple:
         example.obj:10:1: Q101 error uv-disaffine: texture coordinates are not an affine image of the positions: no texture found, texels of an assumed 1024x1024 texture (give the size with --texture-size or the texture-size setting) (175.7 vs 0.5 texels) [face 0]
 
     Use instead:
-        # the same trapezoid re-UVed in its own shape, uv = ((x + 1) / 2, y / 2): an affine map
+        # the same trapezoid re-UVed in its own shape, uv = ((x + 2) / 4, (y + 1) / 4): an affine map
         v -1 0 0
         v 1 0 0
         v 0.5 1 0
         v -0.5 1 0
-        vt 0 0
-        vt 1 0
-        vt 0.75 0.5
-        vt 0.25 0.5
+        vt 0.25 0.25
+        vt 0.75 0.25
+        vt 0.625 0.5
+        vt 0.375 0.5
         f 1/1 2/2 3/3 4/4
 
     How to fix:

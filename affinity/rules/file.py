@@ -29,8 +29,8 @@ def no_faces(mesh, settings) -> tuple | None:
     Example:
         # only v lines: a point cloud, or an export that lost its faces
         v 0 0 0
-        v 1 0 0
-        v 1 1 0
+        v 2 0 0
+        v 2 1 0
         v 0 1 0
 
     Prints:
@@ -39,8 +39,8 @@ def no_faces(mesh, settings) -> tuple | None:
     Use instead:
         # the same vertices exported with their face
         v 0 0 0
-        v 1 0 0
-        v 1 1 0
+        v 2 0 0
+        v 2 1 0
         v 0 1 0
         f 1 2 3 4
 

@@ -37,15 +37,15 @@ def uv_degenerate(quads) -> tuple:
         example.obj:8:1: Q301 warning uv-degenerate: zero area in texture space: the texture smears over it, so Q101 is not measured on it (0 vs 1e-09 relative area) [face 0]
 
     Use instead:
-        # the square unwrapped again: its uv is the unit square, an affine image of it
+        # the square unwrapped again into an island of its own, the texture's upper right quarter
         v 0 0 0
         v 1 0 0
         v 1 1 0
         v 0 1 0
-        vt 0 0
-        vt 1 0
+        vt 0.5 0.5
+        vt 1 0.5
         vt 1 1
-        vt 0 1
+        vt 0.5 1
         f 1/1 2/2 3/3 4/4
 
     References:
@@ -68,7 +68,7 @@ def uv_flipped(quads) -> tuple:
         Flags quads whose UV winding is clockwise while the face winding is
         counter-clockwise (a mirrored UV island); the value reported is the negative
         relative UV area (the signed uv area over the squared longest uv edge: -1
-        for the example's mirrored unit square). Quads whose UV area is within
+        for the example's mirrored square). Quads whose UV area is within
         Q301's threshold (as configured) are Q301's: degenerate, not flipped.
 
     Why it matters:
@@ -84,24 +84,24 @@ def uv_flipped(quads) -> tuple:
         v 1 1 0
         v 0 1 0
         vt 1 0
-        vt 0 0
-        vt 0 1
-        vt 1 1
+        vt 0.5 0
+        vt 0.5 0.5
+        vt 1 0.5
         f 1/1 2/2 3/3 4/4
 
     Prints:
         example.obj:10:1: Q302 info uv-flipped: texture orientation reversed against the surface (-1 relative area) [face 0]
 
     Use instead:
-        # the island mirrored back: uv turns the way the face does
+        # the island mirrored back in place: uv turns the way the face does
         v 0 0 0
         v 1 0 0
         v 1 1 0
         v 0 1 0
-        vt 0 0
+        vt 0.5 0
         vt 1 0
-        vt 1 1
-        vt 0 1
+        vt 1 0.5
+        vt 0.5 0.5
         f 1/1 2/2 3/3 4/4
 
     References:
