@@ -19,6 +19,9 @@ and check in one file)::
             ...
         Prints:
             example.obj:5:1: Q999 warning my-rule: ...
+        Use instead:
+            v 0 0 0
+            ...
         References:
             ...
         How to fix:
@@ -72,6 +75,8 @@ class Rule:
     example : a 4- to 8-line OBJ that triggers this rule and no other
     example_output : the text lines ``affinity check`` prints for ``example``
         saved as ``example.obj`` (a test lints it and compares)
+    use_instead : ``example`` fixed the way ``fix`` says: an input ``affinity check`` finds clean
+        (ruff's second half of a rule's page; a test lints it)
     references : the paper and section the rule comes from
     """
 
@@ -95,6 +100,7 @@ class Rule:
     why: str
     example: str
     example_output: str = ""
+    use_instead: str = ""
     fix: str
     references: str = ""
 
@@ -140,10 +146,10 @@ def register(rule: Rule) -> Rule:
 #: The page's headings in a check's docstring -> the Rule field each fills.
 PAGE_HEADINGS = {
     "What it does": "what", "Why it matters": "why", "Example": "example", "Prints": "example_output",
-    "References": "references", "How to fix": "fix",
+    "Use instead": "use_instead", "References": "references", "How to fix": "fix",
 }
 #: Sections kept line by line (files and output); the others are prose, joined into one paragraph.
-VERBATIM = frozenset({"example", "example_output"})
+VERBATIM = frozenset({"example", "example_output", "use_instead"})
 
 
 def page_fields(doc: str) -> dict[str, str]:
