@@ -4,10 +4,12 @@ What a quad can carry besides its positions (texture coordinates, vertex
 colours, normals) is described here once: the :class:`~affinity.mesh.Mesh`
 fields that hold it, its width, its unit, the note a report gives when a mesh
 lacks it, the name every command uses for it (``render --show``, ``view
---attribute``), and how a difference of two values reads in that unit
-(:func:`pixel_error`). Which rules score an attribute is the rule registry's
-(:func:`affinity.rules.scoring_rules`: a rule names its attribute), so a new
-rule on an attribute is found without touching this table. Imports nothing at load (the command line reads the
+--attribute``), how pictures label it and colour its scores (the 3-D view, the
+study's charts, the Blender panel), and how a difference of two values reads in
+that unit (:func:`pixel_error`). Which rules score an attribute is the rule
+registry's (:func:`affinity.rules.scoring_rules`: a rule names its attribute),
+so a new rule on an attribute is found without touching this table. Imports
+nothing at load (the command line reads the
 names); the measures are imported when a difference is taken.
 """
 
@@ -58,7 +60,9 @@ class Attribute:
     aliases : other spellings accepted on the command line (``"colour"``)
     width : components per value: (T, width) float64
     unit : the unit a split error of it is measured in (``"texels"``, ``"1/255"``, ``"degrees"``)
-    missing : what a report says of a mesh without it (``"no texture coordinates"``)
+    display_name : what prose calls it (``"texture coordinates"``, ``"vertex colours"``)
+    label : what a picture's legend or axis calls it (``"uv"``, ``"colour"``)
+    colormap : the matplotlib colour map its scores are drawn with (the 3-D view, the report's overview)
     unit_length : values are directions, scaled to unit length before measuring
     difference : ``difference(values, reference, texture_size) -> (N,)`` float64, the
         difference of (N, width) values against a reference in ``unit``
@@ -70,7 +74,9 @@ class Attribute:
     aliases: tuple[str, ...] = ()
     width: int
     unit: str
-    missing: str
+    display_name: str
+    label: str
+    colormap: str = "viridis"
     unit_length: bool = False
     difference: Callable[[np.ndarray, np.ndarray, object], np.ndarray]
 
@@ -79,17 +85,27 @@ class Attribute:
         """Stored per position vertex (reached through ``corner_vertex``), not per corner."""
         return self.corner_index == "corner_vertex"
 
+    @property
+    def missing(self) -> str:
+        """What a report says of a mesh without it: ``"no texture coordinates"``."""
+        return f"no {self.display_name}"
+
+    def legend(self, unit: str | None = None) -> str:
+        """The title of a colour bar or axis of its scores in ``unit`` (default: the attribute's own; a
+        reading may change it): ``"uv score (texels)"``."""
+        return f"{self.label} score ({unit or self.unit})"
+
 
 #: Every attribute by Mesh field, in the order scores and pictures prefer them.
 ATTRIBUTES: dict[str, Attribute] = {
     attribute.field: attribute
     for attribute in (
         Attribute(field="texcoords", corner_index="corner_texcoord", name="uv", width=2, unit="texels",
-                  missing="no texture coordinates", difference=_texel_difference),
+                  display_name="texture coordinates", label="uv", difference=_texel_difference),
         Attribute(field="colors", corner_index="corner_vertex", name="color", aliases=("colour",), width=3,
-                  unit="1/255", missing="no vertex colours", difference=_color_difference),
+                  unit="1/255", display_name="vertex colours", label="colour", difference=_color_difference),
         Attribute(field="normals", corner_index="corner_normal", name="normal", width=3, unit="degrees",
-                  missing="no normals", unit_length=True, difference=_normal_difference),
+                  display_name="normals", label="normal", unit_length=True, difference=_normal_difference),
     )
 }
 

@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 from bench_report import timed_process
-from common import parse_with_output, run_conditions, write_table
+from common import markdown_table, parse_with_output, run_conditions, write_table
 
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "meshes"
 CAR = SHARED / "osd_catmark_car.obj"
@@ -81,16 +81,14 @@ def main(argv=None) -> None:
         summary = runs["`affinity fix`"][-1][2].strip().splitlines()[-1].split(": ", 1)[-1]
         written = os.path.getsize(os.path.join(folder, "car.fixed.obj")) / 2**20
     check = statistics.median(run[0] for run in runs["`affinity check`"])
-    rows = [f"| {name} | {statistics.median(r[0] for r in found):.2f} | "
-            f"{statistics.median(r[0] for r in found) / check:.2f} | {max(r[1] for r in found):.0f} |"
+    rows = [(name, f"{statistics.median(r[0] for r in found):.2f}",
+             f"{statistics.median(r[0] for r in found) / check:.2f}", f"{max(r[1] for r in found):.0f}")
             for name, found in runs.items()]
     write_table([
         f"{quads:,} quads ({source}), "
         f"{run_conditions(load, rounds)}, each command in a fresh process:",
         "",
-        "| command | wall (s) | x check | peak memory (MiB) |",
-        "|---|---:|---:|---:|",
-        *rows,
+        *markdown_table(["command", "wall (s)", "x check", "peak memory (MiB)"], rows),
         "",
         f"The fix: {summary.split(' -> ')[0]}; the fixed OBJ is {written:.1f} MiB.",
     ], args.out, "bench_fix.md")

@@ -28,7 +28,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from common import parse_with_output, run_conditions, write_table
+from common import markdown_table, parse_with_output, run_conditions, write_table
 
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "meshes"
 CAR = SHARED / "osd_catmark_car.obj"
@@ -122,14 +122,15 @@ def main(argv=None) -> None:
     wall = statistics.median(run[0] for run in runs)
     memory = max(run[1] for run in runs)
     shared_table = ["", "The meshes of `../shared/meshes`, one `affinity report -q` each:", "",
-                    "| mesh | wall (s) | peak memory (MiB) |", "|---|---:|---:|",
-                    *(f"| {name} | {seconds:.2f} | {peak:.0f} |" for name, seconds, peak in shared)] if shared else []
+                    *markdown_table(["mesh", "wall (s)", "peak memory (MiB)"],
+                                    [(name, f"{seconds:.2f}", f"{peak:.0f}") for name, seconds, peak in shared])
+                    ] if shared else []
     write_table([
         f"{quads:,} quads ({source}, per-face unit uv), {run_conditions(load, rounds)}:",
         "",
-        "| `affinity report -q` | wall (s) | peak memory (MiB) | UV layout (s) | UV layout share |",
-        "|---|---:|---:|---:|---:|",
-        f"| {quads:,} quads | {wall:.2f} | {memory:.0f} | {layout:.2f} | {layout / wall:.1%} |",
+        *markdown_table(
+            ["`affinity report -q`", "wall (s)", "peak memory (MiB)", "UV layout (s)", "UV layout share"],
+            [(f"{quads:,} quads", f"{wall:.2f}", f"{memory:.0f}", f"{layout:.2f}", f"{layout / wall:.1%}")]),
         *shared_table,
     ], args.out, "bench_report.md")
 

@@ -31,6 +31,13 @@ def run_conditions(load: float, rounds: int) -> str:
             f"median of {rounds} round{'s' * (rounds > 1)}")
 
 
+def markdown_table(head: list[str], rows) -> list[str]:
+    """The lines of a Markdown table: ``head`` (column titles), the rule (the first column left-aligned, the
+    others, numbers, right-aligned), then one line per row of ``rows`` (each a sequence of cell texts)."""
+    line = lambda cells: "| " + " | ".join(cells) + " |"
+    return [line(head), "|---|" + "---:|" * (len(head) - 1), *map(line, rows)]
+
+
 def write_table(lines: list[str], folder: Path, name: str) -> str:
     """Write ``lines`` as ``folder/name`` (folder made when missing) and print them; return the text.
 

@@ -163,29 +163,58 @@ def test_world_matrix_is_applied():
 def test_corner_colour_attribute_is_linted(corner_colors, flagged):
     bpy.ops.mesh.primitive_plane_add(size=1)
     plane = bpy.context.object
+    paint_corners(plane, corner_colors)
+    codes = {r["code"] for r in findings(plane)}
+    assert ("Q102" in codes) is flagged
+
+
+def paint_corners(plane, corner_colors):
+    """A corner colour attribute on the unit plane: ``corner_colors`` at (0,0) (1,0) (1,1) (0,1)."""
     color = plane.data.color_attributes.new("Col", "BYTE_COLOR", "CORNER")
     plane.data.color_attributes.active_color = color
-    # Corner colours by the corner's position: (0,0) (1,0) (1,1) (0,1) of the unit square.
     order = {(-1, -1): 0, (1, -1): 1, (1, 1): 2, (-1, 1): 3}
     rgba = []
     for loop in plane.data.loops:
         co = plane.data.vertices[loop.vertex_index].co
         rgba.extend([*corner_colors[order[int(np.sign(co.x)), int(np.sign(co.y))]], 1.0])
     color.data.foreach_set("color_srgb", rgba)
-    codes = {r["code"] for r in findings(plane)}
-    assert ("Q102" in codes) is flagged
+
+
+def tilt_one_corner_normal(plane):
+    """Custom split normals on the plane: the first corner's tilted 40 degrees, the others straight up."""
+    tilted = np.array([np.sin(np.radians(40)), 0, np.cos(np.radians(40))])
+    plane.data.normals_split_custom_set([tilted if i == 0 else np.array([0, 0, 1.0])
+                                         for i in range(len(plane.data.loops))])
 
 
 def test_custom_split_normals_are_linted():
     bpy.ops.mesh.primitive_plane_add(size=1)
     plane = bpy.context.object
     assert "Q103" not in {r["code"] for r in findings(plane)}
-    tilted = np.array([np.sin(np.radians(40)), 0, np.cos(np.radians(40))])
-    normals = [tilted if i == 0 else np.array([0, 0, 1.0]) for i in range(len(plane.data.loops))]
-    plane.data.normals_split_custom_set(normals)
+    tilt_one_corner_normal(plane)
     assert plane.data.has_custom_normals
     q103 = [r for r in findings(plane) if r["code"] == "Q103"]
     assert [r["face"] for r in q103] == [0] and q103[0]["unit"] == "degrees"
+
+
+def test_every_attributes_row_reads_in_the_attribute_registrys_unit():
+    from affinity.attributes import ATTRIBUTES
+    from affinity.rules import RULES
+
+    bpy.ops.mesh.primitive_plane_add(size=1)
+    plane = bpy.context.object
+    paint_corners(plane, [(0, 0, 1), (1, 0, 0), (0, 1, 0), (0, 0, 0)])  # creases: the Q102 page's square
+    tilt_one_corner_normal(plane)
+    plane.data.uv_layers[0].data.foreach_set("uv", [0.0, 0.0, 1.0, 0.0, 0.5, 1.0, 0.0, 1.0])  # not affine
+    expected = {r["code"]: (r["value"], r["unit"]) for r in findings(plane)}
+    assert bpy.ops.affinity.check() == {"FINISHED"}
+    rows = bpy.context.scene.affinity.results
+    assert {RULES[row.code].attribute for row in rows} == set(ATTRIBUTES)
+    for row in rows:
+        unit = ATTRIBUTES[RULES[row.code].attribute].unit
+        assert row.unit == unit == expected[row.code][1]
+        assert row.worst == pytest.approx(expected[row.code][0], rel=1e-6)
+        assert addon.worst_text(row).endswith("/255" if unit == "1/255" else f" {unit}")
 
 
 def test_check_operator_selects_exactly_the_flagged_faces():
@@ -217,6 +246,36 @@ def test_next_walks_the_flagged_faces_worst_first():
     values = {r["face"]: r["value"] for r in q101}
     assert [values[f] for f in seen] == sorted((values[f] for f in seen), reverse=True)
     assert values[seen[0]] == q101[0]["value"] and len(set(seen)) == 3
+
+
+def test_results_row_gives_the_worst_value_in_the_registrys_unit_under_every_reading():
+    """Issue 39: the row's unit was blank under the barycentric reading, where the rule registry names one."""
+    from affinity.rules import RULES, with_unit
+    from affinity.settings import MEASURES
+
+    uv_sphere()
+    props = bpy.context.scene.affinity
+    for measure in MEASURES:
+        props.measure = measure
+        assert bpy.ops.affinity.check() == {"FINISHED"}
+        (row,) = props.results
+        unit = RULES[row.code].unit_for(measure)
+        assert unit and row.unit == unit, measure
+        assert addon.worst_text(row) == with_unit(f"{row.worst:.4g}", unit)  # as affinity check writes it
+
+
+def test_results_row_gives_the_visible_readings_unit_where_a_texture_was_read(tmp_path):
+    """Through a Base Color image Q101's values are C in 1/255 steps (the CLI's JSON says so): the row
+    showed them as texels."""
+    sphere = uv_sphere()
+    textured(sphere, tmp_path / "checker.png")
+    rows = findings(sphere)
+    assert {r["unit"] for r in rows} == {"1/255"}
+    bpy.ops.affinity.check()
+    (row,) = bpy.context.scene.affinity.results
+    assert row.worst in {r["value"] for r in rows}
+    assert row.unit == "1/255"
+    assert addon.worst_text(row) == f"{row.worst:.4g}/255"
 
 
 def test_check_lints_every_selected_mesh_object():

@@ -87,7 +87,8 @@ def test_a_code_registers_once(synthetic_rule):
 
 def test_the_registry_shows_how_to_add_a_rule_with_code_that_works(tmp_path, monkeypatch, capsys):
     """The module docstring of affinity/rules/registry.py, run as it is, registers a rule whose page's
-    example (a 2 by 1 rectangle: longest edge 2, closed form) prints the page's Prints line."""
+    example (a 2 by 1 rectangle: longest edge 2, closed form) prints the page's Prints line and whose
+    Use instead lints clean."""
     import textwrap
 
     from affinity.rules import registry
@@ -104,6 +105,9 @@ def test_the_registry_shows_how_to_add_a_rule_with_code_that_works(tmp_path, mon
         assert status == 1, err
         assert [line for line in out.splitlines() if not line.startswith("Found ")] == rule.example_output.splitlines()
         assert "(2 vs 1 units)" in rule.example_output
+        (tmp_path / "fixed.obj").write_text(rule.use_instead)  # two unit squares: no edge above 1
+        status, out, err = check(["check", "--select", "Q999", "--fail-on", "info", "fixed.obj"], capsys)
+        assert status == 0 and "Q999" not in out, out + err
     finally:
         unregister("Q999")
     assert "Q999" not in RULES

@@ -178,3 +178,54 @@ def test_on_the_trapezoid_the_split_has_the_crease_and_the_error(trapezoid_rows)
     assert rows["hybrid"]["to_mvc"] == 1.0 and rows["hybrid"]["err_rms"] == rows["mvc"]["err_rms"]
     assert math.isnan(split["diagonal_rms"])  # only split-13 has it
     assert rows["split-13"]["diagonal_rms"] > 10
+
+
+# ---------------------------------------------------------------- what is shown: the registries' data
+
+
+@pytest.fixture(scope="module")
+def color_rows():
+    """Bloomenthal Fig. 10 (two unit squares: corner colours blue, red, green, black on the left, an affine set
+    on the right) seen straight on, every configuration, with the lint route swept at two thresholds."""
+    from affinity.scenes import SCENES
+    from affinity.study.sweep import StudySettings, prepare, study_scene
+
+    settings = StudySettings(width=160, height=80, repeat=1, warmup=0, misplacement_thresholds=(2.0, 4.0))
+    case = next(case for case in SCENES if case.name == "color squares")  # a demo scene, not in the study
+    return study_scene(prepare(case, settings), settings)
+
+
+def test_study_errors_are_in_the_unit_the_attribute_registry_gives(trapezoid_rows, color_rows):
+    from affinity.attributes import ATTRIBUTES
+    from affinity.rules import RULES, scoring_rules
+
+    for field, rows in (("texcoords", trapezoid_rows.values()), ("colors", color_rows)):
+        unit = ATTRIBUTES[field].unit
+        assert {row["unit"] for row in rows} == {unit} == {RULES[code].unit for code in scoring_rules(field)}
+    # The split's colour error against exact peaks at the left square's centre: bilinear minus the split is
+    # R t (1 - s), R = c0 - c1 + c2 - c3 = (-1, 1, 1), so |R| / 4 = sqrt(3) / 4 of full scale, in 1/255 steps.
+    split = next(row for row in color_rows if row["method"] == "split")
+    sup = 255 * math.sqrt(3) / 4  # 110.4
+    assert 0.95 * sup < split["err_max"] <= sup * (1 + 1e-9)
+    # The barycentric reading is the uv rule's only (Rule.readings): colours route by the error reading alone.
+    assert {row["route"] for row in color_rows} == {"", "lint error"}
+
+
+def test_the_headline_setting_and_its_words_follow_the_registries(color_rows, monkeypatch):
+    from dataclasses import replace
+
+    from affinity.attributes import ATTRIBUTES
+    from affinity.rules import RULES, scoring_rules
+    from affinity.study.tables import error_label, headline_hybrid, summary_markdown
+
+    (code,) = scoring_rules("colors")
+    scene = color_rows[0]["scene"]
+    assert headline_hybrid(color_rows, scene)["setting"] == RULES[code].default_threshold == 2.0
+    monkeypatch.setitem(RULES, code, replace(RULES[code], default_threshold=4.0))
+    monkeypatch.setitem(ATTRIBUTES, "colors", replace(ATTRIBUTES["colors"], label="tint"))
+    assert headline_hybrid(color_rows, scene)["setting"] == 4.0
+    assert error_label(color_rows[0]["unit"]) == "RMS tint error (1/255)"  # the charts' axis
+    summary = summary_markdown(color_rows, {"cpu": "test"}, ["# study"])
+    assert f"0.5 px tolerance, by view; tint by lint: the {code} threshold, 4/255)" in summary
+    split = next(row for row in color_rows if row["method"] == "split")
+    assert f"| {split['err_rms']:.3g}/255 |" in summary  # a number in 1/255 steps reads as a fraction

@@ -29,16 +29,18 @@ from bpy.props import (
     StringProperty,
 )
 
-from ..rules import RULES
+from ..rules import RULES, number_text, with_unit
 from ..settings import DIAGONALS, MEASURES, Settings
 from . import compat
-from .check import check_object, face_error, severity
+from .check import check_object, face_error, finding_units, severity
 from .convert import ERROR_ATTRIBUTE, ERROR_COLOR, base_color_texture, polygon_corners
 from .fix import fix_object
 
 #: Rules the panel offers: the per-face and per-mesh ones (Q9xx are about files).
 PANEL_RULES = [code for code in RULES if not code.startswith("Q9")]
 THRESHOLDED = [code for code in PANEL_RULES if RULES[code].default_threshold is not None]
+#: The affinity scores: what the Measure reading and the Fix button apply to.
+SCORED = [code for code in PANEL_RULES if RULES[code].scored]
 
 #: (object name, rule code) -> (faces of the object's original mesh, worst first).
 #: Kept in Python: face lists have no fitting property type. A reload of the
@@ -51,7 +53,7 @@ def _settings_annotations() -> dict:
     fields = {
         "measure": EnumProperty(
             name="Measure", default=defaults.measure,
-            items=[(m, m.capitalize(), f"Q101 reading: {m}") for m in MEASURES],
+            items=[(m, m.capitalize(), f"{', '.join(SCORED)} reading: {m}") for m in MEASURES],
         ),
         "diagonal": EnumProperty(
             name="Diagonal", default=defaults.diagonal,
@@ -74,7 +76,7 @@ def _settings_annotations() -> dict:
         ),
         "fix_level": EnumProperty(
             name="Fix level", default="warning",
-            items=[(level, level.capitalize(), f"Fix Q101-Q103 findings at {level} and above")
+            items=[(level, level.capitalize(), f"Fix {', '.join(SCORED)} findings at {level} and above")
                    for level in ("info", "warning", "error")],
         ),
         "max_refine": IntProperty(
@@ -123,12 +125,25 @@ def lint_options(props) -> dict:
         "evaluated": props.use_modifiers,
         "uv_layer": props.uv_layer or None,
     }
-    if options["measure"] == "barycentric" and "Q101" in options["thresholds"]:
-        # The texel threshold means nothing for the dimensionless score: keep its own default.
-        del options["thresholds"]["Q101"]
+    for code in THRESHOLDED:
+        if reading_changes_unit(code, props.measure):
+            # The panel's threshold is in the rule's own unit (texels), meaningless for this reading's
+            # (the dimensionless barycentric score): the reading keeps its own default.
+            del options["thresholds"][code]
     if props.texture_size > 0:
         options["texture_size"] = props.texture_size
     return options
+
+
+def reading_changes_unit(code: str, measure: str) -> bool:
+    """Whether rule ``code`` reads ``measure`` in a unit of its own (the rule registry's ``readings``)."""
+    return measure in RULES[code].readings
+
+
+def worst_text(row) -> str:
+    """A results row's worst value with its unit, as ``affinity check`` writes a value: ``3.2 texels``,
+    ``12/255``."""
+    return with_unit(number_text(row.worst), row.unit)
 
 
 def selected_meshes(context) -> list:
@@ -227,7 +242,7 @@ class AFFINITY_OT_check(bpy.types.Operator):
                 row = props.results.add()
                 row.object_name, row.code, row.rule_name = obj.name, hits.code, RULES[hits.code].name
                 row.count, row.worst = len(hits), float(hits.values[order[0]])
-                row.unit = "" if props.measure == "barycentric" and hits.code == "Q101" else RULES[hits.code].unit
+                row.unit = finding_units(hits)[order[0]]
                 row.selectable = bool(mapping is not None and hits.faces[0] >= 0)
                 if row.selectable:
                     faces = mapping[hits.faces[order]]
@@ -349,7 +364,7 @@ class AFFINITY_UL_results(bpy.types.UIList):
         row = layout.row(align=True)
         row.label(text=f"{item.code} {item.rule_name}")
         row.label(text=f"{item.count}")
-        row.label(text=f"{item.worst:.4g} {item.unit}".rstrip())
+        row.label(text=worst_text(item))
         row.label(text=item.object_name)
         button = row.row(align=True)
         button.enabled = item.selectable
@@ -390,7 +405,7 @@ class AFFINITY_PT_panel(bpy.types.Panel):
             row.prop(props, "use_" + code, text=f"{code} {RULES[code].name}")
             if code in THRESHOLDED:
                 sub = row.row(align=True)
-                sub.enabled = getattr(props, "use_" + code) and not (code == "Q101" and props.measure == "barycentric")
+                sub.enabled = getattr(props, "use_" + code) and not reading_changes_unit(code, props.measure)
                 sub.prop(props, "threshold_" + code, text="")
         layout.prop(props, "measure")
         layout.prop(props, "diagonal")

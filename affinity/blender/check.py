@@ -57,15 +57,17 @@ def check_object(obj, **options) -> ObjectCheck:
     """
     from ..findings import settle
     from ..lint import lint_mesh
-    from ..rules import resolve_codes
+    from ..rules import RULES, resolve_codes
     from ..settings import Settings
 
     convert = {k: options.pop(k) for k in _CONVERSION_OPTIONS if k in options}
     conversion = convert_object(obj, **convert)
     mesh, texture = conversion.mesh, conversion.texture
     notes = list(conversion.notes)
-    if conversion.uv_layer is None and "Q101" in resolve_codes(options.get("select"), options.get("ignore")):
-        notes.append("Q101 skipped: the mesh has no UV map")
+    if conversion.uv_layer is None:
+        notes.extend(f"{code} skipped: the mesh has no UV map"
+                     for code in resolve_codes(options.get("select"), options.get("ignore"))
+                     if RULES[code].scored and RULES[code].attribute == "texcoords")
     if mesh.texture_path() is None and texture is not None and "texture_size" not in options:
         options["texture_size"] = max(texture.size)
         if texture.size[0] != texture.size[1]:
@@ -92,6 +94,22 @@ def _finding_dicts(mesh, hits, settings, original_face) -> list[dict]:
             row["original_face"] = int(original_face[finding.face]) if finding.face >= 0 else -1
         rows.append(row)
     return rows
+
+
+def finding_units(hits) -> np.ndarray:
+    """(n,) str: the unit of each value of settled ``hits`` (:func:`affinity.findings.settle`), as
+    ``affinity check --format json`` gives it: the texture's (``1/255``, ``degrees``) where Q101's visible
+    reading read C, else the rule's unit under the reading (``texels``, ``barycentric score``).
+
+    Parameters
+    ----------
+    hits : RuleHits with ``unit`` set and ``visible`` None or VisibleColumns of (n,) ``picks`` and ``shifts``
+    """
+    units = np.full(len(hits), hits.unit, dtype=object)
+    if hits.visible is not None:
+        read = (hits.visible.picks >= 0) & np.isfinite(hits.visible.shifts)
+        units[read] = np.asarray(hits.visible.units, dtype=object)[hits.visible.picks[read]]
+    return units
 
 
 def severity(hits) -> np.ndarray:

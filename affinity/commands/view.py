@@ -24,7 +24,8 @@ def add_parser(sub) -> None:
     )
     p.add_argument("mesh", metavar="MESH")
     p.add_argument("--attribute", choices=attribute_choices(), type=spelling,
-                   help="the score to colour by (default: uv, else colour, else normal)")
+                   help="the score to colour by (default: the first the mesh has of "
+                        f"{', '.join(attribute_choices())})")
     p.add_argument("--up", choices=["x", "y", "z"], help="world up axis")
     p.add_argument("--screenshot", metavar="PNG", help="render off-screen into PNG instead of opening a window")
     p.set_defaults(run=run)

@@ -11,6 +11,7 @@ import importlib.util
 
 import numpy as np
 
+from ..attributes import attribute_named
 from ..lint import QuadScores
 from ..mesh import Mesh
 from .framing import UP_AXES
@@ -75,19 +76,23 @@ def score_range(scores: QuadScores) -> tuple[float, float]:
 def build_scene(plotter, mesh: Mesh, scores: QuadScores | None, scalar_bar: bool = True) -> None:
     """Add the mesh to ``plotter``: coloured by ``scores`` (log scale, grey where unscored), flagged quads outlined.
 
+    The colour map and the colour bar's title are the attribute registry's (``Attribute.colormap``,
+    ``Attribute.legend``), the bar's unit that of the scores' reading.
+
     ``scalar_bar`` False leaves the colour bar to the caller (the report draws it beside the picture).
     """
     surface = polydata(mesh)
     if scores is None or len(scores.faces) == 0:
         plotter.add_mesh(surface, color=SURFACE_GREY, show_edges=True, edge_color="#6b7280")
         return
+    attribute = attribute_named(scores.attribute)
     low, top = score_range(scores)
     per_face = np.full(surface.n_cells, np.nan)  # the cells past the faces are fans of big faces
     per_face[scores.faces] = np.clip(scores.values, low, top)
     surface.cell_data[scores.unit] = per_face
-    plotter.add_mesh(surface, scalars=scores.unit, cmap="viridis", log_scale=True, clim=(low, top),
+    plotter.add_mesh(surface, scalars=scores.unit, cmap=attribute.colormap, log_scale=True, clim=(low, top),
                      nan_color=SURFACE_GREY, show_edges=True, edge_color="#374151", show_scalar_bar=scalar_bar,
-                     scalar_bar_args={"title": f"{scores.attribute} ({scores.unit})\n", "fmt": "%.2g", "vertical": True,
+                     scalar_bar_args={"title": attribute.legend(scores.unit) + "\n", "fmt": "%.2g", "vertical": True,
                                       "position_x": 0.86, "position_y": 0.1, "height": 0.75, "width": 0.06,
                                       "title_font_size": 14, "label_font_size": 12, "color": "#1f2937"})
     flagged = scores.faces[scores.flagged]

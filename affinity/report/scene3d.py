@@ -214,9 +214,16 @@ def shown_text(data: dict) -> str:
 
 
 def view_scripts() -> str:
-    """The view's style and scripts, once per page: three.js as a classic script, then ``view3d.js``."""
+    """The view's style and scripts, once per page: three.js as a classic script, then ``view3d.js``.
+
+    The page carries the view's own style and script minified (rcssmin, rjsmin), as it carries three.js's
+    minified build: a third smaller, and the page is an output, not a second copy of the sources.
+    """
+    from rcssmin import cssmin
+    from rjsmin import jsmin
+
     from .threejs import three_script
 
-    style = (TEMPLATES / "view3d.css").read_text(encoding="utf-8")
-    script = (TEMPLATES / "view3d.js").read_text(encoding="utf-8")
+    style = cssmin((TEMPLATES / "view3d.css").read_text(encoding="utf-8")) + "\n"
+    script = jsmin((TEMPLATES / "view3d.js").read_text(encoding="utf-8")) + "\n"
     return f"<style>\n{style}</style>\n<script>\n{three_script()}\n</script>\n<script>\n{script}</script>\n"

@@ -46,9 +46,11 @@ def uv_disaffinity(quads) -> Measured:
         centre it takes the split's shift at the quad's centre instead, with
         --measure barycentric the paper's dimensionless score at .01. On the
         example's trapezoid (side ratio r = 1/2) the split shifts the texture at
-        its centre by an eighth of its width, 128 texels at 1024, and by 176 texels
-        at its worst, (1 - r) / (1 + sqrt r)^2 of the width. A parallelogram whose
-        uv is a parallelogram (an affine map) is never flagged.
+        its centre by an eighth of its width, 128 texels at 1024 (--measure
+        centre), and at its worst by (1 - r) / (1 + sqrt r)^2 of the width, the
+        175.7 texels printed below. A quad whose uv is an affine image of its
+        positions (a parallelogram carrying a parallelogram, or the trapezoid below
+        re-UVed in its own shape) is never flagged.
 
     Example:
         # a trapezoid (a quad near the pole of a lat-long sphere) carrying the unit square of uv
@@ -64,6 +66,18 @@ def uv_disaffinity(quads) -> Measured:
 
     Prints:
         example.obj:10:1: Q101 error uv-disaffine: texture coordinates are not an affine image of the positions: no texture found, texels of an assumed 1024x1024 texture (give the size with --texture-size or the texture-size setting) (175.7 vs 0.5 texels) [face 0]
+
+    Use instead:
+        # the same trapezoid re-UVed in its own shape, uv = ((x + 2) / 4, (y + 1) / 4): an affine map
+        v -1 0 0
+        v 1 0 0
+        v 0.5 1 0
+        v -0.5 1 0
+        vt 0.25 0.25
+        vt 0.75 0.25
+        vt 0.625 0.5
+        vt 0.375 0.5
+        f 1/1 2/2 3/3 4/4
 
     How to fix:
         Refine the quad: affinity fix splits it into n x n quads on its own
@@ -91,6 +105,11 @@ def color_disaffinity(quads) -> Measured:
         Measures the largest difference between the split's and the quad's bilinear
         vertex colour, in 1/255 steps, and flags quads above the threshold: a
         warning up to 8/255, an error above, where the seam is plainly visible.
+        On a parallelogram the two differ most at its centre, by a quarter of
+        |c0 - c1 + c2 - c3| (c0 to c3 the corner colours in [0, 1]): on the
+        example, |(-1, 1, 1)| / 4 = sqrt(3) / 4, the 255 sqrt(3) / 4 = 110.4 steps
+        printed below. Colours with c0 + c2 = c1 + c3 are an affine image of the
+        parallelogram and are never flagged.
 
     Example:
         # a unit square with corner colours blue, red, green, black: no parallelogram in colour space
@@ -102,6 +121,14 @@ def color_disaffinity(quads) -> Measured:
 
     Prints:
         example.obj:6:1: Q102 error color-disaffine: vertex colours are not an affine image of the positions (110.4 vs 2/255) [face 0]
+
+    Use instead:
+        # the same square repainted blue, red, yellow, cyan: the colours vary evenly, c0 + c2 = c1 + c3
+        v 0 0 0 0 0 1
+        v 1 0 0 1 0 0
+        v 1 1 0 1 1 0
+        v 0 1 0 0 1 1
+        f 1 2 3 4
 
     How to fix:
         Refine the quad (affinity fix, or subdivide it) so each piece carries a
@@ -123,7 +150,12 @@ def normal_disaffinity(quads) -> Measured:
         Measures how far the split turns the interpolated normal at its worst point,
         atan2(|split - bilinear|, |mean corner normal|) in degrees, and flags quads
         above the threshold: a warning up to 8 degrees, an error above, where the
-        bend in the shading is plainly visible.
+        bend in the shading is plainly visible. On a parallelogram with unit corner
+        normals n0 to n3 the split turns the normal most at the centre, by
+        atan2(|n0 - n1 + n2 - n3|, |n0 + n1 + n2 + n3|): on the example that is
+        atan((19 - 8 sqrt 5) / sqrt 41), the 9.847 degrees printed below. Normals
+        with n0 + n2 = n1 + n3 (a cylinder's, turning along one direction) are
+        never flagged.
 
     Example:
         # a flat square whose corner normals lean out unevenly: the lighting bends along the diagonal
@@ -139,6 +171,16 @@ def normal_disaffinity(quads) -> Measured:
 
     Prints:
         example.obj:10:1: Q103 error normal-disaffine: normals are not an affine image of the positions (9.847 vs 2 degrees) [face 0]
+
+    Use instead:
+        # the same square with a cylinder's normals: they turn evenly along x, n0 + n2 = n1 + n3
+        v 0 0 0
+        v 1 0 0
+        v 1 1 0
+        v 0 1 0
+        vn -0.6 0 0.8
+        vn 0.6 0 0.8
+        f 1//1 2//2 3//2 4//1
 
     How to fix:
         Refine the quad (affinity fix, or subdivide it) so each piece spans a

@@ -1,8 +1,9 @@
 """A rule's page and the README's rule table, written from the registry.
 
 The page follows ruff's layout: What it does / Why it matters / Example (the
-rule's OBJ and the line ``affinity check`` prints for it) / References / How to
-fix; it ends with the fix a modelling tool can apply (design.md).
+rule's OBJ and the line ``affinity check`` prints for it) / Use instead (the
+example fixed, which ``affinity check`` finds clean) / References / How to fix;
+it ends with the fix a modelling tool can apply (design.md).
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ SECTIONS = (
     ("What it does", "what"),
     ("Why it matters", "why"),
     ("Example", "example"),
+    ("Use instead", "use_instead"),
     ("References", "references"),
     ("How to fix", "fix"),
 )
@@ -63,14 +65,31 @@ def with_unit(number: str, unit: str) -> str:
     return f"{number} {unit}".rstrip()
 
 
+def _file(obj: str, outcome: str, markdown: bool) -> str:
+    """An input file of the page, then ``outcome`` (if any): what ``affinity check`` makes of it."""
+    obj = obj.rstrip("\n")
+    block = f"```\n{obj}\n```" if markdown else textwrap.indent(obj, "        ")
+    return block + (f"\n\n{'' if markdown else '    '}{outcome}" if outcome else "")
+
+
 def _example(rule: Rule, markdown: bool) -> str:
     """The example OBJ, then what ``affinity check example.obj`` prints for it."""
-    obj, output = rule.example.rstrip("\n"), rule.example_output.rstrip("\n")
+    output = rule.example_output.rstrip("\n")
     if markdown:
-        text = f"```\n{obj}\n```"
-        return text + (f"\n\n`affinity check example.obj` prints:\n\n```\n{output}\n```" if output else "")
-    indent = lambda block: textwrap.indent(block, "        ")
-    return indent(obj) + (f"\n\n    affinity check example.obj prints:\n\n{indent(output)}" if output else "")
+        printed = f"`affinity check example.obj` prints:\n\n```\n{output}\n```"
+    else:
+        printed = "affinity check example.obj prints:\n\n" + textwrap.indent(output, "        ")
+    return _file(rule.example, printed if output else "", markdown)
+
+
+def _use_instead(rule: Rule, markdown: bool) -> str:
+    """The example fixed the way the page's *How to fix* says: ``affinity check`` finds it clean."""
+    command = "`affinity check example.obj`" if markdown else "affinity check example.obj"
+    return _file(rule.use_instead, f"{command} finds nothing in it (exit 0).", markdown)
+
+
+#: Sections written as files, each by its own writer; the others are prose.
+FILES = {"Example": _example, "Use instead": _use_instead}
 
 
 def rule_page(rule: Rule, markdown: bool = False) -> str:
@@ -89,20 +108,20 @@ def rule_page(rule: Rule, markdown: bool = False) -> str:
     if markdown:
         head = [f"## {rule.code} {rule.name}", "", f"*{rule.summary}*", "", facts]
         body = [part for title, text in sections
-                for part in ("", f"### {title}", "", _example(rule, True) if title == "Example" else text)]
+                for part in ("", f"### {title}", "", FILES[title](rule, True) if title in FILES else text)]
     else:
         head = [f"{rule.code} {rule.name}: {rule.summary}", facts]
         fill = lambda text: textwrap.fill(text, 79, initial_indent="    ", subsequent_indent="    ")
         body = [part for title, text in sections
-                for part in ("", title, _example(rule, False) if title == "Example" else fill(text))]
+                for part in ("", title, FILES[title](rule, False) if title in FILES else fill(text))]
     return "\n".join(head + body) + "\n"
 
 
 def rules_table() -> str:
     """The Markdown rule table of the README (generated, never edited by hand): every rule, then Q901."""
     rows = [
-        "`affinity rules` lists the rules; `affinity rule CODE` prints a rule's page: what it does, "
-        "why it matters, an example and how to fix it.",
+        "`affinity rules` lists the rules; `affinity rule CODE` prints a rule's page: what it does, why it "
+        "matters, an example and what it prints, the example fixed (*Use instead*, which lints clean) and how to fix it.",
         "",
         "| Code | Name | Level | Default threshold | Flags | How to fix |",
         "|---|---|---|---|---|---|",

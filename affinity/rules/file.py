@@ -20,7 +20,8 @@ def no_faces(context) -> Measured:
 
     What it does:
         Flags a readable file that has vertices but no faces; the value reported is
-        the number of vertices, on face -1 and line 1 (no face to point at).
+        the number of vertices (the example's four v lines), on face -1 and line 1
+        (no face to point at).
 
     Why it matters:
         Nothing will render; usually a broken export (point cloud, lost face block).
@@ -28,12 +29,20 @@ def no_faces(context) -> Measured:
     Example:
         # only v lines: a point cloud, or an export that lost its faces
         v 0 0 0
-        v 1 0 0
-        v 1 1 0
+        v 2 0 0
+        v 2 1 0
         v 0 1 0
 
     Prints:
         example.obj:1:1: Q205 warning no-faces: the mesh has vertices but no faces (4 vertices)
+
+    Use instead:
+        # the same vertices exported with their face
+        v 0 0 0
+        v 2 0 0
+        v 2 1 0
+        v 0 1 0
+        f 1 2 3 4
 
     How to fix:
         Re-export the mesh with faces enabled in the exporter's geometry options.
@@ -79,9 +88,10 @@ def missing_resources(context) -> Measured:
         from the texture-size setting, and the finding says so.
 
     Why it matters:
-        Without the texture the same quad reads a different number of texels (256
-        with texture-size 1024, 1024 with a 4096 texture): the finding keeps the
-        unit from changing behind the user's back. A checkout without textures is
+        Without the texture the same quad reads a different number of texels (a
+        shift of a quarter of the texture's width is 256 texels with texture-size
+        1024, 1024 with a 4096 texture): the finding keeps the unit from changing
+        behind the user's back. A checkout without textures is
         common in CI, so it is info and does not fail the gate by itself.
 
     Example:
@@ -95,9 +105,17 @@ def missing_resources(context) -> Measured:
     Prints:
         example.obj:2:1: Q902 info missing-resource: an mtllib or map_Kd named by the file cannot be found or read: mtllib missing.mtl not found
 
+    Use instead:
+        # the same mesh without the line naming a library it does not need (one file cannot ship one)
+        v 0 0 0
+        v 1 0 0
+        v 1 1 0
+        f 1 2 3
+
     How to fix:
-        Add the file next to the mesh (git lfs pull for LFS pointers), or fix the
-        name in the mtllib or map_Kd line.
+        Add the file next to the mesh (git lfs pull for LFS pointers), fix the
+        name in the mtllib or map_Kd line, or, where the mesh needs no material,
+        drop the line (re-export without materials).
     """
     # The files the loader found referenced (``mesh.resources``, the resource registry's
     # roles), each looked at once; a USD stage's layers are pxr's to compose, and their
@@ -139,7 +157,8 @@ UNREADABLE_PAGE = """File cannot be parsed.
 What it does:
     Reports a file that cannot be read as a mesh, with the line. It is not a lint
     finding: the message goes to stderr, the exit code is 2, and --select/--ignore
-    do not apply to it.
+    do not apply to it. The example's face, on line 5, names vertex 4 of a file
+    with 3.
 
 Why it matters:
     Nothing in it can be checked.
@@ -149,6 +168,17 @@ Example:
     v 0 0 0
     v 1 0 0
     v 1 1 0
+    f 1 2 3 4
+
+Prints:
+    example.obj:5: Q901 unreadable: vertex index out of range (the file has 3)
+
+Use instead:
+    # the same face with the vertex it names
+    v 0 0 0
+    v 1 0 0
+    v 1 1 0
+    v 0 1 0
     f 1 2 3 4
 
 How to fix:

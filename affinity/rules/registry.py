@@ -37,6 +37,16 @@ rule is one decorated function (tests/test_rule_registry.py runs this one)::
             f 1 2 3 4
         Prints:
             example.obj:6:1: Q999 warning long-edge: a quad has an edge longer than the threshold (2 vs 1 units) [face 0]
+        Use instead:
+            # the rectangle cut into two unit squares
+            v 0 0 0
+            v 1 0 0
+            v 2 0 0
+            v 2 1 0
+            v 1 1 0
+            v 0 1 0
+            f 1 2 5 6
+            f 2 3 4 5
         References:
             None: an example.
         How to fix:
@@ -115,6 +125,8 @@ class Rule:
     example : a 4- to 8-line OBJ that triggers this rule and no other
     example_output : the text lines ``affinity check`` prints for ``example``
         saved as ``example.obj`` (a test lints it and compares)
+    use_instead : ``example`` fixed the way ``fix`` says: an input ``affinity check`` finds clean
+        (ruff's second half of a rule's page; a test lints it)
     references : the paper and section the rule comes from
     """
 
@@ -138,6 +150,7 @@ class Rule:
     why: str
     example: str
     example_output: str = ""
+    use_instead: str = ""
     fix: str
     references: str = ""
 
@@ -183,10 +196,10 @@ def register(rule: Rule) -> Rule:
 #: The page's headings in a check's docstring -> the Rule field each fills.
 PAGE_HEADINGS = {
     "What it does": "what", "Why it matters": "why", "Example": "example", "Prints": "example_output",
-    "References": "references", "How to fix": "fix",
+    "Use instead": "use_instead", "References": "references", "How to fix": "fix",
 }
 #: Sections kept line by line (files and output); the others are prose, joined into one paragraph.
-VERBATIM = frozenset({"example", "example_output"})
+VERBATIM = frozenset({"example", "example_output", "use_instead"})
 
 
 def page_fields(doc: str) -> dict[str, str]:

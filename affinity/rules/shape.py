@@ -22,7 +22,9 @@ def degenerate(quads) -> Measured:
         the threshold gets no Q101-Q103, whether or not this rule is selected (one
         finding per defect; the message says so); a quad with one repeated corner
         (a pole quad) is a triangle with area and keeps them: their value is exact
-        there.
+        there. The value reported is the area of the smallest of the four triangles
+        of the two splits relative to the squared longest edge: 0 where two corners
+        coincide, as in the example.
 
     Why it matters:
         One of the two triangles of the split covers no pixels, so the half of the
@@ -38,6 +40,13 @@ def degenerate(quads) -> Measured:
 
     Prints:
         example.obj:5:1: Q201 warning degenerate-quad: zero area, collapsed edge or repeated corner (0 vs 1e-09 relative area) [face 0]
+
+    Use instead:
+        # the collapsed corners merged: the triangle the face really is
+        v 0 0 0
+        v 1 0 0
+        v 1 1 0
+        f 1 2 3
 
     How to fix:
         Merge the collapsed corners (Blender: Mesh > Clean Up > Merge by Distance)
@@ -59,7 +68,10 @@ def nonplanar(quads) -> Measured:
         splits), in degrees, and flags quads above the threshold. 45 degrees is
         where Blender's 3D-Print Toolbox calls a face distorted. A triangle without
         area folds nothing here: that quad is Q201's. The affinity test runs on the
-        projection onto the quad's plane.
+        projection onto the quad's plane. In the example the split along the
+        diagonal 0-2 has triangle normals (0, -1, 1) and (-1, 0, 1): it folds by
+        arccos(1/2), the 60 degrees printed below (the split along 1-3 folds by
+        arccos(1/sqrt 3), 54.74 degrees, and diagonal = both reports the worse).
 
     Why it matters:
         A folded quad has no single flat shape: each diagonal split gives a
@@ -78,6 +90,15 @@ def nonplanar(quads) -> Measured:
     Prints:
         example.obj:6:1: Q202 warning nonplanar-quad: the split folds: the two triangles meet at an angle along the diagonal (60 vs 45 degrees) [face 0]
 
+    Use instead:
+        # the same corners triangulated along the intended diagonal: each triangle is flat
+        v 0 0 0
+        v 1 0 0
+        v 1 1 1
+        v 0 1 0
+        f 1 2 3
+        f 1 3 4
+
     How to fix:
         Flatten the quad (Blender: Mesh > Clean Up > Make Planar Faces), subdivide
         it, or triangulate it along the intended diagonal.
@@ -91,7 +112,9 @@ def concave(quads) -> Measured:
 
     What it does:
         Flags quads whose largest interior angle, in their own plane, is above the
-        threshold (180 degrees: a reflex corner).
+        threshold (180 degrees: a reflex corner). The example's edges leave its
+        reflex corner at atan(1/3) to the axes, so its interior angle is
+        270 - 2 atan(1/3) degrees, the 233.1 printed below.
 
     Why it matters:
         Splitting along the wrong diagonal folds a triangle outside the quad;
@@ -109,6 +132,14 @@ def concave(quads) -> Measured:
 
     Prints:
         example.obj:6:1: Q203 info concave-quad: one corner is reflex (233.1 vs 180 degrees) [face 0]
+
+    Use instead:
+        # the same dart with its reflex corner moved outward: a convex kite
+        v 0 0 0
+        v 2 0 0
+        v 1.5 1.5 0
+        v 0 2 0
+        f 1 2 3 4
 
     How to fix:
         Move the reflex corner outward, or split the quad into two triangles along
@@ -132,8 +163,11 @@ def bowtie(quads) -> Measured:
 
     What it does:
         Flags quads whose edges cross (a bow-tie) in their own plane; the value
-        reported is the folded fraction of the quad. A bow-tie gets no Q101-Q103,
-        whether or not this rule is selected (one finding per defect).
+        reported is the folded fraction of the quad: the share of its corner-turn
+        area (the sum of |T_i|, T_i the doubled area of the triangle at corner i)
+        that turns clockwise, 1/2 for a symmetric bow-tie such as the example's. A
+        bow-tie gets no Q101-Q103, whether or not this rule is selected (one
+        finding per defect).
 
     Why it matters:
         A self-crossing quad has no consistent orientation; one half renders
@@ -149,6 +183,14 @@ def bowtie(quads) -> Measured:
 
     Prints:
         example.obj:6:1: Q204 error bowtie-quad: the quad crosses itself (0.5 folded fraction) [face 0]
+
+    Use instead:
+        # the same corners in the order (0,0), (1,0), (1,1), (0,1): the crossing edges flipped
+        v 0 0 0
+        v 1 1 0
+        v 1 0 0
+        v 0 1 0
+        f 1 3 2 4
 
     How to fix:
         Reorder the corners (flip the crossing edge) or delete and refill the face

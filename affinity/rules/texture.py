@@ -15,9 +15,10 @@ def uv_degenerate(quads) -> Measured:
 
     What it does:
         Flags quads whose texture-space area is at or below the threshold relative
-        to their UV size. Such a quad gets no Q101 (its uv has no affine map to
-        measure), whether or not this rule is selected: one finding per defect,
-        and the message says so.
+        to their UV size (its signed uv area over its squared longest uv edge,
+        0 where the corners share one line, as in the example). Such a quad gets
+        no Q101 (its uv has no affine map to measure), whether or not this rule
+        is selected: one finding per defect, and the message says so.
 
     Why it matters:
         The whole quad samples a line or a point of the texture: it smears.
@@ -34,6 +35,18 @@ def uv_degenerate(quads) -> Measured:
 
     Prints:
         example.obj:8:1: Q301 warning uv-degenerate: zero area in texture space: the texture smears over it, so Q101 is not measured on it (0 vs 1e-09 relative area) [face 0]
+
+    Use instead:
+        # the square unwrapped again into an island of its own, the texture's upper right quarter
+        v 0 0 0
+        v 1 0 0
+        v 1 1 0
+        v 0 1 0
+        vt 0.5 0.5
+        vt 1 0.5
+        vt 1 1
+        vt 0.5 1
+        f 1/1 2/2 3/3 4/4
 
     References:
         Bloomenthal 2022, §2 (the barycentric test divides by the uv triangles' areas).
@@ -54,8 +67,9 @@ def uv_flipped(quads) -> Measured:
     What it does:
         Flags quads whose UV winding is clockwise while the face winding is
         counter-clockwise (a mirrored UV island); the value reported is the negative
-        relative UV area. Quads whose UV area is within Q301's threshold (as
-        configured) are Q301's: degenerate, not flipped.
+        relative UV area (the signed uv area over the squared longest uv edge: -1
+        for the example's mirrored square). Quads whose UV area is within
+        Q301's threshold (as configured) are Q301's: degenerate, not flipped.
 
     Why it matters:
         Mirrored UVs flip the tangent frame: normal maps light the wrong way.
@@ -70,13 +84,25 @@ def uv_flipped(quads) -> Measured:
         v 1 1 0
         v 0 1 0
         vt 1 0
-        vt 0 0
-        vt 0 1
-        vt 1 1
+        vt 0.5 0
+        vt 0.5 0.5
+        vt 1 0.5
         f 1/1 2/2 3/3 4/4
 
     Prints:
         example.obj:10:1: Q302 info uv-flipped: texture orientation reversed against the surface (-1 relative area) [face 0]
+
+    Use instead:
+        # the island mirrored back in place: uv turns the way the face does
+        v 0 0 0
+        v 1 0 0
+        v 1 1 0
+        v 0 1 0
+        vt 0.5 0
+        vt 1 0
+        vt 1 0.5
+        vt 0.5 0.5
+        f 1/1 2/2 3/3 4/4
 
     References:
         Mikkelsen 2008, Simulation of wrinkled surfaces revisited (tangent frames at mirrored UVs).

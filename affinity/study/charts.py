@@ -16,7 +16,7 @@ import math
 
 import numpy as np
 
-from .tables import headline_hybrid
+from .tables import error_label, headline_hybrid
 
 #: Errors below this are drawn at it (a log axis has no zero): "no error" to plotting precision.
 ERROR_FLOOR = 1e-4
@@ -102,7 +102,7 @@ def error_against_time(rows: list[dict], time_label: str = "median time (ms)") -
         _plain_log(ax.yaxis)
         ax.set_title(scene, fontsize=9, loc="left")
         ax.set_xlabel(time_label, fontsize=8)
-        ax.set_ylabel(f"RMS error ({of_scene[0]['unit']})", fontsize=8)
+        ax.set_ylabel(error_label(of_scene[0]["unit"]), fontsize=8)
         ax.tick_params(labelsize=7)
     _legend(figure, axes)
     figure.suptitle(f"Error against exact vs run time (errors below {ERROR_FLOOR:g} drawn at it)", fontsize=10)
@@ -129,7 +129,7 @@ def hybrid_sweep(rows: list[dict]) -> bytes:
         _plain_log(ax.yaxis)
         ax.set_title(scene, fontsize=9, loc="left")
         ax.set_xlabel("quads sent to mvc (%)", fontsize=8)
-        ax.set_ylabel(f"RMS error ({of_scene[0]['unit']}), solid", fontsize=8)
+        ax.set_ylabel(error_label(of_scene[0]["unit"]) + ", solid", fontsize=8)
         timing.set_ylabel("median ms, dotted", fontsize=8)
         for each in (ax, timing):
             each.tick_params(labelsize=7)

@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..attributes import Attribute, attribute_named
 from ..mesh import Mesh
 from ..scenes import Scene
 from ..settings import Settings
@@ -74,7 +75,8 @@ class PreparedScene:
 
     ``faces`` (R,) the mesh face of each render quad; ``clip`` (R, 4, 4);
     ``inputs`` the attributes drawn (``affinity.draw.shading.ShadingInputs``);
-    ``code`` the lint rule of the attribute shown (Q101 uv, Q102 colours);
+    ``show`` the attribute shown, as the command line names it (``"uv"``, ``"color"``);
+    ``code`` the scored rule of that attribute (the rule registry's, e.g. uv's uv-disaffine);
     ``lint`` the Settings governing the mesh's file (``affinity.config.file_settings``);
     ``routes`` maps a hybrid route name to (its per-render-quad values (R,), for
     ``"view"`` the ``affinity.draw.drawing.uv_routing_inputs``,
@@ -94,9 +96,14 @@ class PreparedScene:
     routes: dict = field(default_factory=dict)
 
     @property
+    def attribute(self) -> Attribute:
+        """The attribute shown, from the attribute registry: its field, unit and label."""
+        return attribute_named(self.show)
+
+    @property
     def columns(self) -> slice:
-        """The attribute columns compared (uv or colour)."""
-        return self.inputs.uv if self.show == "uv" else self.inputs.color
+        """The attribute columns compared (``ShadingInputs`` names them as the attribute is named)."""
+        return getattr(self.inputs, self.attribute.name)
 
 
 @dataclass
@@ -120,6 +127,7 @@ def prepare(case: Scene, settings: StudySettings) -> PreparedScene:
     """
     from ..draw.drawing import RenderOptions, render_mesh
     from ..draw.texture import checker
+    from ..lint import scored_code_of
 
     mesh = case.mesh()
     if mesh.n_faces == 0:
@@ -131,7 +139,7 @@ def prepare(case: Scene, settings: StudySettings) -> PreparedScene:
     drawn = render_mesh(mesh, RenderOptions(method="split", show=show, width=settings.width, height=settings.height,
                                             camera=case.view.camera, up=case.view.up, texture=texture))
     direction = np.subtract(drawn.camera.eye, drawn.camera.target)
-    scene = PreparedScene(case, mesh, drawn.faces, drawn.clip, drawn.inputs, show, "Q101" if show == "uv" else "Q102",
+    scene = PreparedScene(case, mesh, drawn.faces, drawn.clip, drawn.inputs, show, scored_code_of(show, mesh),
                           texture, direction / np.linalg.norm(direction), drawn.settings)
     scene.routes = _routes(scene, settings)
     return scene
@@ -147,6 +155,7 @@ def _routes(scene: PreparedScene, settings: StudySettings) -> dict:
 
     from ..draw.drawing import uv_routing_inputs
     from ..lint import quad_scores
+    from ..rules import RULES
 
     routes = {}
     if scene.show == "uv":
@@ -154,7 +163,7 @@ def _routes(scene: PreparedScene, settings: StudySettings) -> dict:
         inputs = uv_routing_inputs(scene.mesh, scene.faces, scene.inputs.attrs[..., scene.inputs.uv], scene.lint)
         routes["view"] = (inputs, settings.tolerances, time.perf_counter() - start)
     readings = [("error", settings.misplacement_thresholds)]
-    if scene.show == "uv":
+    if "barycentric" in RULES[scene.code].readings:  # the paper's score: a reading of the uv rule only
         readings.append(("barycentric", settings.barycentric_thresholds))
     if settings.lint_route or scene.show != "uv":
         for measure, thresholds in readings:
@@ -255,11 +264,10 @@ def _compared(scene, settings, frame, reference):
     against ``reference`` there. (Split and the quad-filling methods may show different quads at a
     pixel of a concave or bow-tie quad: that is coverage, not interpolation, and is left out.)"""
     from ..attributes import pixel_error
-    from ..rules import RULES
 
     both = (frame.face >= 0) & (frame.face == reference.face)
     error = pixel_error(frame.attrs[both][:, scene.columns], reference.attrs[both][:, scene.columns],
-                        RULES[scene.code].attribute, settings.texture_size)
+                        scene.attribute.field, settings.texture_size)
     return both, error
 
 
@@ -267,7 +275,6 @@ def _errors(scene, settings, frame, exact, image, exact_image, clip, density) ->
     """Attribute error (and, given the texture density (H, W), in screen pixels), PSNR, SSIM
     against exact, and the crease of ``frame``."""
     from ..attributes import pixel_error
-    from ..rules import RULES
 
     both, error = _compared(scene, settings, frame, exact)
     summary = error_summary(error)
@@ -278,10 +285,10 @@ def _errors(scene, settings, frame, exact, image, exact_image, clip, density) ->
         in_pixels = error_summary(pixels[np.isfinite(pixels)])
     jump, pixels = crease(frame.attrs[..., scene.columns], frame.face, clip)
     fitted = ~np.isnan(jump).any(axis=1)
-    size = pixel_error(jump[fitted], np.zeros_like(jump[fitted]), RULES[scene.code].attribute, settings.texture_size)
+    size = pixel_error(jump[fitted], np.zeros_like(jump[fitted]), scene.attribute.field, settings.texture_size)
     measured = bool(both.any())
     return {
-        "unit": "texels" if scene.code == "Q101" else "1/255",
+        "unit": scene.attribute.unit,
         "compared_pixels": int(both.sum()),
         "err_rms": summary["rms"], "err_p99": summary["p99"], "err_max": summary["max"],
         "px_rms": in_pixels["rms"], "px_p99": in_pixels["p99"], "px_max": in_pixels["max"],

@@ -9,11 +9,39 @@ import csv
 import math
 
 from ..atomic import atomic_write
+from ..attributes import ATTRIBUTES, Attribute
+from ..rules import RULES, scoring_rules, threshold_text, with_unit
 from .sweep import COLUMNS
 
-#: The hybrid setting the headline table shows: the renderer's default pixel
-#: tolerance (``RenderOptions.pixel_tolerance``) for uv, the Q102 default threshold for colours.
-HEADLINE_SETTINGS = {"view": 0.5, "lint error": 2.0}
+
+def headline_settings(unit: str) -> dict[str, float]:
+    """Route -> the hybrid setting the headline table shows for a scene whose errors are in ``unit``: by
+    view the renderer's default pixel tolerance (``RenderOptions.pixel_tolerance``), by lint the default
+    threshold of the scored rule of the attribute measured in ``unit`` (the registries': 2/255 for colours)."""
+    return {"view": _pixel_tolerance(), "lint error": _lint_rule(unit).default_threshold}
+
+
+def _pixel_tolerance() -> float:
+    """The renderer's default pixel tolerance: the view route's headline setting."""
+    from ..draw.drawing import RenderOptions
+
+    return RenderOptions.pixel_tolerance
+
+
+def attribute_in(unit: str) -> Attribute:
+    """The attribute whose errors are measured in ``unit`` (a row's ``unit``; each attribute has its own)."""
+    (attribute,) = [attribute for attribute in ATTRIBUTES.values() if attribute.unit == unit]
+    return attribute
+
+
+def error_label(unit: str) -> str:
+    """What an axis of RMS errors in ``unit`` is called: ``"RMS uv error (texels)"``."""
+    return f"RMS {attribute_in(unit).label} error ({unit})"
+
+
+def _lint_rule(unit: str):
+    """The first scored rule of the attribute whose errors are in ``unit``."""
+    return RULES[scoring_rules(attribute_in(unit).field)[0]]
 
 
 def write_csv(rows: list[dict], path: str) -> None:
@@ -32,10 +60,11 @@ def _cell(value) -> str:
 
 
 def headline_hybrid(rows: list[dict], scene: str) -> dict | None:
-    """The scene's hybrid row at the headline setting (view route first), or None."""
-    for route, setting in HEADLINE_SETTINGS.items():
-        for row in rows:
-            if row["scene"] == scene and row["route"] == route and math.isclose(row["setting"], setting):
+    """The scene's hybrid row at the headline setting (:func:`headline_settings`, view route first), or None."""
+    of_scene = [row for row in rows if row["scene"] == scene]
+    for route, setting in headline_settings(of_scene[0]["unit"]).items():
+        for row in of_scene:
+            if row["route"] == route and math.isclose(row["setting"], setting):
                 return row
     return None
 
@@ -58,10 +87,14 @@ def summary_markdown(rows: list[dict], facts: dict[str, str], header: list[str])
 
 
 def _headline(rows: list[dict], scenes: list[str]) -> list[str]:
+    by_view = {row["scene"] for row in rows if row["route"] == "view"}
+    by_lint = [_lint_rule(unit) for unit in dict.fromkeys(row["unit"] for row in rows if row["scene"] not in by_view)]
+    lint = "".join(f"; {ATTRIBUTES[rule.attribute].label} by lint: the {rule.code} threshold, {threshold_text(rule)}"
+                   for rule in by_lint)
     lines = [
         "## Where the hybrid sits",
         "",
-        ("Hybrid at the default setting (0.5 px tolerance, by view; colours: the Q102 threshold, 2/255). "
+        (f"Hybrid at the default setting ({_pixel_tolerance():g} px tolerance, by view{lint}). "
          "Times are medians; the time ratios are of the medians and, in brackets, of the fastest runs (less "
          "disturbed by other jobs on a shared machine). Errors are RMS against exact; the last column is the RMS "
          "difference between the splits along the two diagonals."),
@@ -74,7 +107,7 @@ def _headline(rows: list[dict], scenes: list[str]) -> list[str]:
         by_method = {row["method"]: row for row in rows if row["scene"] == scene and not row["route"]}
         hybrid = headline_hybrid(rows, scene)
         split, mvc = by_method["split"], by_method["mvc"]
-        unit = " tx" if split["unit"] == "texels" else "/255"
+        unit = with_unit("", split["unit"])  # what follows a number: " texels", "/255"
         if hybrid is None:
             hybrid_cells = ["—", "—", "—", "—"]
         else:
@@ -102,8 +135,8 @@ def _headline_in_pixels(rows: list[dict], scenes: list[str]) -> list[str]:
     ]
     for scene in scenes:
         by_method = {row["method"]: row for row in rows if row["scene"] == scene and not row["route"]}
-        if by_method["split"]["unit"] != "texels":
-            continue
+        if math.isnan(by_method["split"]["px_max"]):
+            continue  # no texture density: the attribute shown is not a texture's
         hybrid = headline_hybrid(rows, scene)
         cells = [by_method["split"], hybrid, by_method["mvc"], by_method["bilinear"], by_method["projective"]]
         values = ["—" if row is None else f"{_num(row['px_p99'])} / {_num(row['px_max'])}" for row in cells]
