@@ -53,11 +53,6 @@ def _unit(vectors: np.ndarray) -> np.ndarray:
     return np.divide(vectors, length, out=np.zeros_like(vectors), where=length > 0)
 
 
-def _cross2(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """(..., 2), (..., 2) -> (...) the z component of a x b."""
-    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
-
-
 def _corner_major(corners: np.ndarray) -> np.ndarray:
     """(Q, 4, D) -> (4, Q, D) copy, so that each corner p_k is one contiguous block and
     combining corners streams through memory."""
@@ -454,17 +449,25 @@ def interior_angles(quads: PlanarQuads) -> np.ndarray:
     """Interior angle at every corner in the quad's plane, in degrees.
 
     angle_k = 180 - atan2(turn_k, e_in . e_out) in degrees, with e_in = p_k - p_{k-1},
-    e_out = p_{k+1} - p_k and turn_k = e_in x e_out; above 180 at a reflex corner.
-    Turns within the degenerate tolerance are taken as exactly 0, so three
-    collinear corners read 180, not a reflex 180 plus rounding. Meaningful for
+    e_out = p_{k+1} - p_k, both projected onto the quad's plane, and turn_k = e_in x e_out
+    = T_{k+2} (the triangle (p_{k-1}, p_k, p_{k+1})); above 180 at a reflex corner. The
+    projected dot product is e_in . e_out - (e_in . n)(e_out . n) for the unit plane normal
+    n, so nothing is projected. Turns within the degenerate tolerance are taken as exactly
+    0, so three collinear corners read 180, not a reflex 180 plus rounding. Meaningful for
     simple (non-bow-tie) quads.
 
     Returns
     -------
     (Q, 4) float64
     """
-    e_out = np.roll(quads.xy, -1, axis=1) - quads.xy
-    e_in = np.roll(e_out, 1, axis=1)
-    turn = _cross2(e_in, e_out)
-    turn[np.abs(turn) <= quads.tolerance[:, None]] = 0.0
-    return 180.0 - np.degrees(np.arctan2(turn, np.einsum("qkd,qkd->qk", e_in, e_out)))
+    e = _edges(quads.components)
+    e_in, e_out = e[:, [3, 0, 1, 2]], e[:, :4]  # (D, 4, Q): into and out of corners 0..3
+    dot = dot_by_component(e_in, e_out)
+    if quads.plane_normals is not None:
+        n = quads.plane_normals
+        length = np.sqrt(squared_lengths(n))
+        n = np.divide(n, length, out=np.zeros_like(n), where=length > 0)[:, None]
+        dot -= dot_by_component(e_in, n) * dot_by_component(e_out, n)
+    turn = quads.areas[:, _CORNER_TURN_AT].T
+    turn[np.abs(turn) <= quads.tolerance] = 0.0
+    return 180.0 - np.degrees(np.arctan2(turn, dot)).T

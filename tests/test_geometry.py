@@ -125,6 +125,25 @@ def test_interior_angles():
     np.testing.assert_allclose(straight[0, 1], 180)
 
 
+def test_interior_angles_of_folded_quads_are_those_of_their_projection_onto_the_quads_plane():
+    """Nonplanar quads: the corners projected onto the plane through their centroid with normal
+    d02 x d13 (numpy), and the angles between the projected edges (the reference walks the corners;
+    the measure reads the plane's areas and dot products). Their sum is 360 for simple quads."""
+    rng = np.random.default_rng(203)
+    corners = lift(SQUARE) + rng.normal(scale=0.15, size=(300, 4, 3))
+    normal = np.cross(corners[:, 2] - corners[:, 0], corners[:, 3] - corners[:, 1])
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+    flat = corners - np.einsum("qkd,qd->qk", corners, normal)[..., None] * normal[:, None]
+    e_out = np.roll(flat, -1, axis=1) - flat
+    e_in = np.roll(e_out, 1, axis=1)
+    turn = np.einsum("qkd,qd->qk", np.cross(e_in, e_out), normal)
+    expected = 180 - np.degrees(np.arctan2(turn, np.einsum("qkd,qkd->qk", e_in, e_out)))
+    quads = planar_quads(corners)
+    simple = ~is_bowtie(quads)
+    np.testing.assert_allclose(interior_angles(quads)[simple], expected[simple], atol=1e-9)
+    np.testing.assert_allclose(interior_angles(quads)[simple].sum(axis=1), 360, atol=1e-9)
+
+
 def test_concave_and_bowtie_are_told_apart_in_any_orientation():
     rng = np.random.default_rng(3)
     shapes = [SQUARE, DART, BOWTIE, BOWTIE_SKEWED, DART[::-1]]

@@ -88,3 +88,30 @@ def test_q103_is_the_worst_turn_of_the_split_normal_found_by_dense_sampling(lean
         worst = max(np.linalg.norm(split02 - bilinear, axis=1).max(), np.linalg.norm(split13 - bilinear, axis=1).max())
         expected = np.degrees(np.arctan2(worst, np.linalg.norm(n[q].mean(axis=0))))
         assert measured.values[q] == pytest.approx(expected, rel=1e-5, abs=1e-9)
+
+
+@pytest.fixture
+def mixed_quads() -> Mesh:
+    """Separate quads jittered far enough to be concave, bow-ties or folded, with uv, colours and normals."""
+    rng = np.random.default_rng(203)
+    q = 400
+    square = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], dtype=float)
+    corners = square + rng.normal(scale=0.3, size=(q, 4, 3)) + 3 * np.arange(q)[:, None, None] * np.array([1.0, 0, 0])
+    normals = np.concatenate([rng.uniform(-0.8, 0.8, (q, 4, 2)), np.ones((q, 4, 1))], axis=2)
+    mesh = quads_with_normals(corners, normals)
+    mesh.texcoords = rng.uniform(0, 1, (4 * q, 2))
+    mesh.corner_texcoord = np.arange(4 * q)
+    mesh.colors = rng.uniform(0, 1, (4 * q, 3))
+    return mesh
+
+
+@pytest.mark.parametrize("code", ["Q101", "Q102", "Q103", "Q201", "Q202", "Q203", "Q204", "Q301", "Q302"])
+def test_no_check_reads_its_own_threshold(code, mixed_quads):
+    """A check is a pure measure: the same rows and values whatever the rule's threshold (lint compares)."""
+    check = RULES[code].check
+    readings = [check(batch_of(mixed_quads, Settings(thresholds={code: t}))) for t in (-1e9, 0.0, 180.0, 1e9)]
+    rows = [np.arange(400)[measured.rows] for measured in readings]
+    assert len(rows[0]) > 0
+    for measured, taken in zip(readings[1:], rows[1:]):
+        np.testing.assert_array_equal(taken, rows[0])
+        np.testing.assert_array_equal(measured.values, readings[0].values)

@@ -145,16 +145,8 @@ def concave(quads) -> Measured:
         Move the reflex corner outward, or split the quad into two triangles along
         the diagonal through the reflex corner (Blender: Face > Triangulate).
     """
-    planar = quads.planar
-    candidates = ~is_bowtie(planar)
-    if quads.settings.threshold("Q203") >= 180:
-        # An angle above 180 degrees needs a clockwise turn; half the tolerance
-        # keeps every turn interior_angles could read as one.
-        candidates &= (planar.areas < -0.5 * planar.tolerance[:, None]).any(axis=1)
-    rows = np.flatnonzero(candidates)
-    if len(rows) == 0:
-        return Measured.nothing()
-    return Measured(rows, interior_angles(planar.take(rows)).max(axis=1))
+    rows = np.flatnonzero(~is_bowtie(quads.planar))
+    return Measured(rows, interior_angles(quads.planar).max(axis=1)[rows])
 
 
 @rule(code="Q204", name="bowtie-quad", level="error", unit="folded fraction", references=REFERENCES)
