@@ -6,7 +6,8 @@ the rule's default threshold, in a fresh process per tree and round, the trees t
 
     python benchmarks/bench_rule_checks.py --base /path/to/other/tree [--quads 1000000] [--rounds 3]
 
-``--small``: 20,000 quads, one round. Not a test: run it and read it.
+Without ``--base`` the tree is timed against itself: the noise between two runs. ``--small``: 20,000
+quads, one round. Not a test: run it and read it.
 """
 
 from __future__ import annotations
@@ -65,7 +66,8 @@ def timings(tree: Path, quads: int) -> dict[str, float]:
 
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--base", type=Path, required=True, help="the other tree (e.g. a worktree of main)")
+    parser.add_argument("--base", type=Path, default=ROOT,
+                        help="the other tree, e.g. an export of main (default: this one, the noise)")
     parser.add_argument("--quads", type=int, default=1_000_000)
     parser.add_argument("--rounds", type=int, default=3)
     args = parse_with_output(parser, "20,000 quads, one round", "folder of the table", argv)
@@ -77,8 +79,8 @@ def main(argv=None) -> None:
         runs["this"].append(timings(ROOT, quads))
     median = {tree: {code: statistics.median(r[code] for r in rounds_) for code in CODES}
               for tree, rounds_ in runs.items()}
-    lines = [f"Rule checks on {quads:,} quads (lint_mesh, one rule selected, best of 3 in a process); "
-             f"{run_conditions(load, rounds)}; {time.strftime('%Y-%m-%d')}", "",
+    lines = [f"Rule checks on {quads:,} quads (lint_mesh, one rule selected, best of 3 in a process), base "
+             f"{args.base}; {run_conditions(load, rounds)}; {time.strftime('%Y-%m-%d')}", "",
              "| rule | base (s) | this tree (s) | this / base |", "|---|---:|---:|---:|"]
     for code in CODES:
         base, this = median["base"][code], median["this"][code]
