@@ -178,7 +178,7 @@ def test_demo_report_prints_the_commands_run_time_and_its_parts(demo):
     assert 0.75 * result.wall <= printed <= result.wall
     (line,) = [p.text() for p in summary.find_all("p", "parts")]
     parts = dict(part.strip().removesuffix(" s").rsplit(" ", 1) for part in line.split(":", 1)[1].split("·"))
-    assert {"start-up", "lint", "scores", "renders", "3-D overview", "close-ups", "page"} <= parts.keys()
+    assert {"start-up", "lint", "renders", "3-D overview", "close-ups", "page"} <= parts.keys()
     assert sum(map(float, parts.values())) == pytest.approx(printed, abs=0.05 + 0.1 * printed)
 
 
