@@ -6,7 +6,7 @@ fields that hold it, its width, its unit, the note a report gives when a mesh
 lacks it, the name every command uses for it (``render --show``, ``view
 --attribute``), and how a difference of two values reads in that unit. Which
 rules score an attribute is read from the rule registry
-(:func:`scoring_rules`), so a new rule on an attribute is found without
+(``affinity.lint.scored_codes``), so a new rule on an attribute is found without
 touching this table. Imports nothing at load (the command line reads the
 names); the measures are imported when a difference is taken.
 """
@@ -115,13 +115,6 @@ def canonical_name(text: str) -> str:
         return attribute_named(text).name
     except KeyError:
         return text
-
-
-def scoring_rules(field: str) -> list[str]:
-    """Codes of the scored rules (``Rule.scored``) on the attribute ``field``, in code order."""
-    from .rules import RULES
-
-    return [code for code, rule in RULES.items() if rule.scored and rule.attribute == field]
 
 
 #: The attributes a picture draws when nothing else decides, in order of preference (Mesh fields); a mesh with

@@ -326,8 +326,8 @@ def lint_pass(mesh: Mesh, settings: Settings, visible: bool = True, scores: bool
 
 
 def _measured(batch: QuadBatch, rule, causes: Unmeasurable) -> tuple[np.ndarray, np.ndarray]:
-    """(n,) int64 rows into ``batch`` and (n,) float64 values of the quads quad ``rule`` measures; a scored rule
-    leaves out the quads one of its ``causes`` takes over (one finding per defect)."""
+    """(n,) int64 rows into ``batch`` and (n,) float64 values of the quads ``rule``'s check measures; a scored
+    rule leaves out the quads one of its ``causes`` takes over (one finding per defect)."""
     rows, values = rule.check(batch)
     rows = np.arange(len(batch))[rows]
     if rule.scored:

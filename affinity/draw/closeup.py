@@ -34,7 +34,7 @@ from ..rules import RULES
 from ..settings import Settings
 from .faces import face_centroids, face_subset, face_vertices, mean_normal, ring_of, vector_areas
 
-# -- Framing ---------------------------------------------------------------------------------------------------
+# -- Tuning: framing ------------------------------------------------------------------------------------------
 #: Side of a close-up picture, pixels.
 CLOSEUP_SIZE = 240
 #: Vertical field of view of a close-up, degrees.
@@ -60,7 +60,7 @@ WHOLE_PLACE = 2.0
 #: no pixels from any side, so the floor does not apply and its outline's halo marks it.
 SLIVER_AREA = 1e-3
 
-# -- Panels ----------------------------------------------------------------------------------------------------
+# -- Tuning: panels -------------------------------------------------------------------------------------------
 #: Methods of a close-up, left to right.
 CLOSEUP_METHODS = ("split", "hybrid", "exact")
 #: The 1-texel texture the line pattern replaces pixel by pixel.
@@ -78,7 +78,7 @@ AMBIENT, LIT = 0.12, 0.88
 FOLD_SURFACE = np.array([0.86, 0.86, 0.84])
 DIAGONAL_INK = np.array([0.05, 0.35, 0.85], dtype=np.float32)
 
-# -- Error map -------------------------------------------------------------------------------------------------
+# -- Tuning: error map ----------------------------------------------------------------------------------------
 #: Shown attributes whose close-up also gets the split's difference from exact amplified, when it is faint (a
 #: colour or normal crease of a few 1/255, a uv error under a pixel): the largest channel change is brought to
 #: about ``COLOUR_REACH`` (of 1), the largest uv displacement to about ``UV_REACH`` pixels on screen, by a gain

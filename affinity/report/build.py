@@ -153,7 +153,7 @@ class MeshResult:
     def drawn(self) -> str:
         """What the renders draw (:func:`affinity.attributes.drawn_attribute`): ``"uv"``, ``"color"`` or
         ``"shaded"``; the attribute of the rule shown when it is drawable."""
-        return drawn_attribute(self.mesh, RULES[self.shown].attribute if self.shown else None)
+        return drawn_for(self.mesh, self.shown)
 
 
 @dataclass
@@ -307,6 +307,12 @@ def shown_code(file: FileReport, scores: dict[str, QuadScores]) -> str | None:
     return next((code for code in scores if code in flagged), next(iter(scores), None))
 
 
+def drawn_for(mesh: Mesh, shown: str | None) -> str:
+    """What the renders of ``mesh`` draw when they show the scored rule ``shown`` (None: none): its attribute
+    when a picture can draw it, else uv, else colours, else shading (:func:`affinity.attributes.drawn_attribute`)."""
+    return drawn_attribute(mesh, RULES[shown].attribute if shown else None)
+
+
 def collect_mesh(item: MeshInput, settings: Settings, step: Callable[[str], None] = lambda name: None,
                  options: ReportOptions = ReportOptions()) -> MeshResult:
     """Lint (once, with every quad's scores), render and picture one mesh; an unreadable file gives a result
@@ -344,7 +350,7 @@ def _collect_pictures(item: MeshInput, file: FileReport, mesh: Mesh, settings: S
     view = view_of(mesh, item.view, options)
     checks = item.view.checks and mesh.texcoords is not None
     texture = options.texture or (checker(512, item.view.checks) if checks else None)
-    drawn = drawn_attribute(mesh, RULES[shown].attribute if shown else None)
+    drawn = drawn_for(mesh, shown)
     rendered = render_views(mesh, drawn, view, options, settings, texture, timer)
     stability = None
     if "hybrid" in rendered.renders:
