@@ -8,7 +8,7 @@ lacks it, the name every command uses for it (``render --show``, ``view
 study's charts, the Blender panel), and how a difference of two values reads in
 that unit. Which
 rules score an attribute is read from the rule registry
-(:func:`scoring_rules`), so a new rule on an attribute is found without
+(``affinity.lint.scored_codes``), so a new rule on an attribute is found without
 touching this table. Imports nothing at load (the command line reads the
 names); the measures are imported when a difference is taken.
 """
@@ -133,8 +133,22 @@ def canonical_name(text: str) -> str:
         return text
 
 
-def scoring_rules(field: str) -> list[str]:
-    """Codes of the scored rules (``Rule.scored``) on the attribute ``field``, in code order."""
-    from .rules import RULES
+#: The attributes a picture draws when nothing else decides, in order of preference (Mesh fields); a mesh with
+#: none of them is shaded (its normals light it: drawn as colours they would hide the surface).
+DRAWN_IN_ORDER = ("texcoords", "colors")
 
-    return [code for code, rule in RULES.items() if rule.scored and rule.attribute == field]
+
+def drawn_attribute(mesh, preferred: str | None = None) -> str:
+    """What a picture of ``mesh`` draws: the attribute ``preferred`` (a Mesh field, e.g. the one a finding is
+    about) when it is one of :data:`DRAWN_IN_ORDER` and the mesh has it, else the first of those the mesh has,
+    by its command-line name (``"uv"``, ``"color"``), else ``"shaded"``.
+
+    >>> from types import SimpleNamespace
+    >>> terrain = SimpleNamespace(texcoords=[(0, 0)], colors=[(1, 0, 0)], normals=None)
+    >>> drawn_attribute(terrain), drawn_attribute(terrain, "colors"), drawn_attribute(terrain, "normals")
+    ('uv', 'color', 'uv')
+    >>> drawn_attribute(SimpleNamespace(texcoords=None, colors=None, normals=[(0, 0, 1)]))
+    'shaded'
+    """
+    fields = ((preferred,) if preferred in DRAWN_IN_ORDER else ()) + DRAWN_IN_ORDER
+    return next((ATTRIBUTES[field].name for field in fields if getattr(mesh, field) is not None), "shaded")

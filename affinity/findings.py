@@ -168,6 +168,9 @@ class FileReport:
     ``values``: per rule code, ``[face within the prim, [value per prim, None where
     that prim has no finding]]`` for the findings whose prims disagree (different
     textures bound).
+
+    ``scores`` (only when asked, for the report: never stored) maps each scored rule the mesh has an
+    attribute for to the :class:`affinity.lint.QuadScores` of every quad it measures, from the same lint.
     """
 
     path: str
@@ -183,6 +186,7 @@ class FileReport:
     notes: list[str] = field(default_factory=list)
     transient: bool = False
     shared: list[dict] = field(default_factory=list)
+    scores: dict = field(default_factory=dict)
 
     @property
     def n_findings(self) -> int:
@@ -228,17 +232,18 @@ def settle(hits: list[RuleHits], settings, group_names: list[str], inline=()) ->
     return settled
 
 
-def mesh_report(path: str, mesh, settings, inline=()) -> FileReport:
+def mesh_report(path: str, mesh, settings, inline=(), scores: bool = False) -> FileReport:
     """The report of the file at ``path`` whose mesh is ``mesh``: its findings (lint, then :func:`settle`
     with ``settings`` and the ``inline`` ignores, then :func:`share_authored_geometry`), counts, groups,
-    and for a USD stage its prims, metadata and the loader's notes."""
-    from .lint import lint_mesh
+    and for a USD stage its prims, metadata and the loader's notes; with ``scores``, every quad's scores
+    from the same lint (:attr:`FileReport.scores`)."""
+    from .lint import lint_pass
 
-    hits, shared = share_authored_geometry(settle(lint_mesh(mesh, settings), settings, list(mesh.group_names), inline),
-                                           mesh)
+    linted = lint_pass(mesh, settings, scores=scores)
+    hits, shared = share_authored_geometry(settle(linted.hits, settings, list(mesh.group_names), inline), mesh)
     return FileReport(path, counts=mesh.counts(), hits=hits, shared=shared, group_names=list(mesh.group_names),
                       prim_face_start=mesh.prim_face_start, up_axis=mesh.up_axis,
-                      meters_per_unit=mesh.meters_per_unit, notes=list(mesh.notes))
+                      meters_per_unit=mesh.meters_per_unit, notes=list(mesh.notes), scores=linted.scores)
 
 
 def share_authored_geometry(hits: list[RuleHits], mesh) -> tuple[list[RuleHits], list[dict]]:
@@ -320,7 +325,8 @@ def report_to_bytes(report: FileReport) -> bytes:
     import zlib
     from dataclasses import fields
 
-    meta = {f.name: getattr(report, f.name) for f in fields(report) if f.name not in ("hits", "prim_face_start")}
+    kept_apart = ("hits", "prim_face_start", "scores")  # scores are the report's, never stored
+    meta = {f.name: getattr(report, f.name) for f in fields(report) if f.name not in kept_apart}
     meta["hits"] = [{"code": h.code, "threshold": h.threshold, "level": h.level, "unit": h.unit,
                      "details": h.details, "error_above": h.error_above, "visible": _visible_meta(h.visible)}
                     for h in report.hits]

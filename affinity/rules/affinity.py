@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..geometry import squared_lengths
 from ..measures import barycentric_score, color_steps, normal_degrees, texels
 from .registry import rule
 
@@ -191,15 +190,4 @@ def normal_disaffinity(quads) -> tuple:
         only makes every tool shade the same one.
     """
     rows, unit = quads.complete("normals")  # unit length already (see affinity.lint.CornerTables.gather)
-    m = quads.split_error(rows, unit)
-    # The angle atan2(|m|, |mean normal|) exceeds the threshold only where
-    # |m| > tan(threshold) |mean normal|: the arctangent is taken for those only.
-    threshold = quads.settings.threshold("Q103")
-    picked = slice(None)
-    if 0 <= threshold < 89:  # a negative threshold (every value wanted) picks every quad
-        m_length = np.sqrt(squared_lengths(m))
-        mean_length = np.sqrt(squared_lengths(unit.sum(axis=1))) / 4
-        picked = np.flatnonzero(m_length >= mean_length * (np.tan(np.radians(threshold)) * (1 - 1e-9)))
-    rows = np.arange(len(quads))[rows][picked]
-    degrees = normal_degrees(m.T[picked], np.transpose(unit, (2, 1, 0))[picked])
-    return rows, degrees
+    return rows, normal_degrees(quads.split_error(rows, unit).T, np.transpose(unit, (2, 1, 0)))

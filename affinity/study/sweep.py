@@ -125,6 +125,7 @@ def prepare(case: Scene, settings: StudySettings) -> PreparedScene:
 
     Raises ValueError for a mesh without faces, or with neither uv nor vertex colours (nothing to compare).
     """
+    from ..attributes import drawn_attribute
     from ..draw.drawing import RenderOptions, render_mesh
     from ..draw.texture import checker
     from ..lint import scored_code_of
@@ -132,8 +133,8 @@ def prepare(case: Scene, settings: StudySettings) -> PreparedScene:
     mesh = case.mesh()
     if mesh.n_faces == 0:
         raise ValueError(f"{case.name}: the mesh has no faces")
-    show = "uv" if mesh.texcoords is not None else "color" if mesh.colors is not None else None
-    if show is None:
+    show = drawn_attribute(mesh)
+    if show == "shaded":
         raise ValueError(f"{case.name}: no texture coordinates or vertex colours to compare")
     texture = checker(settings.texture_size) if show == "uv" else None
     drawn = render_mesh(mesh, RenderOptions(method="split", show=show, width=settings.width, height=settings.height,
