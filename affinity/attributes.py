@@ -6,10 +6,9 @@ fields that hold it, its width, its unit, the note a report gives when a mesh
 lacks it, the name every command uses for it (``render --show``, ``view
 --attribute``), how pictures label it and colour its scores (the 3-D view, the
 study's charts, the Blender panel), and how a difference of two values reads in
-that unit (:func:`pixel_error`). Which rules score an attribute is the rule
-registry's (:func:`affinity.rules.scoring_rules`: a rule names its attribute),
-so a new rule on an attribute is found without touching this table. Imports
-nothing at load (the command line reads the
+that unit (:func:`pixel_error`). Which rules score an attribute is read from the
+rule registry (``affinity.lint.scored_codes``), so a new rule on an attribute is
+found without touching this table. Imports nothing at load (the command line reads the
 names); the measures are imported when a difference is taken.
 """
 
@@ -131,6 +130,27 @@ def canonical_name(text: str) -> str:
         return attribute_named(text).name
     except KeyError:
         return text
+
+
+#: The attributes a picture draws when nothing else decides, in order of preference (Mesh fields); a mesh with
+#: none of them is shaded (its normals light it: drawn as colours they would hide the surface).
+DRAWN_IN_ORDER = ("texcoords", "colors")
+
+
+def drawn_attribute(mesh, preferred: str | None = None) -> str:
+    """What a picture of ``mesh`` draws: the attribute ``preferred`` (a Mesh field, e.g. the one a finding is
+    about) when it is one of :data:`DRAWN_IN_ORDER` and the mesh has it, else the first of those the mesh has,
+    by its command-line name (``"uv"``, ``"color"``), else ``"shaded"``.
+
+    >>> from types import SimpleNamespace
+    >>> terrain = SimpleNamespace(texcoords=[(0, 0)], colors=[(1, 0, 0)], normals=None)
+    >>> drawn_attribute(terrain), drawn_attribute(terrain, "colors"), drawn_attribute(terrain, "normals")
+    ('uv', 'color', 'uv')
+    >>> drawn_attribute(SimpleNamespace(texcoords=None, colors=None, normals=[(0, 0, 1)]))
+    'shaded'
+    """
+    fields = ((preferred,) if preferred in DRAWN_IN_ORDER else ()) + DRAWN_IN_ORDER
+    return next((ATTRIBUTES[field].name for field in fields if getattr(mesh, field) is not None), "shaded")
 
 
 def pixel_error(values: np.ndarray, reference: np.ndarray, attribute: str, texture_size) -> np.ndarray:

@@ -168,6 +168,9 @@ class FileReport:
     ``values``: per rule code, ``[face within the prim, [value per prim, None where
     that prim has no finding]]`` for the findings whose prims disagree (different
     textures bound).
+
+    ``scores`` (only when asked, for the report: never stored) maps each scored rule the mesh has an
+    attribute for to the :class:`affinity.lint.QuadScores` of every quad it measures, from the same lint.
     """
 
     path: str
@@ -183,6 +186,7 @@ class FileReport:
     notes: list[str] = field(default_factory=list)
     transient: bool = False
     shared: list[dict] = field(default_factory=list)
+    scores: dict = field(default_factory=dict)
 
     @property
     def n_findings(self) -> int:
@@ -308,7 +312,8 @@ def report_to_bytes(report: FileReport) -> bytes:
     import zlib
     from dataclasses import fields
 
-    meta = {f.name: getattr(report, f.name) for f in fields(report) if f.name not in ("hits", "prim_face_start")}
+    kept_apart = ("hits", "prim_face_start", "scores")  # scores are the report's, never stored
+    meta = {f.name: getattr(report, f.name) for f in fields(report) if f.name not in kept_apart}
     meta["hits"] = [{"code": h.code, "threshold": h.threshold, "level": h.level, "unit": h.unit,
                      "details": h.details, "error_above": h.error_above, "visible": _visible_meta(h.visible)}
                     for h in report.hits]

@@ -24,7 +24,7 @@ from .findings import FileReport, RuleHits, settle, share_authored_geometry
 from .geometry import PlanarQuads, planar_quads_by_component, squared_lengths
 from .measures import split_error_by_component, split_scale
 from .mesh import Mesh
-from .rules import RULES, resolve_codes, scoring_rules
+from .rules import RULES, resolve_codes
 from .settings import Settings
 
 #: Quads measured together. Whole-mesh temporaries of a million quads spill out
@@ -260,19 +260,27 @@ def _map_quad_batches(mesh: Mesh, settings: Settings, measure, attributes=(), gr
 
 
 def lint_mesh(mesh: Mesh, settings: Settings, visible: bool = True) -> list[RuleHits]:
-    """Apply every rule enabled by ``settings.select``/``settings.ignore`` to ``mesh``.
+    """The findings of :func:`lint_pass` (without scores)."""
+    return lint_pass(mesh, settings, visible).hits
+
+
+def lint_pass(mesh: Mesh, settings: Settings, visible: bool = True, scores: bool = False) -> MeshLint:
+    """Apply every rule enabled by ``settings.select``/``settings.ignore`` to ``mesh``, in one pass over its quads.
 
     Q101 is in texels (each quad's texture size from its material's texture header,
     else ``settings.texture_size``), or the paper's dimensionless score with
     ``settings.measure == "barycentric"``; Q102 in 1/255 steps; Q103 in degrees. A
     quad is measured for an attribute only when all four corners have it. With
     ``visible``, Q101's findings on quads whose textures decode are read through them
-    (C, design.md "The visible reading"; ``RuleHits.visible``).
+    (C, design.md "The visible reading"; ``RuleHits.visible``). With ``scores``, the same
+    pass also keeps every measured quad's value of each scored rule the mesh has an
+    attribute for (:func:`scored_codes`), selected or not: the values the findings are
+    those above the threshold of (before the visible reading).
 
     Returns
     -------
-    list of RuleHits, one per rule with at least one finding, in rule-table order;
-    faces in file order within each.
+    MeshLint: ``hits``, one RuleHits per rule with at least one finding, in rule-table order, faces in
+    file order within each; ``scores``, rule code -> QuadScores (empty without ``scores``).
     """
     enabled = [RULES[code] for code in resolve_codes(settings.select, settings.ignore)]
     reads_textures = (visible and RULES["Q101"] in enabled and RULES["Q101"].unit_for(settings.measure) == "texels"
@@ -287,37 +295,42 @@ def lint_mesh(mesh: Mesh, settings: Settings, visible: bool = True) -> list[Rule
             hits.append(RuleHits(rule.code, faces, mesh.face_line[faces] if found.lines is None else found.lines,
                                  found.values, 0.0, np.zeros(len(faces), dtype=np.int32), details=found.details))
     quad_rules = [rule for rule in enabled if rule.scope == "quad"]
+    scored = [RULES[code] for code in scored_codes(mesh)] if scores else []
     thresholds = {rule.code: settings.threshold(rule.code) if rule.has_threshold else None for rule in quad_rules}
 
-    def flag(batch: QuadBatch) -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    def flag(batch: QuadBatch) -> tuple[dict, dict]:
         """Rule code -> (faces, values, breaks) of the batch's flagged quads, one finding per defect
-        (:class:`Unmeasurable`); ``breaks`` (n,) bool marks the causes that took other findings' place."""
-        found = {}
+        (:class:`Unmeasurable`), ``breaks`` (n,) bool marking the causes that took other findings' place;
+        and scored rule code -> (faces, values) of every quad it measures."""
+        found, measured = {}, {}
         causes = Unmeasurable(batch)
-        for rule in quad_rules:
-            measured = rule.check(batch)
-            rows, values = np.arange(len(batch))[measured.rows], measured.values
+        for rule in quad_rules + [rule for rule in scored if rule not in quad_rules]:
+            rows, values = _measured(batch, rule, causes)
+            if rule in scored:
+                measured[rule.code] = batch.faces[rows], values
+            if rule not in quad_rules:
+                continue
             threshold = thresholds[rule.code]
             if threshold is not None:
                 flagged = rule.flagged(values, threshold)
                 rows, values = rows[flagged], values[flagged]
-            if rule.scored:
-                measured = ~causes.masked(rule)[rows]
-                rows, values = rows[measured], values[measured]
             found[rule.code] = batch.faces[rows], values, causes.breaks(rule.code)[rows]
-        return found
+        return found, measured
 
-    attributes = sorted({rule.attribute for rule in quad_rules if rule.attribute})
+    attributes = sorted({rule.attribute for rule in quad_rules + scored if rule.attribute})
     grid = quad_texel_grid(mesh, settings) if "texcoords" in attributes else None
-    batches = _map_quad_batches(mesh, settings, flag, attributes, grid) if quad_rules else []
-    scored = [rule for rule in quad_rules if rule.scored and getattr(mesh, rule.attribute) is not None]
+    batches = _map_quad_batches(mesh, settings, flag, attributes, grid) if quad_rules or scored else []
+    measured = {rule.code: _quad_scores(settings, rule, [found[1][rule.code] for found in batches])
+                for rule in scored}
+    batches = [found[0] for found in batches]
+    maskable = [rule for rule in quad_rules if rule.scored and getattr(mesh, rule.attribute) is not None]
     for rule in quad_rules:
         faces = np.concatenate([found[rule.code][0] for found in batches] or [np.zeros(0, dtype=np.int64)])
         if len(faces):
             values = np.concatenate([found[rule.code][1] for found in batches])
             threshold = thresholds[rule.code]
             breaks = np.concatenate([found[rule.code][2] for found in batches])
-            taken = [r.code for r in scored if r.attribute in CAUSE_MASKS.get(rule.code, ())]
+            taken = [r.code for r in maskable if r.attribute in CAUSE_MASKS.get(rule.code, ())]
             found = RuleHits(rule.code, faces, mesh.face_line[faces], values,
                              0.0 if threshold is None else float(threshold), mesh.face_group[faces],
                              details=_texel_details(settings, rule, faces, values, grid)
@@ -330,18 +343,30 @@ def lint_mesh(mesh: Mesh, settings: Settings, visible: bool = True) -> list[Rule
     if preparing is not None:  # no Q101 finding read it: the decode is not left running into the next file
         preparing.join()
     order = {code: i for i, code in enumerate(RULES)}
-    return sorted(hits, key=lambda h: order[h.code])
+    return MeshLint(sorted(hits, key=lambda h: order[h.code]), measured)
 
 
-def mesh_report(path: str, mesh, settings, inline=()) -> FileReport:
+def _measured(batch: QuadBatch, rule, causes: Unmeasurable) -> tuple[np.ndarray, np.ndarray]:
+    """(n,) int64 rows into ``batch`` and (n,) float64 values of the quads ``rule``'s check measures; a scored
+    rule leaves out the quads one of its ``causes`` takes over (one finding per defect)."""
+    measured = rule.check(batch)
+    rows, values = np.arange(len(batch))[measured.rows], measured.values
+    if rule.scored:
+        measured = ~causes.masked(rule)[rows]
+        rows, values = rows[measured], values[measured]
+    return rows, values
+
+
+def mesh_report(path: str, mesh, settings, inline=(), scores: bool = False) -> FileReport:
     """The report of the file at ``path`` whose mesh is ``mesh``: its findings (lint, then :func:`settle`
     with ``settings`` and the ``inline`` ignores, then :func:`share_authored_geometry`), counts, groups,
-    and for a USD stage its prims, metadata and the loader's notes."""
-    hits, shared = share_authored_geometry(settle(lint_mesh(mesh, settings), settings, list(mesh.group_names), inline),
-                                           mesh)
+    and for a USD stage its prims, metadata and the loader's notes; with ``scores``, every quad's scores
+    from the same lint (:attr:`FileReport.scores`)."""
+    linted = lint_pass(mesh, settings, scores=scores)
+    hits, shared = share_authored_geometry(settle(linted.hits, settings, list(mesh.group_names), inline), mesh)
     return FileReport(path, counts=mesh.counts(), hits=hits, shared=shared, group_names=list(mesh.group_names),
                       prim_face_start=mesh.prim_face_start, up_axis=mesh.up_axis,
-                      meters_per_unit=mesh.meters_per_unit, notes=list(mesh.notes))
+                      meters_per_unit=mesh.meters_per_unit, notes=list(mesh.notes), scores=linted.scores)
 
 
 #: Cause rule -> the attributes whose scored rules (Q101-Q103) it takes over (:class:`Unmeasurable`).
@@ -482,7 +507,7 @@ def quad_uv_error(mesh: Mesh, diagonal: str = "02") -> tuple[np.ndarray, np.ndar
     return faces, np.concatenate(_map_quad_batches(mesh, Settings(), measure, ("texcoords",)) or [np.zeros(0)])
 
 
-@dataclass
+@dataclass(frozen=True)
 class QuadScores:
     """One affinity rule's reading for every quad that has the attribute at all four corners.
 
@@ -494,7 +519,7 @@ class QuadScores:
     threshold : the rule flags values above it
     faces : (n,) int64, face index in file order
     values : (n,) float64, the measured score; quads the rule cannot measure
-        (NaN, e.g. a missing corner attribute) are not listed
+        (NaN, e.g. a missing corner attribute, or one finding per defect: :class:`Unmeasurable`) are not listed
     """
 
     code: str
@@ -510,35 +535,42 @@ class QuadScores:
         return RULES[self.code].flagged(self.values, self.threshold)
 
 
-def scored_codes(mesh: Mesh) -> list[str]:
-    """The scored rules (Q101-Q103, and any registered later) whose attribute the mesh has, in code order."""
-    return [code for code, rule in RULES.items() if rule.scored and getattr(mesh, rule.attribute) is not None]
+@dataclass(frozen=True)
+class MeshLint:
+    """One pass of the rules over a mesh (:func:`lint_pass`): ``hits`` (list of RuleHits, rule-table order) and
+    ``scores`` (scored rule code -> :class:`QuadScores` of every measured quad; empty unless asked)."""
+
+    hits: list[RuleHits]
+    scores: dict[str, QuadScores]
 
 
-def scored_codes_of(attribute: str, mesh: Mesh | None = None) -> list[str]:
-    """Every scored rule of an attribute named as on the command line (``"uv"``, ``"color"``,
-    ``"colour"``, ``"normal"``), in code order; with ``mesh``, only those the mesh can be scored by."""
-    codes = scoring_rules(attribute_named(attribute).field)
-    return codes if mesh is None else [code for code in codes if code in scored_codes(mesh)]
+def scored_codes(mesh: Mesh | None = None, attribute: str | None = None) -> list[str]:
+    """Codes of the scored rules (Q101-Q103, and any registered later), in code order: those on ``attribute``
+    (named as on the command line, ``"uv"``, ``"colour"``, ...) when given, and of them those whose attribute
+    ``mesh`` has when given. KeyError for an attribute no command names."""
+    field = None if attribute is None else attribute_named(attribute).field
+    return [code for code, rule in RULES.items() if rule.scored and field in (None, rule.attribute)
+            and (mesh is None or getattr(mesh, rule.attribute) is not None)]
 
 
-def scored_code_of(attribute: str, mesh: Mesh | None = None) -> str:
-    """The first of :func:`scored_codes_of` (with ``mesh``, the first the mesh can be scored by;
-    the first registered when it can be scored by none)."""
-    codes = scored_codes_of(attribute)
-    return next((code for code in codes if mesh is None or code in scored_codes(mesh)), codes[0])
+def _quad_scores(settings: Settings, rule, measured: list[tuple[np.ndarray, np.ndarray]]) -> QuadScores:
+    """The :class:`QuadScores` of scored ``rule`` from its batches' ``measured`` (faces, values), in file order."""
+    faces = np.concatenate([faces for faces, _ in measured] or [np.zeros(0, dtype=np.int64)])
+    values = np.concatenate([values for _, values in measured] or [np.zeros(0)])
+    return QuadScores(rule.code, ATTRIBUTES[rule.attribute].name, rule.unit_for(settings.measure),
+                      settings.threshold(rule.code), faces, values)
 
 
 def quad_scores(mesh: Mesh, settings: Settings, code: str) -> QuadScores:
-    """Score every quad of ``mesh`` with the scored rule ``code`` (as ``settings`` configure it).
-
-    The rule runs with its threshold at -inf, so every measured quad is kept and
-    the scores are exactly the values ``affinity check`` compares with the threshold.
-    """
+    """Score every quad of ``mesh`` with the scored rule ``code`` alone (as ``settings`` configure it): the values
+    ``affinity check`` compares with the threshold, for every quad the rule measures. No finding is made: a
+    caller that also lints takes the scores from that pass (:func:`lint_pass` with ``scores``)."""
     rule = RULES[code]
-    everything = replace(settings, select=[code], ignore=[], thresholds={**settings.thresholds, code: -np.inf})
-    hits = lint_mesh(mesh, everything, visible=False)
-    faces = hits[0].faces if hits else np.zeros(0, dtype=np.int64)
-    values = hits[0].values if hits else np.zeros(0)
-    return QuadScores(code, ATTRIBUTES[rule.attribute].name, rule.unit_for(settings.measure),
-                      settings.threshold(code), faces, values)
+
+    def measure(batch: QuadBatch) -> tuple[np.ndarray, np.ndarray]:
+        rows, values = _measured(batch, rule, Unmeasurable(batch))
+        return batch.faces[rows], values
+
+    if getattr(mesh, rule.attribute) is None:
+        return _quad_scores(settings, rule, [])
+    return _quad_scores(settings, rule, _map_quad_batches(mesh, settings, measure, (rule.attribute,)))

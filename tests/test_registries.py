@@ -21,7 +21,7 @@ import pytest
 
 from affinity import cli
 from affinity.attributes import ATTRIBUTES, attribute_named, canonical_name
-from affinity.lint import lint_mesh, scored_codes_of
+from affinity.lint import lint_mesh, scored_codes
 from affinity.loaders import load
 from affinity.loaders.formats import LOADERS, MESH_SUFFIXES, hook_pattern
 from affinity.loaders.resources import ResourceRole, register_role, unregister_role
@@ -241,7 +241,7 @@ def test_a_normal_map_rule_needs_one_rule_and_one_resource_role(q104, normal_map
     assert [(r.role, r.name) for r in mesh.resources] == [("mtllib", "look.mtl"), ("map_Kd", "tex.png"),
                                                           ("normal-map", "nrm.png")]
     # Scored: the attribute has two scoring rules now, and the lint reads Q104 in the normal map's texels.
-    assert scored_codes_of("uv", mesh) == ["Q101", "Q104"]
+    assert scored_codes(mesh, "uv") == ["Q101", "Q104"]
     hits = {h.code: h for h in lint_mesh(mesh, Settings(select=["Q101", "Q104"]))}
     np.testing.assert_allclose(hits["Q104"].values, 2 * hits["Q101"].values)  # 128 px against 64 px
     # The cache follows the normal map: touching it checks the mesh again.

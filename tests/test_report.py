@@ -179,7 +179,7 @@ def test_demo_report_prints_the_commands_run_time_and_its_parts(demo):
     assert 0.75 * result.wall <= printed <= result.wall
     (line,) = [p.text() for p in summary.find_all("p", "parts")]
     parts = dict(part.strip().removesuffix(" s").rsplit(" ", 1) for part in line.split(":", 1)[1].split("·"))
-    expected = {"start-up", "lint", "scores", "renders", "3-D overview", "close-ups", "page"}
+    expected = {"start-up", "lint", "renders", "3-D overview", "close-ups", "page"}
     if importlib.util.find_spec("pyvista") is None:  # the overview is pyvista's picture; the page says it is left out
         expected.discard("3-D overview")
         assert "3-D overview" not in parts

@@ -162,7 +162,8 @@ def test_a_place_an_earlier_closeup_shows_gets_no_closeup_of_its_own(tmp_path):
 
 
 def test_closeup_camera_looks_at_the_place_along_its_normal_and_fits_its_ring():
-    from affinity.draw.closeup import TILT_DEGREES, closeup_view, face_subset
+    from affinity.draw.closeup import TILT_DEGREES, closeup_view
+    from affinity.draw.faces import face_subset
     from affinity.draw.framing import camera_for
     from render import to_clip
 
@@ -341,13 +342,13 @@ def test_a_mirrored_uv_closeup_draws_glyphs_and_a_disaffine_one_does_not(tmp_pat
 @pytest.mark.parametrize(("difference", "gain"), [(5 / 255, 20), (3 / 255, 20), (0.004, 100), (0.3, 1), (1e-3, 500),
                                                   (0.0, 1), (0.9, 1)])
 def test_gain_brings_the_largest_change_to_about_half(difference, gain):
-    from affinity.report.closeups import gain_for
+    from affinity.draw.closeup import gain_for
 
     assert gain_for(difference) == gain  # 1, 2 or 5 times a power of ten, the most that keeps it at <= 0.5
 
 
 def test_amplified_difference_is_exact_plus_gain_times_the_split_s_change():
-    from affinity.report.closeups import amplified_difference
+    from affinity.draw.closeup import amplified_difference
 
     rng = np.random.default_rng(3)
     exact = rng.uniform(0.35, 0.65, (16, 16, 3))  # never clipped at the gain
@@ -384,7 +385,7 @@ def test_a_faint_colour_crease_gets_an_amplified_panel_that_shows_it(tmp_path):
 
 
 def test_amplified_uv_moves_the_split_s_texture_by_gain_times_its_error():
-    from affinity.report.closeups import UV_REACH, amplified_uv
+    from affinity.draw.closeup import UV_REACH, amplified_uv
 
     rng = np.random.default_rng(5)
     exact = rng.uniform(0, 1, (12, 12, 2))
@@ -670,8 +671,8 @@ def test_a_mirrored_closeup_s_glyphs_are_the_unflipped_reference_s_mirrored_on_s
     once with its uv, once with u mirrored (1 - u, every quad Q302). The glyph ink of the mirrored one matches
     the reference's ink mirrored left-right on screen (best over shifts: the glyph cells' phase differs) far
     better than the reference as it is (a symmetric glyph would match both alike)."""
+    from affinity.draw.closeup import closeup
     from affinity.draw.texture import GLYPH_INK
-    from affinity.report.closeups import closeup
     from affinity.report.places import Place
     from affinity.settings import Settings
 

@@ -12,7 +12,7 @@ import pytest
 from helpers.closeup_panels import Closeups, decode_panel
 from helpers.corpus import SHARED_MESHES
 
-from affinity.draw.fold import DIAGONAL_INK
+from affinity.draw.closeup import DIAGONAL_INK
 from affinity.draw.shading import FLAG_COLOUR
 from affinity.loaders.objwriter import write_obj
 from affinity.mesh import mesh_from_polygons

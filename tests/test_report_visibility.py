@@ -68,8 +68,8 @@ def faces_of(ranges: str) -> np.ndarray:
 def place_pixels(mesh, figure: dict, size: int, faces: str | None = None) -> int:
     """The pixels the figure's place (or ``faces``, ranges as in ``data-place``) covers in a depth-tested
     face-id render of its drawn faces at its camera."""
-    from affinity.draw.closeup import face_subset
     from affinity.draw.drawing import RenderOptions, render_mesh
+    from affinity.draw.faces import face_subset
 
     numbers = [float(x) for x in figure["camera"].split(",")]
     camera = (tuple(numbers[:3]), tuple(numbers[3:6]), numbers[6])

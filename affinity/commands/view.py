@@ -34,18 +34,13 @@ def add_parser(sub) -> None:
 def _scores(mesh, path: str, attribute: str | None):
     """The chosen attribute's scores under the file's configuration, None when the mesh has nothing to score."""
     from ..config import file_settings
-    from ..lint import quad_scores, scored_code_of, scored_codes
+    from ..lint import quad_scores, scored_codes
     from ..output.names import printable
 
-    if attribute is None:
-        code = next(iter(scored_codes(mesh)), None)  # uv, else colours, else normals
-    else:
-        code = scored_code_of(attribute, mesh)
-        if code not in scored_codes(mesh):
-            raise UsageError(f"{printable(path)}: the mesh has no {attribute} attribute to score")
-    if code is None:
-        return None
-    return quad_scores(mesh, file_settings(path), code)
+    codes = scored_codes(mesh, attribute)  # without an attribute: uv, else colours, else normals
+    if not codes and attribute is not None:
+        raise UsageError(f"{printable(path)}: the mesh has no {attribute} attribute to score")
+    return quad_scores(mesh, file_settings(path), codes[0]) if codes else None
 
 
 def run(args) -> int:

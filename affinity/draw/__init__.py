@@ -2,16 +2,33 @@
 
 - :mod:`.drawing`: ``render_mesh(mesh, RenderOptions) -> RenderResult``, the one entry point;
 - :mod:`.framing`: cameras and up axes when the user names none;
+- :mod:`.faces`: a mesh's faces as sets (corners, centroids, areas, neighbours, sub-meshes);
+- :mod:`.closeup`: a close-up of a place: framing, panels and error map, with its tuning constants;
 - :mod:`.quads`: the mesh as the renderer's quads (triangles and n-gons fanned);
 - :mod:`.routing`: the hybrid's per-quad choice between ``split`` and ``mvc``;
 - :mod:`.shading`: per-corner inputs, pixel colours, the shared palette;
-- :mod:`.texture`, :mod:`.png`: images in and out;
+- :mod:`.texture`, :mod:`.png`, :mod:`.flat`: images in and out, flat face-id pictures;
 - :mod:`.view`: the 3-D view of ``affinity view`` and the report's overview (pyvista, the ``view`` extra).
 
 ``render`` (the rasterizer) knows nothing of meshes; this package is where meshes
-meet it. Heavy imports (``render``, Pillow) happen inside the functions.
+meet it. Heavy imports (``render``, Pillow) happen inside the functions. The names
+below are the package's public API: the layers above use these, not its modules.
 """
 
-from .drawing import RenderOptions, RenderResult, render_mesh
+from .closeup import CLOSEUP_SIZE, Closeup, CloseupView, closeup
+from .drawing import RenderOptions, RenderResult, over_render_budget, render_mesh
+from .faces import face_centroids, face_vertices
+from .flat import face_ids
+from .framing import overview_camera, up_axis_of, used_points
+from .png import png_bytes, to_pixels
+from .quads import render_corners
+from .routing import MVC, SPLIT
+from .shading import FLAG_COLOUR, OVERLAY_TINT, flat_normals
+from .texture import TextureError, checker
+from .view import INSTALL_HINT, overview_image, pyvista_installed, score_range
 
-__all__ = ["RenderOptions", "RenderResult", "render_mesh"]
+__all__ = ["CLOSEUP_SIZE", "FLAG_COLOUR", "INSTALL_HINT", "MVC", "OVERLAY_TINT", "SPLIT", "Closeup", "CloseupView",
+           "RenderOptions", "RenderResult", "TextureError", "checker", "closeup", "face_centroids", "face_ids",
+           "face_vertices", "flat_normals", "over_render_budget", "overview_camera", "overview_image", "png_bytes",
+           "pyvista_installed", "render_corners", "render_mesh", "score_range", "to_pixels", "up_axis_of",
+           "used_points"]

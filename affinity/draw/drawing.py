@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..attributes import drawn_attribute
 from ..mesh import Mesh
 from ..settings import Settings
 from .framing import camera_for
@@ -147,12 +148,6 @@ def mvc_pixels(face: np.ndarray, methods: np.ndarray) -> np.ndarray:
     return (face >= 0) & (methods[np.maximum(face, 0)] == MVC)
 
 
-def default_show(mesh: Mesh) -> str:
-    if mesh.texcoords is not None:
-        return "uv"
-    return "color" if mesh.colors is not None else "shaded"
-
-
 def uv_routing_inputs(mesh: Mesh, faces: np.ndarray, uv: np.ndarray, settings: Settings):
     """The view-independent part of routing by view (``affinity.draw.routing``), once per mesh:
     the split's texture displacement of every render quad, and the lint's uv error
@@ -189,12 +184,14 @@ def choose_methods(mesh: Mesh, faces: np.ndarray, uv: np.ndarray | None, clip: n
         moves, uv_error = uv_routing_inputs(mesh, faces, uv, settings)
         return route_by_view(moves, uv, clip, options.width, options.height,
                              options.pixel_tolerance, options.cull, uv_error)
-    from ..lint import lint_mesh, scored_code_of
+    from ..lint import quad_scores, scored_codes
+    from ..rules import resolve_codes
 
-    code = scored_code_of("uv" if routes_uv else ("color" if show == "color" else "normal"))
+    code = scored_codes(attribute="uv" if routes_uv else ("color" if show == "color" else "normal"))[0]
     flagged = np.zeros(mesh.n_faces, dtype=bool)
-    for hits in lint_mesh(mesh, replace(settings, select=[code], diagonal="02"), visible=False):
-        flagged[hits.faces] = True
+    if resolve_codes([code], settings.ignore):  # an ignored rule sends nothing to mvc
+        scores = quad_scores(mesh, replace(settings, diagonal="02"), code)
+        flagged[scores.faces[scores.flagged]] = True
     return np.where(flagged[faces], MVC, SPLIT)
 
 
@@ -258,7 +255,7 @@ def render_mesh(source: str | Mesh | None, options: RenderOptions,
     settings = options.settings or file_settings(mesh.path)
     if mesh.n_faces == 0:
         raise ValueError(f"{mesh.path}: the mesh has no faces to render")
-    show = options.show or default_show(mesh)
+    show = options.show or drawn_attribute(mesh)
     problem = over_render_budget(mesh)
     if problem:
         raise OverBudget(problem)

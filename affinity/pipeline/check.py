@@ -29,9 +29,10 @@ def check_file(path: str, settings: Settings, usd=None, source: bytes | None = N
     return load_and_check(path, settings, usd, source)[0]
 
 
-def load_and_check(path: str, settings: Settings, usd=None,
-                   source: bytes | None = None) -> tuple[FileReport, Mesh | None]:
-    """:func:`check_file`, also handing back the loaded mesh (None when it could not be read)."""
+def load_and_check(path: str, settings: Settings, usd=None, source: bytes | None = None,
+                   scores: bool = False) -> tuple[FileReport, Mesh | None]:
+    """:func:`check_file`, also handing back the loaded mesh (None when it could not be read); with ``scores``,
+    the report holds every quad's scores from the same lint (:attr:`FileReport.scores`)."""
     from ..lint import mesh_report
     from ..loaders import load, reads_whole
 
@@ -43,7 +44,7 @@ def load_and_check(path: str, settings: Settings, usd=None,
         mesh = load(path, usd, source)
         ignores = _inline_ignores(source, mesh) if reads_whole(path) else []
         del source  # not needed past here: a big file's bytes are not held while its mesh is linted
-        report = mesh_report(path, mesh, settings, ignores)
+        report = mesh_report(path, mesh, settings, ignores, scores)
     except SkippedFile as skip:
         return FileReport(path, skipped=skip.reason), None
     except MeshError as err:

@@ -3,14 +3,15 @@
 The pipeline, one module per step:
 
 - :mod:`.demo` — the built-in scenes and the view each is shown from;
-- :mod:`.build` — collects, per mesh, the lint, every quad's scores
-  (``affinity.lint.quad_scores``), the renders and the 3-D overview;
+- :mod:`.build` — collects, per mesh, the lint with every quad's scores
+  (one pass, ``affinity.lint.lint_pass``), the renders, the 3-D overview and
+  the close-ups (``affinity.draw.closeup``), each step returning its values;
 - :mod:`.stiffness` — the numerical stability of the hybrid's mvc pixels;
 - :mod:`.sections` — one function per section, each deciding from the
   collected data whether it appears or is left out with a one-line reason;
 - :mod:`.page` — renders the sections with the Jinja2 templates (autoescaped);
-- :mod:`.places`, :mod:`.closeups`, :mod:`.uvlayout` — the flagged places,
-  their close-ups and the texture-space view;
+- :mod:`.places`, :mod:`.uvlayout` — the flagged places and the
+  texture-space view;
 - :mod:`.images`, :mod:`.charts` — pictures, colour bars and inline SVG charts.
 
 Nothing heavy is imported here: Pillow, Jinja2, matplotlib and pyvista are

@@ -19,8 +19,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..attributes import drawn_attribute
 from ..findings import FileReport
-from ..lint import QuadScores, quad_scores, scored_codes
+from ..lint import QuadScores
 from ..mesh import Mesh
 from ..rules import RULES
 from ..scenes import View
@@ -30,8 +31,6 @@ from .demo import MeshInput
 
 #: Methods drawn beside the hybrid when it sent quads to mvc (``exact``: the ray / bilinear-patch reference).
 COMPARED_METHODS = ("split", "mvc", "exact")
-#: Side of a close-up picture, pixels.
-CLOSEUP_SIZE = 240
 #: The overview's pyvista and the charts' matplotlib: about 2 s of imports, done on a thread while the
 #: renders run (see :func:`import_in_background`).
 SLOW_IMPORTS = ("pyvista.plotting", "matplotlib.figure", "matplotlib.backends.backend_svg")
@@ -105,14 +104,15 @@ class ReportOptions:
     place_faces: int = PLACE_FACES
 
 
-@dataclass(eq=False)
+@dataclass(frozen=True, eq=False)
 class MeshResult:
-    """Everything collected for one input file.
+    """Everything collected for one input file, assembled once by :func:`collect_mesh`.
 
     ``file`` is the lint outcome (with ``error`` or ``skipped`` set, nothing
-    else is collected). ``shown`` is the rule code of the attribute the renders
-    show: the first scored rule with findings, else the first scored (uv, colours, normals); None: plain
-    shading. ``renders`` maps a method (``hybrid`` and, when
+    else is collected). ``scores`` are every quad's scores of each scored rule the mesh has an attribute
+    for, from that same lint. ``shown`` is the rule code whose attribute the renders show: the first scored
+    rule with findings, else the first scored (uv, colours, normals); None: plain shading (what is drawn:
+    :attr:`drawn`). ``renders`` maps a method (``hybrid`` and, when
     it sent quads to mvc, ``split``, ``mvc``, ``exact``) to its render (the
     hybrid's ``tinted`` image is the overlay of the quads it sent to mvc). ``overview`` is the pyvista picture
     (H, W, 3) uint8, else ``overview_note`` says why there is none. ``camera``
@@ -135,19 +135,25 @@ class MeshResult:
     render_error: str | None = None
     overview: np.ndarray | None = None
     overview_note: str | None = None
-    warnings: list[str] = field(default_factory=list)
+    warnings: tuple[str, ...] = ()
     options: ReportOptions = ReportOptions()
     camera: tuple | None = None
     up: str | None = None
-    places: list = field(default_factory=list)
-    closeups: list = field(default_factory=list)
-    dropped: list[str] = field(default_factory=list)
+    places: tuple = ()
+    closeups: tuple = ()
+    dropped: tuple[str, ...] = ()
     parts: dict[str, float] = field(default_factory=dict)
     stability: object | None = None
 
     @property
     def readable(self) -> bool:
         return self.file.error is None and self.file.skipped is None
+
+    @property
+    def drawn(self) -> str:
+        """What the renders draw (:func:`affinity.attributes.drawn_attribute`): ``"uv"``, ``"color"`` or
+        ``"shaded"``; the attribute of the rule shown when it is drawable."""
+        return drawn_for(self.mesh, self.shown)
 
 
 @dataclass
@@ -187,149 +193,180 @@ def _texture_label(mesh: Mesh, view: View, texture: str | None = None) -> str:
     return f"texture {name} (map_Kd)" if refused is None else f"checker texture (map_Kd {name}: {refused})"
 
 
-def _render(result: MeshResult, texture: np.ndarray | None, step: StepTimer) -> None:
-    """The hybrid render; when it sent quads to mvc, the compared methods too."""
-    from ..draw.drawing import RenderOptions, render_mesh
-    from ..draw.routing import MVC
-    from ..draw.texture import TextureError
+@dataclass(frozen=True)
+class Renders:
+    """What :func:`render_views` drew: ``renders`` method -> RenderResult, ``error`` why there is no render
+    (None: the hybrid was drawn), ``over_budget`` whether that is the renderer's budget (the overview would
+    draw the same stack of faces, for minutes), ``warnings`` the hybrid's lines (a missing map_Kd, ...)."""
 
-    size = result.options.size
-    # a mesh with uv whose findings are its vertex colours (a terrain) is drawn in its colours, not the checker
-    show = "color" if result.shown and RULES[result.shown].attribute == "colors" else None
+    renders: dict
+    error: str | None = None
+    over_budget: bool = False
+    warnings: tuple[str, ...] = ()
 
-    def draw(warn=lambda line: None, **options):
-        chosen = RenderOptions(width=size[0], height=size[1], camera=result.camera, up=result.up, show=show,
-                               texture=texture, pixel_tolerance=result.options.pixel_tolerance, **options)
-        return render_mesh(result.mesh, chosen, warn)
 
+def render_views(mesh: Mesh, drawn: str, view: tuple[tuple | None, str], options: ReportOptions,
+                 settings: Settings, texture: str | np.ndarray | None, step: StepTimer) -> Renders:
+    """The hybrid render of ``mesh`` showing ``drawn`` from ``view`` (camera, up), routed by ``settings`` (the
+    report's, resolved once); when it sent quads to mvc, the compared methods too."""
     from render.raster import OverBudget
 
+    from ..draw import MVC, RenderOptions, TextureError, render_mesh
+
+    camera, up = view
+
+    def draw(warn=lambda line: None, **chosen):
+        return render_mesh(mesh, RenderOptions(width=options.size[0], height=options.size[1], camera=camera, up=up,
+                                               show=drawn, texture=texture, pixel_tolerance=options.pixel_tolerance,
+                                               settings=settings, **chosen), warn)
+
     step("render hybrid", "renders")
+    warnings: list[str] = []
     try:
-        hybrid = draw(warn=result.warnings.append, method="hybrid")
+        hybrid = draw(warn=warnings.append, method="hybrid")
     except (ValueError, TextureError) as err:
-        result.render_error = str(err)
-        if isinstance(err, OverBudget):  # pyvista would draw the same stack of faces, for minutes
-            result.overview_note = "the mesh is over the renderer's budget (see the render's line)"
-        return
-    result.renders["hybrid"] = hybrid
-    if not (hybrid.methods == MVC).any():
-        return
-    for method in COMPARED_METHODS:
-        step(f"render {method}", "renders")
-        result.renders[method] = draw(method=method)
+        return Renders({}, str(err), isinstance(err, OverBudget), tuple(warnings))
+    renders = {"hybrid": hybrid}
+    if (hybrid.methods == MVC).any():
+        for method in COMPARED_METHODS:
+            step(f"render {method}", "renders")
+            renders[method] = draw(method=method)
+    return Renders(renders, warnings=tuple(warnings))
 
 
-def _overview(result: MeshResult, step: StepTimer) -> None:
-    from ..draw.view import INSTALL_HINT, overview_image, pyvista_installed
+def overview_picture(mesh: Mesh, scores: QuadScores | None, view: tuple[tuple | None, str], size: tuple[int, int],
+                     step: StepTimer) -> tuple[np.ndarray | None, str | None]:
+    """The pyvista overview of ``mesh`` coloured by ``scores`` from ``view`` (camera, up): the picture, or None
+    and why there is none."""
+    from ..draw import INSTALL_HINT, overview_image, pyvista_installed
 
-    if result.overview_note:  # left out already, and why
-        return
     if not pyvista_installed():
-        result.overview_note = f"pyvista is not installed (the view extra: {INSTALL_HINT})"
-        return
-    if result.mesh.n_faces == 0:
-        result.overview_note = "the mesh has no faces to show"
-        return
+        return None, f"pyvista is not installed (the view extra: {INSTALL_HINT})"
+    if mesh.n_faces == 0:
+        return None, "the mesh has no faces to show"
     step("3-D overview")
     import_in_background(SLOW_IMPORTS).join()
-    scores = result.scores.get(result.shown)
     try:
-        result.overview = overview_image(result.mesh, scores, result.camera, result.up, result.options.size,
-                                         scalar_bar=False)
+        return overview_image(mesh, scores, *view, size, scalar_bar=False), None
     except RuntimeError as err:  # pyvista's way of saying the off-screen render failed
-        result.overview_note = f"pyvista could not render off-screen: {err}"
+        return None, f"pyvista could not render off-screen: {err}"
 
 
-def _view(result: MeshResult) -> None:
+def view_of(mesh: Mesh, scene: View, options: ReportOptions) -> tuple[tuple | None, str]:
     """The camera and up axis of the renders and the overview: ``--camera``/``--up``, else the scene's view,
-    else the whole mesh from its broad side (:func:`affinity.draw.framing.overview_camera`)."""
-    from ..draw.framing import overview_camera, up_axis_of
+    else the whole mesh from its broad side (:func:`affinity.draw.overview_camera`)."""
+    from ..draw import overview_camera, up_axis_of
 
-    options, view = result.options, result.input.view
-    result.up = up_axis_of(result.mesh, options.up or view.up)
-    result.camera = options.camera or view.camera
-    if result.camera is None and result.mesh.n_faces:
-        result.camera = overview_camera(result.mesh, *options.size, result.up)
+    up = up_axis_of(mesh, options.up or scene.up)
+    camera = options.camera or scene.camera
+    if camera is None and mesh.n_faces:
+        camera = overview_camera(mesh, *options.size, up)
+    return camera, up
 
 
-def _closeups(result: MeshResult, step: StepTimer) -> None:
-    """Rank every flagged place; draw the first ``max_views`` that share no face with an earlier close-up, whose
-    worst face no earlier close-up shows (``Closeup.seen``) and that show no earlier one's defect again
+def draw_closeups(mesh: Mesh, hits: list, settings: Settings, options: ReportOptions,
+                  step: StepTimer) -> tuple[tuple, tuple, tuple[str, ...]]:
+    """Every flagged place ranked, the close-ups drawn and the lines for the places dropped.
+
+    The first ``max_views`` places are drawn that share no face with an earlier close-up, whose worst face no
+    earlier close-up shows (``Closeup.seen``) and that show no earlier one's defect again
     (:func:`affinity.report.places.repeats`): each close-up a new spot."""
-    from ..draw.closeup import face_centroids
-    from ..draw.framing import used_points
-    from .closeups import closeup
+    from ..draw import closeup, face_centroids, used_points
     from .places import choose_places, places_of, repeats
 
     step("places")
-    mesh = result.mesh
-    by_rule = {hits.code: places_of(mesh, hits, result.options.place_faces) for hits in result.file.hits}
-    result.places = choose_places(by_rule, sum(len(p) for p in by_rule.values()))
+    by_rule = {found.code: places_of(mesh, found, options.place_faces) for found in hits}
+    places = choose_places(by_rule, sum(len(p) for p in by_rule.values()))
+    closeups, dropped = [], []
     shown = np.zeros(mesh.n_faces, dtype=bool)  # no two close-ups share a face
     seen = np.zeros(mesh.n_faces, dtype=bool)  # nor show one place's worst face again
     centroids = face_centroids(mesh)
     points = used_points(mesh)
     box = (points.min(axis=0), points.max(axis=0)) if len(points) else (np.zeros(3), np.zeros(3))
-    for place in result.places:
-        if len(result.closeups) == result.options.max_views:
+    for place in places:
+        if len(closeups) == options.max_views:
             break
         if (shown[place.faces].any() or seen[place.worst]
-                or any(repeats(place, drawn.place, centroids, *box) for drawn in result.closeups)):
+                or any(repeats(place, drawn.place, centroids, *box) for drawn in closeups)):
             continue
-        step(f"close-up {len(result.closeups) + 1}", "close-ups")
-        drawn = closeup(mesh, place, result.settings, CLOSEUP_SIZE, result.options.pixel_tolerance,
-                        result.options.texture)
+        step(f"close-up {len(closeups) + 1}", "close-ups")
+        drawn = closeup(mesh, place, settings, pixel_tolerance=options.pixel_tolerance, texture=options.texture)
         if drawn.dropped:
-            result.dropped.append(drawn.dropped)
+            dropped.append(drawn.dropped)
         else:
-            result.closeups.append(drawn)
+            closeups.append(drawn)
             shown[place.faces] = True
             seen[drawn.seen] = True
+    return tuple(places), tuple(closeups), tuple(dropped)
+
+
+def shown_code(file: FileReport, scores: dict[str, QuadScores]) -> str | None:
+    """The scored rule whose attribute the renders show: the first with findings, else the first the mesh has
+    (uv, else colours, else normals); None when the mesh has none."""
+    flagged = {hits.code for hits in file.hits}
+    return next((code for code in scores if code in flagged), next(iter(scores), None))
+
+
+def drawn_for(mesh: Mesh, shown: str | None) -> str:
+    """What the renders of ``mesh`` draw when they show the scored rule ``shown`` (None: none): its attribute
+    when a picture can draw it, else uv, else colours, else shading (:func:`affinity.attributes.drawn_attribute`)."""
+    return drawn_attribute(mesh, RULES[shown].attribute if shown else None)
 
 
 def collect_mesh(item: MeshInput, settings: Settings, step: Callable[[str], None] = lambda name: None,
                  options: ReportOptions = ReportOptions()) -> MeshResult:
-    """Lint, score, render and picture one mesh; an unreadable file gives a result with ``file.error``.
+    """Lint (once, with every quad's scores), render and picture one mesh; an unreadable file gives a result
+    with ``file.error``. ``settings`` govern the lint and every render's routing.
 
     ``step`` is called with each step's name as it starts (the progress bar).
     """
-    from ..draw.drawing import over_render_budget
-    from ..draw.texture import checker
     from ..pipeline.check import load_and_check
 
     start = time.perf_counter()
     timer = StepTimer(step)
     timer("lint")
-    file, mesh = load_and_check(item.path, settings)
-    result = MeshResult(item, file, settings, mesh=mesh, options=options)
-    if result.readable:
-        timer("scores")
+    file, mesh = load_and_check(item.path, settings, scores=True)
+    found = {}
+    if file.error is None and file.skipped is None:
         import_in_background(SLOW_IMPORTS)
-        result.scores = {code: quad_scores(result.mesh, settings, code) for code in scored_codes(result.mesh)}
-        flagged = {hits.code for hits in file.hits}  # the flagged attribute, else uv, else colours, else normals
-        result.shown = next((code for code in result.scores if code in flagged), next(iter(result.scores), None))
-        result.texture = _texture_label(result.mesh, item.view, options.texture)
-        has_uv = result.mesh.texcoords is not None
-        result.render_error = over_render_budget(result.mesh)
-        if result.render_error:  # no pictures: framing and drawing it would take gigabytes
-            result.overview_note = "the mesh is over the renderer's budget (see the render's line)"
-        else:
-            _view(result)
-            texture = options.texture or (checker(512, item.view.checks) if item.view.checks and has_uv else None)
-            _render(result, texture, timer)
-            if "hybrid" in result.renders:
-                from .stiffness import render_stability
-
-                timer("stability")
-                result.stability = render_stability(result.renders["hybrid"])
-            _overview(result, timer)
-            if result.mesh.n_faces:
-                _closeups(result, timer)
+        found = _collect_pictures(item, file, mesh, settings, options, timer)
     import_in_background(SLOW_IMPORTS).join()  # nothing half-imported is left to the caller
-    result.parts = timer.stop()
-    result.seconds = time.perf_counter() - start
-    return result
+    parts = timer.stop()
+    return MeshResult(item, file, settings, time.perf_counter() - start, mesh, options=options, parts=parts, **found)
+
+
+def _collect_pictures(item: MeshInput, file: FileReport, mesh: Mesh, settings: Settings, options: ReportOptions,
+                      timer: StepTimer) -> dict:
+    """The fields of a readable mesh's :class:`MeshResult` after its lint: what is shown, the renders, the
+    stability of the hybrid, the overview and the close-ups, each step computed from the ones before it."""
+    from ..draw import checker, over_render_budget
+
+    shown = shown_code(file, file.scores)
+    found = {"scores": file.scores, "shown": shown, "texture": _texture_label(mesh, item.view, options.texture)}
+    problem = over_render_budget(mesh)
+    if problem:  # no pictures: framing and drawing it would take gigabytes
+        return {**found, "render_error": problem,
+                "overview_note": "the mesh is over the renderer's budget (see the render's line)"}
+    view = view_of(mesh, item.view, options)
+    checks = item.view.checks and mesh.texcoords is not None
+    texture = options.texture or (checker(512, item.view.checks) if checks else None)
+    drawn = drawn_for(mesh, shown)
+    rendered = render_views(mesh, drawn, view, options, settings, texture, timer)
+    stability = None
+    if "hybrid" in rendered.renders:
+        from .stiffness import render_stability
+
+        timer("stability")
+        stability = render_stability(rendered.renders["hybrid"])
+    if rendered.over_budget:
+        overview, note = None, "the mesh is over the renderer's budget (see the render's line)"
+    else:
+        overview, note = overview_picture(mesh, file.scores.get(shown), view, options.size, timer)
+    places, closeups, dropped = draw_closeups(mesh, file.hits, settings, options, timer) if mesh.n_faces else (
+        (), (), ())
+    return {**found, "renders": rendered.renders, "render_error": rendered.error, "warnings": rendered.warnings,
+            "camera": view[0], "up": view[1], "stability": stability, "overview": overview, "overview_note": note,
+            "places": places, "closeups": closeups, "dropped": dropped}
 
 
 def collect_run(items: list[MeshInput], settings_for: Callable[[str], Settings], settings: Settings,

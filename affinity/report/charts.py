@@ -12,7 +12,7 @@ import re
 
 import numpy as np
 
-from ..draw.shading import FLAG_COLOUR
+from ..draw import FLAG_COLOUR
 
 PASS_COLOUR = "#5b7fa6"
 #: Values spanning more than this ratio get a logarithmic x axis.

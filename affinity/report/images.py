@@ -11,7 +11,7 @@ from html import escape
 
 import numpy as np
 
-from ..draw.png import png_bytes, to_pixels
+from ..draw import png_bytes, to_pixels
 
 #: The heatmaps' ramp, white (no error) -> orange -> dark red (the scale's top): ordered, and prints well.
 HEAT_STOPS = ((1.0, 1.0, 1.0), (0.99, 0.55, 0.24), (0.50, 0.0, 0.05))

@@ -82,7 +82,7 @@ def group_faces(mesh: Mesh, faces: np.ndarray) -> list[np.ndarray]:
     Returns one (k,) int64 array of positions into ``faces`` per group, in the
     order of the groups' first face.
     """
-    from ..draw.closeup import face_vertices
+    from ..draw import face_vertices
 
     if len(faces) == 0:
         return []
@@ -147,7 +147,7 @@ def places_of(mesh: Mesh, hits: RuleHits, limit: int = PLACE_FACES) -> list[Plac
 
     A group of neighbours bigger than ``limit`` faces is :func:`carve`d into places of at most ``limit``.
     """
-    from ..draw.closeup import face_centroids
+    from ..draw import face_centroids
 
     rule = RULES[hits.code]
     keep = hits.faces >= 0

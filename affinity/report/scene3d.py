@@ -20,8 +20,9 @@ from pathlib import Path
 import numpy as np
 
 from ..attributes import ATTRIBUTE_NAMES, ATTRIBUTES
+from ..lint import scored_codes
 from ..mesh import Mesh
-from ..rules import LEVELS, RULES, scoring_rules
+from ..rules import LEVELS, RULES
 from .build import MeshResult
 
 #: Render quads the view embeds at most (about 100 bytes of page each, all attributes).
@@ -69,7 +70,7 @@ def _attribute_block(mesh: Mesh, corners: np.ndarray, field: str, settings) -> d
     """One attribute of the render quads: its corner values (R, 4, width) float32 as base64 and how to read a
     difference of it (the unit, the visibility threshold of its scored rule), or None when the mesh lacks it.
     Normals missing at a corner (or in the whole mesh) are the face's flat normal, as the renderer shades."""
-    from ..draw.shading import flat_normals
+    from ..draw import flat_normals
 
     values = mesh.corner_attribute(field, corners)
     if field == "normals":
@@ -77,7 +78,7 @@ def _attribute_block(mesh: Mesh, corners: np.ndarray, field: str, settings) -> d
         values = fallback if values is None else np.where(np.isnan(values), fallback, values)
     if values is None:
         return None
-    codes = scoring_rules(field)
+    codes = scored_codes(attribute=ATTRIBUTE_NAMES[field])
     visible = (settings.error_above(codes[0]) or RULES[codes[0]].visible_threshold) if codes else None
     attribute = ATTRIBUTES[field]
     return {"name": attribute.name, "width": attribute.width, "unit": attribute.unit, "visible": visible,
@@ -153,7 +154,7 @@ def view_data(result: MeshResult, budget: int = VIEW_QUAD_BUDGET) -> tuple[dict,
     (R,) uint8 the worst finding level of its face (1 error, 2 warning, 3 info,
     0 none), and per attribute the corner values (R, 4, width) float32.
     """
-    from ..draw.quads import render_corners
+    from ..draw import render_corners
 
     mesh = result.mesh
     rows, worst_level = _findings(result)

@@ -218,11 +218,12 @@ def findings_section(result: MeshResult) -> Section:
 
 
 def _shown_text(result: MeshResult) -> str:
-    if result.shown == "Q101":
+    """What the renders draw (:attr:`MeshResult.drawn`), and why when it is not the uv."""
+    if result.drawn == "uv":
         return f"uv, {result.texture}"
-    if result.shown == "Q102" and result.mesh.texcoords is None:
+    if result.drawn == "color" and result.mesh.texcoords is None:
         return "vertex colours (the mesh has no texture coordinates)"
-    if result.shown == "Q102":
+    if result.drawn == "color":
         return "vertex colours (the findings are about them, not the uv)"
     return "shading (the mesh has no texture coordinates or vertex colours)"
 
@@ -235,7 +236,7 @@ def renders_section(result: MeshResult) -> Section:
     title = "Renders"
     if result.render_error:
         return leave_out("renders", title, f"cannot render: {result.render_error}")
-    from ..draw.routing import MVC
+    from ..draw import MVC
 
     hybrid = result.renders["hybrid"]
     routed = int(np.count_nonzero(hybrid.methods == MVC))
@@ -266,7 +267,7 @@ def overlay_section(result: MeshResult) -> Section:
     title = "Quads sent to mvc"
     if result.render_error:
         return leave_out("overlay", title, f"cannot render: {result.render_error}")
-    from ..draw.routing import MVC
+    from ..draw import MVC
 
     hybrid = result.renders["hybrid"]
     routed = int(np.count_nonzero(hybrid.methods == MVC))
@@ -490,7 +491,7 @@ def overview_section(result: MeshResult) -> Section:
     title = "3-D overview"
     if result.overview is None:
         return leave_out("overview", title, result.overview_note)
-    from ..draw.view import score_range
+    from ..draw import score_range
 
     scores = result.scores.get(result.shown)
     bar = ""

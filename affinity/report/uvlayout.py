@@ -82,9 +82,7 @@ def layout_image(mesh: Mesh, flagged: np.ndarray, size: int) -> Layout | None:
     the share of them that is flagged; where distinct quads overlap, flagged ones
     are drawn over the others.
     """
-    from ..draw.flat import face_ids
-    from ..draw.quads import render_corners
-    from ..draw.shading import OVERLAY_TINT
+    from ..draw import OVERLAY_TINT, face_ids, render_corners
 
     faces, corners = render_corners(mesh)
     uv = mesh.corner_attribute("texcoords", corners)

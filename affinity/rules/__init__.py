@@ -25,7 +25,6 @@ from .registry import (
     register,
     resolve_codes,
     rule,
-    scoring_rules,
     unregister,
 )
 
@@ -41,4 +40,4 @@ def find_rule(key: str) -> Rule | None:
 
 __all__ = ["LEVELS", "RULES", "SECTIONS", "UNREADABLE", "Measured", "Rule", "find_rule", "number_text", "number_texts",
            "page_fields", "register",
-           "resolve_codes", "rule", "rule_page", "rules_table", "scoring_rules", "threshold_text", "unregister", "with_unit"]
+           "resolve_codes", "rule", "rule_page", "rules_table", "threshold_text", "unregister", "with_unit"]

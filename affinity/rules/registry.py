@@ -254,12 +254,6 @@ def unregister(code: str) -> None:
     del RULES[code]
 
 
-def scoring_rules(field: str) -> list[str]:
-    """Codes of the scored rules (``Rule.scored``) on the attribute ``field`` (a Mesh field,
-    ``"texcoords"``), in code order."""
-    return [code for code, rule in RULES.items() if rule.scored and rule.attribute == field]
-
-
 def resolve_codes(select: list[str] | None, ignore: list[str] | None) -> list[str]:
     """Rule codes enabled by ``select``/``ignore`` prefixes (``"Q1"``, ``"Q101"``, ``"ALL"``)."""
 

@@ -125,21 +125,22 @@ def prepare(case: Scene, settings: StudySettings) -> PreparedScene:
 
     Raises ValueError for a mesh without faces, or with neither uv nor vertex colours (nothing to compare).
     """
+    from ..attributes import drawn_attribute
     from ..draw.drawing import RenderOptions, render_mesh
     from ..draw.texture import checker
-    from ..lint import scored_code_of
+    from ..lint import scored_codes
 
     mesh = case.mesh()
     if mesh.n_faces == 0:
         raise ValueError(f"{case.name}: the mesh has no faces")
-    show = "uv" if mesh.texcoords is not None else "color" if mesh.colors is not None else None
-    if show is None:
+    show = drawn_attribute(mesh)
+    if show == "shaded":
         raise ValueError(f"{case.name}: no texture coordinates or vertex colours to compare")
     texture = checker(settings.texture_size) if show == "uv" else None
     drawn = render_mesh(mesh, RenderOptions(method="split", show=show, width=settings.width, height=settings.height,
                                             camera=case.view.camera, up=case.view.up, texture=texture))
     direction = np.subtract(drawn.camera.eye, drawn.camera.target)
-    scene = PreparedScene(case, mesh, drawn.faces, drawn.clip, drawn.inputs, show, scored_code_of(show, mesh),
+    scene = PreparedScene(case, mesh, drawn.faces, drawn.clip, drawn.inputs, show, scored_codes(mesh, show)[0],
                           texture, direction / np.linalg.norm(direction), drawn.settings)
     scene.routes = _routes(scene, settings)
     return scene
