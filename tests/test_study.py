@@ -196,12 +196,14 @@ def color_rows():
 
 
 def test_study_errors_are_in_the_unit_the_attribute_registry_gives(trapezoid_rows, color_rows):
-    from affinity.attributes import ATTRIBUTES, scoring_rules
+    from affinity.attributes import ATTRIBUTES
+    from affinity.lint import scored_codes
     from affinity.rules import RULES
 
     for field, rows in (("texcoords", trapezoid_rows.values()), ("colors", color_rows)):
         unit = ATTRIBUTES[field].unit
-        assert {row["unit"] for row in rows} == {unit} == {RULES[code].unit for code in scoring_rules(field)}
+        codes = scored_codes(attribute=ATTRIBUTES[field].name)
+        assert {row["unit"] for row in rows} == {unit} == {RULES[code].unit for code in codes}
     # The split's colour error against exact peaks at the left square's centre: bilinear minus the split is
     # R t (1 - s), R = c0 - c1 + c2 - c3 = (-1, 1, 1), so |R| / 4 = sqrt(3) / 4 of full scale, in 1/255 steps.
     split = next(row for row in color_rows if row["method"] == "split")
@@ -214,11 +216,12 @@ def test_study_errors_are_in_the_unit_the_attribute_registry_gives(trapezoid_row
 def test_the_headline_setting_and_its_words_follow_the_registries(color_rows, monkeypatch):
     from dataclasses import replace
 
-    from affinity.attributes import ATTRIBUTES, scoring_rules
+    from affinity.attributes import ATTRIBUTES
+    from affinity.lint import scored_codes
     from affinity.rules import RULES
     from affinity.study.tables import error_label, headline_hybrid, summary_markdown
 
-    (code,) = scoring_rules("colors")
+    (code,) = scored_codes(attribute="colour")
     scene = color_rows[0]["scene"]
     assert headline_hybrid(color_rows, scene)["setting"] == RULES[code].default_threshold == 2.0
     monkeypatch.setitem(RULES, code, replace(RULES[code], default_threshold=4.0))

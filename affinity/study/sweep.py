@@ -128,7 +128,7 @@ def prepare(case: Scene, settings: StudySettings) -> PreparedScene:
     from ..attributes import drawn_attribute
     from ..draw.drawing import RenderOptions, render_mesh
     from ..draw.texture import checker
-    from ..lint import scored_code_of
+    from ..lint import scored_codes
 
     mesh = case.mesh()
     if mesh.n_faces == 0:
@@ -140,7 +140,7 @@ def prepare(case: Scene, settings: StudySettings) -> PreparedScene:
     drawn = render_mesh(mesh, RenderOptions(method="split", show=show, width=settings.width, height=settings.height,
                                             camera=case.view.camera, up=case.view.up, texture=texture))
     direction = np.subtract(drawn.camera.eye, drawn.camera.target)
-    scene = PreparedScene(case, mesh, drawn.faces, drawn.clip, drawn.inputs, show, scored_code_of(show, mesh),
+    scene = PreparedScene(case, mesh, drawn.faces, drawn.clip, drawn.inputs, show, scored_codes(mesh, show)[0],
                           texture, direction / np.linalg.norm(direction), drawn.settings)
     scene.routes = _routes(scene, settings)
     return scene

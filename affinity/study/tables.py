@@ -9,7 +9,8 @@ import csv
 import math
 
 from ..atomic import atomic_write
-from ..attributes import ATTRIBUTES, Attribute, scoring_rules
+from ..attributes import ATTRIBUTES, Attribute
+from ..lint import scored_codes
 from ..rules import RULES, threshold_text, with_unit
 from .sweep import COLUMNS
 
@@ -41,7 +42,7 @@ def error_label(unit: str) -> str:
 
 def _lint_rule(unit: str):
     """The first scored rule of the attribute whose errors are in ``unit``."""
-    return RULES[scoring_rules(attribute_in(unit).field)[0]]
+    return RULES[scored_codes(attribute=attribute_in(unit).name)[0]]
 
 
 def write_csv(rows: list[dict], path: str) -> None:
