@@ -22,9 +22,11 @@ from __future__ import annotations
 import re
 from typing import TextIO
 
+import numpy as np
+
 from ..findings import FileReport
 from ..rules import LEVELS, RULES, UNREADABLE
-from . import CheckRun, Columns, Selection, face_lines, statistics, text_lines
+from . import CheckRun, Columns, Selection, face_line_pieces, rows, statistics, text_lines
 
 # Characters XML 1.0 cannot carry at all (control characters, lone surrogates from undecodable file names).
 _NOT_XML = re.compile("[^\t\n\r\x20-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
@@ -54,21 +56,21 @@ def _attributes(**values) -> str:
 
 
 def _finding_cases(fail_on: str):
-    """The ``<testcase>`` text of each finding of a :class:`Columns`: failing at ``fail_on`` and above."""
+    """The ``<testcase>`` text of each finding of a :class:`Columns` (a grid of rows, :mod:`.rows`, for
+    findings on faces): failing at ``fail_on`` and above."""
     failing = set(LEVELS[: LEVELS.index(fail_on) + 1])
 
-    def cases(c: Columns) -> list[str]:
+    def cases(c: Columns) -> np.ndarray | list[str]:
         path = xml_attribute(c.path)
         rule = f"{xml_attribute(c.code)} {xml_attribute(c.name)}"
         failure = f'<failure type="{xml_attribute(c.code)}" message="{rule}: {xml_attribute(RULES[c.code].summary)}">'
-        lines = face_lines(c, xml_text)
-        if lines is not None:  # measured faces of a mesh file: one shape for every case
-            case, where = f'<testcase classname="{path}" name="{rule} face ', f'" file="{path}" line="'
-            opens = {level: f'">{failure}' if level in failing else '"><system-out>' for level in LEVELS}
-            closes = {level: "</failure></testcase>\n" if level in failing else "</system-out></testcase>\n"
-                      for level in LEVELS}
-            return [f"{case}{face}{where}{line}{opens[level]}{t}{closes[level]}"
-                    for face, line, level, t in zip(c.number_texts[2], c.number_texts[0], c.level, lines)]
+        if c.on_faces:  # measured faces of a mesh file: one shape for every case, laid out a column at a time
+            fails = c.level_ranks <= LEVELS.index(fail_on)
+            return rows.grid([f'<testcase classname="{path}" name="{rule} face '.encode(), c.face_digits,
+                              f'" file="{path}" line="'.encode(), c.line_digits,
+                              rows.choice(fails, ['"><system-out>', f'">{failure}']),
+                              *face_line_pieces(c, xml_text),
+                              rows.choice(fails, ["</system-out></testcase>\n", "</failure></testcase>\n"])], len(c))
         lines = text_lines(c)
         if _needs_escaping(c):  # numbers never do: only the path, messages, groups and prims can
             lines = list(map(xml_text, lines))
@@ -103,8 +105,8 @@ def _suite(run: CheckRun, selection: Selection, counts: dict[str, int], out: Tex
                   f"<skipped{_attributes(message=report.skipped)}/></testcase>\n")
     elif not report.hits:
         out.write(f'    <testcase classname="{path}" name="affinity check"/>\n')
-    for block in selection.formatted(_finding_cases(run.fail_on)):
-        out.write("".join(block))
+    for block in selection.written(_finding_cases(run.fail_on)):
+        out.write(block)
     out.write("  </testsuite>\n")
 
 
