@@ -529,7 +529,7 @@ def format_value(value: float) -> str:
     return f"{value:.4g}"
 
 
-def _measured(c: Columns) -> tuple[str, str]:
+def measurement_suffixes(c: Columns) -> tuple[str, str]:
     """What follows a value in a description: its unit (``" texels"``, ``"/255"``) where there is no threshold,
     else ``" vs 0.5 texels"``."""
     unit = with_unit("", c.unit)  # what follows the number: " texels", "/255"
@@ -546,7 +546,7 @@ def descriptions(c: Columns) -> list[str]:
     if not c.unit:
         return list(c.message)
     if c.visible is None:
-        unit, against = _measured(c)
+        unit, against = measurement_suffixes(c)
         return [f"{m} ({v:.4g}{unit}{against})" for m, v in zip(c.message, c.value)]
     return [_described(m, v, read.get("bound"), read.get("threshold", c.threshold), read.get("unit", c.unit))
             for m, v, read in zip(c.message, c.value, c.visible)]
@@ -598,7 +598,7 @@ def face_line_pieces(c: Columns, escape=str) -> list[rows.Piece]:
     """The pieces (:mod:`.rows`) of the text lines of findings on faces (:attr:`Columns.on_faces`), without
     line ends, their texts (path, name, unit, messages) passed through ``escape`` (XML for JUnit); each
     number column converted at once, each distinct text encoded once."""
-    unit, against = _measured(c)
+    unit, against = measurement_suffixes(c)
     which, messages = distinct(c.message)
     return [f"{escape(printable(c.path))}:".encode(), c.line_digits, b":", rows.integers(c.columns),
             f": {c.code} ".encode(), rows.choice(c.level_ranks, LEVELS), f" {escape(c.name)}: ".encode(),
@@ -641,7 +641,7 @@ def working_relative(path: str) -> str | None:
 
 
 #: The format of :func:`value_token`, for formatting many values at once.
-VALUE_TOKEN = "{:.6g}"
+VALUE_TOKEN = "%.6g"
 
 
 def value_token(value: float) -> str:
@@ -651,5 +651,5 @@ def value_token(value: float) -> str:
     this token (with rule, file and group) identifies a finding across face
     reordering and edits elsewhere in the file (baseline, SARIF fingerprints).
     """
-    return VALUE_TOKEN.format(value)
+    return VALUE_TOKEN % value
 

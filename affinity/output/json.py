@@ -97,17 +97,22 @@ def _finding_rows(settings):
         if not c.plain:
             extra = {} if measure is None else {"measure": measure}
             return ["," + encode({**finding_dict(f), **extra}, separators=(",", ":")) for f in c.findings()]
-        # json writes a finite float as repr does (%r); NaN and the infinities as NaN, Infinity, -Infinity
-        value = (rows.formatted(c.value, "%r") if np.isfinite(c.values).all()
-                 else rows.formatted(list(map(encode, c.value)), "%s"))
         which, ends = _ends(c, f',"threshold":{encode(c.threshold)},"unit":{encode(c.unit)},"level":"',
                             "}" if measure is None else f',"measure":{encode(measure)}}}')
         return rows.grid([f',{{"path":{encode(c.path)},"line":'.encode(), rows.integers(c.lines), b',"column":',
                           rows.integers(c.columns),
                           f',"code":{encode(c.code)},"name":{encode(c.name)},"face":'.encode(),
-                          rows.integers(c.faces), b',"value":', value, rows.choice(which, ends)], len(c))
+                          c.face_digits, b',"value":', json_values(c), rows.choice(which, ends)], len(c))
 
     return finding_rows
+
+
+def json_values(c: Columns) -> np.ndarray:
+    """(n, w) uint8: the values as JSON text (:func:`.rows.formatted`): a finite float as repr writes it, as
+    ``json`` does; NaN and the infinities as ``NaN``, ``Infinity``, ``-Infinity``."""
+    if np.isfinite(c.values).all():
+        return rows.formatted(c.value, "%r")
+    return rows.formatted(list(map(json.dumps, c.value)), "%s")
 
 
 def _ends(c: Columns, unit: str, tail: str) -> tuple[np.ndarray, list[str]]:
