@@ -269,8 +269,9 @@ def group_name(report: FileReport, index: int) -> str:
     return report.group_names[index] if 0 <= index < len(report.group_names) else ""
 
 
-def columns(report: FileReport, hits: RuleHits, take: np.ndarray) -> Columns:
-    """The findings ``take`` (k,) int64 of ``hits`` as :class:`Columns`."""
+def columns(report: FileReport, hits: RuleHits, take: np.ndarray, ranks: np.ndarray | None = None) -> Columns:
+    """The findings ``take`` (k,) int64 of ``hits`` as :class:`Columns`; ``ranks`` (n,) int8 is
+    ``hits.level_ranks()`` where a caller taking many blocks has it already."""
     rule = RULES[hits.code]
     faces, groups, lines = hits.faces[take], hits.groups[take], hits.lines[take]
     usd = report.prim_face_start is not None
@@ -292,7 +293,7 @@ def columns(report: FileReport, hits: RuleHits, take: np.ndarray) -> Columns:
         unit=hits.unit if hits.unit is not None else rule.unit,
         threshold=None if rule.default_threshold is None else hits.threshold,
         lines=lines, columns=(lines > 0).astype(np.int64), faces=faces, values=hits.values[take],
-        level_ranks=hits.level_ranks()[take], group=group, message=message, prim=prim,
+        level_ranks=(hits.level_ranks() if ranks is None else ranks)[take], group=group, message=message, prim=prim,
         shared=shared, visible=visible if visible is not None and any(visible) else None,
     )
 
@@ -396,6 +397,7 @@ class Selection:
         once): per block its size and, per rule in it, the positions (k,) int64 of its rows in the block, their
         :class:`Columns` and their values of ``along`` (n,) (None without)."""
         starts = np.cumsum([0] + [len(take) for _, take in self.parts])
+        ranks = [hits.level_ranks() for hits, _ in self.parts]
         for begin in range(0, len(self.order), block):
             index = self.order[begin : begin + block]
             part = np.searchsorted(starts, index, side="right") - 1
@@ -404,7 +406,7 @@ class Selection:
             for p in present:
                 where = np.flatnonzero(part == p)
                 hits, take = self.parts[p]
-                rules.append((where, columns(self.report, hits, take[index[where] - starts[p]]),
+                rules.append((where, columns(self.report, hits, take[index[where] - starts[p]], ranks[p]),
                               None if along is None else along[begin + where]))
             yield len(index), rules
 

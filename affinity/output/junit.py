@@ -30,8 +30,6 @@ from . import CheckRun, Columns, Selection, face_line_pieces, rows, statistics, 
 
 # Characters XML 1.0 cannot carry at all (control characters, lone surrogates from undecodable file names).
 _NOT_XML = re.compile("[^\t\n\r\x20-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
-#: What an attribute value or character data cannot hold as it is.
-_SPECIAL = re.compile("[&<>\"\t\n\r]|" + _NOT_XML.pattern)
 
 
 def xml_text(text: str) -> str:
@@ -43,12 +41,6 @@ def xml_attribute(text: str) -> str:
     """``text`` as a double-quoted attribute value (quotes, tabs and line breaks kept as references)."""
     return (xml_text(text).replace('"', "&quot;").replace("\t", "&#9;").replace("\n", "&#10;")
             .replace("\r", "&#13;"))
-
-
-def _needs_escaping(c: Columns) -> bool:
-    """Whether the texts a :class:`Columns` is written from hold anything XML must escape or cannot carry."""
-    texts = {c.path, *c.message, *c.group, *(p for p in c.prim if p is not None)}
-    return any(_SPECIAL.search(text) for text in texts)
 
 
 def _attributes(**values) -> str:
@@ -71,9 +63,7 @@ def _finding_cases(fail_on: str):
                               rows.choice(fails, ['"><system-out>', f'">{failure}']),
                               *face_line_pieces(c, xml_text),
                               rows.choice(fails, ["</system-out></testcase>\n", "</failure></testcase>\n"])], len(c))
-        lines = text_lines(c)
-        if _needs_escaping(c):  # numbers never do: only the path, messages, groups and prims can
-            lines = list(map(xml_text, lines))
+        lines = list(map(xml_text, text_lines(c)))  # a bound reads "<=", texts may hold "&"
         names = [rule if face < 0 else f"{rule} face {face}" if prim is None
                  else f"{rule} {xml_attribute(prim)} face {face}" for face, prim in zip(c.face, c.prim)]
         return [f'<testcase classname="{path}" name="{name}" file="{path}" line="{line}">'
