@@ -35,9 +35,13 @@ def integers(numbers: np.ndarray) -> np.ndarray:
         one = np.frombuffer(b"%d" % numbers[0], dtype=np.uint8)
         return np.broadcast_to(one, (len(numbers), len(one)))
     magnitude = np.abs(numbers)
-    powers = 10 ** np.arange(len(str(int(magnitude.max(initial=0)))) - 1, -1, -1, dtype=np.int64)  # (w,)
-    digits = (magnitude[:, None] // powers % 10 + ord("0")).astype(np.uint8)  # (n, w)
-    digits[:, :-1][magnitude[:, None] < powers[:-1]] = 0  # leading zeros (a lone 0 keeps its digit)
+    width = len(str(int(magnitude.max(initial=0))))
+    digits = np.empty((len(numbers), width), dtype=np.uint8)
+    rest = magnitude.copy()
+    for place in range(width - 1, -1, -1):  # a loop over digit places, each a column at once
+        digits[:, place] = rest % 10 + ord("0")
+        rest //= 10
+    digits[:, :-1][magnitude[:, None] < 10 ** np.arange(width - 1, 0, -1)] = 0  # leading zeros (0 keeps its digit)
     if not (numbers < 0).any():
         return digits
     sign = np.where(numbers < 0, ord("-"), 0).astype(np.uint8)[:, None]
