@@ -41,8 +41,10 @@ def test_floats_are_written_as_repr_and_percent_g_write_them():
     rng = np.random.default_rng(4)
     values = [*(rng.random(3000) * 10.0 ** rng.integers(-30, 30, 3000)).tolist(),
               0.0, -0.0, 5e-324, 1e300, float("inf"), float("-inf"), float("nan"), 0.1, 1e16, 123456789.0]
-    assert rows.assemble([rows.formatted(values, "%r"), b";"]) == "".join(f"{v!r};" for v in values)
-    assert rows.assemble([rows.formatted(values, "%.4g"), b";"]) == "".join(f"{v:.4g};" for v in values)
+    for spec in ("%r", "%.4g", "%.6g"):
+        assert rows.assemble([rows.floats(values, spec), b";"]) == "".join(spec % v + ";" for v in values)
+    assert rows.assemble([rows.floats([-2.2250738585072014e-308, -1.7976931348623157e308], "%r"), b";"]) == (
+        "-2.2250738585072014e-308;-1.7976931348623157e+308;")  # the longest texts fill the slot
 
 
 def test_texts_keep_their_spaces_and_non_ascii_characters():

@@ -604,7 +604,7 @@ def face_line_pieces(c: Columns, escape=str) -> list[rows.Piece]:
     which, messages = distinct(c.message)
     return [f"{escape(printable(c.path))}:".encode(), c.line_digits, b":", rows.integers(c.columns),
             f": {c.code} ".encode(), rows.choice(c.level_ranks, LEVELS), f" {escape(c.name)}: ".encode(),
-            rows.choice(which, [escape(m) for m in messages]), b" (", rows.formatted(c.value, "%.4g"),
+            rows.choice(which, [escape(m) for m in messages]), b" (", rows.floats(c.value, "%.4g"),
             f"{escape(unit + against)}) [face ".encode(), c.face_digits, b"]"]
 
 

@@ -111,7 +111,7 @@ def json_values(c: Columns) -> np.ndarray:
     """(n, w) uint8: the values as JSON text (:func:`.rows.formatted`): a finite float as repr writes it, as
     ``json`` does; NaN and the infinities as ``NaN``, ``Infinity``, ``-Infinity``."""
     if np.isfinite(c.values).all():
-        return rows.formatted(c.value, "%r")
+        return rows.floats(c.value, "%r")
     return rows.formatted(list(map(json.dumps, c.value)), "%s")
 
 

@@ -12,13 +12,14 @@ NumPy, floats with one ``%`` over a joined template (``%r`` is JSON's float
 text, ``%.4g`` the text lines'). Time and memory grow with the findings, with
 small constants and no Python step per finding.
 
->>> assemble([b"face ", integers(np.array([7, 12, -3])), b": ", formatted([0.5, 1e-7, 2.0], "%r"), b"\\n"])
+>>> assemble([b"face ", integers(np.array([7, 12, -3])), b": ", floats([0.5, 1e-7, 2.0], "%r"), b"\\n"])
 'face 7: 0.5\\nface 12: 1e-07\\nface -3: 2.0\\n'
 """
 
 from __future__ import annotations
 
 import functools
+import sys
 from collections.abc import Sequence
 
 import numpy as np
@@ -49,10 +50,19 @@ def integers(numbers: np.ndarray) -> np.ndarray:
 
 
 def formatted(values: Sequence, spec: str) -> np.ndarray:
-    """(n, w) uint8: each of ``values`` (n,) as ``spec % value`` writes it (``"%r"``, ``"%.4g"``, ``"%s"`` for
-    texts), converted in one ``%`` over a joined template, left-aligned in a NUL-padded slot. The texts
-    must hold no NUL."""
+    """(n, w) uint8: each of ``values`` (n,) as ``spec % value`` writes it (``"%s"`` for texts), converted in
+    one ``%`` over a joined template, left-aligned in a NUL-padded slot. The texts must hold no NUL."""
     return padded(((spec + "\0") * len(values) % tuple(values)).encode(), len(values))
+
+
+def floats(values: Sequence[float], spec: str) -> np.ndarray:
+    """(n, w) uint8: each of ``values`` (n,) float as ``spec`` (``"%r"``, ``"%.4g"``) writes it, NUL-padded:
+    formatted in one ``%`` at the widest a float can take (the most negative double's text), so the slots
+    need no searching; the columns no value reaches are dropped."""
+    width = len(spec % -sys.float_info.max)
+    text = (f"%-{width}{spec[1:]}" * len(values) % tuple(values)).replace(" ", "\0").encode()
+    laid = np.frombuffer(text, dtype=np.uint8).reshape(len(values), width)
+    return laid[:, : int(np.flatnonzero(laid.any(axis=0)).max(initial=-1)) + 1]
 
 
 def padded(joined: bytes, n: int) -> np.ndarray:

@@ -162,7 +162,7 @@ def token_ids(values: np.ndarray) -> np.ndarray:
     same = (key[:, 1:] == key[:, :-1]).all(axis=0)
     unsure = np.flatnonzero(~(sure[1:] & sure[:-1]))
     if len(unsure):
-        tokens = rows.formatted([*distinct[unsure].tolist(), *distinct[unsure + 1].tolist()], VALUE_TOKEN)
+        tokens = rows.floats([*distinct[unsure].tolist(), *distinct[unsure + 1].tolist()], VALUE_TOKEN)
         same[unsure] = (tokens[: len(unsure)] == tokens[len(unsure) :]).all(axis=1)
     ids = np.concatenate([[0], np.cumsum(~same)])[inverse.ravel()]
     ids[(values == 0) & np.signbit(values)] = len(distinct)
@@ -223,7 +223,7 @@ def _face_results(c: Columns, location: dict, compact, head: str, shared: str, i
     return rows.grid([
         head.encode(), rows.choice(c.level_ranks, [sarif_level(level) for level in LEVELS]),
         b'","message":{"text":', rows.choice(which_message, [encode(m + " (")[:-1] for m in messages]),
-        rows.formatted(c.value, "%.4g"), encode(f"{unit}{against}), face ")[1:-1].encode(), c.face_digits,
+        rows.floats(c.value, "%.4g"), encode(f"{unit}{against}), face ")[1:-1].encode(), c.face_digits,
         f'"}},"locations":[{{"physicalLocation":{{"artifactLocation":{compact(location)}'.encode(),
         *(region if (c.lines > 0).all() else []),
         b'},"logicalLocations":[{"name":"face ', c.face_digits, b'","fullyQualifiedName":',
