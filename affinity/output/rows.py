@@ -100,8 +100,10 @@ def grid(pieces: Sequence[Piece], n: int) -> np.ndarray:
 
 
 def text(rows: np.ndarray) -> str:
-    """The text of a grid of rows (:func:`grid`): its bytes without the NUL padding, decoded as UTF-8."""
-    return rows.tobytes().replace(b"\0", b"").decode("utf-8")
+    """The text of a grid of rows (:func:`grid`): its bytes without the NUL padding, decoded as UTF-8. (A
+    mask takes the same time however many NULs there are; ``bytes.replace`` takes a step per NUL, and a
+    JUnit case that does not fail pads its opening by some 90: 86 -> 72 ms on the car's JUnit.)"""
+    return rows[rows != 0].tobytes().decode("utf-8")
 
 
 def assemble(pieces: Sequence[Piece]) -> str:
