@@ -36,12 +36,16 @@ def integers(numbers: np.ndarray) -> np.ndarray:
         one = np.frombuffer(b"%d" % numbers[0], dtype=np.uint8)
         return np.broadcast_to(one, (len(numbers), len(one)))
     magnitude = np.abs(numbers)
-    width = len(str(int(magnitude.max(initial=0))))
+    largest = int(magnitude.max(initial=0))
+    width = len(str(largest))
     digits = np.empty((len(numbers), width), dtype=np.uint8)
-    rest = magnitude.copy()
+    rest = magnitude.astype(np.uint32 if largest < 2**32 else np.uint64)  # 32-bit division: twice as fast
+    ten = rest.dtype.type(10)
     for place in range(width - 1, -1, -1):  # a loop over digit places, each a column at once
-        digits[:, place] = rest % 10 + ord("0")
-        rest //= 10
+        quotient = rest // ten
+        digits[:, place] = rest - quotient * ten
+        rest = quotient
+    digits += ord("0")
     digits[:, :-1][magnitude[:, None] < 10 ** np.arange(width - 1, 0, -1)] = 0  # leading zeros (0 keeps its digit)
     if not (numbers < 0).any():
         return digits
