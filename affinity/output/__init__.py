@@ -157,6 +157,11 @@ def finding_dict(f: Finding) -> dict:
             if (value := getattr(f, name)) is not None or name not in OPTIONAL_FIELDS}
 
 
+def _listed(array: str) -> cached_property:
+    """A :class:`Columns` attribute: its array ``array`` as a list, made on first use."""
+    return cached_property(lambda columns: getattr(columns, array).tolist())
+
+
 @dataclass(eq=False)
 class Columns:
     """Findings of one rule in one file as columns, for the formats that write many rows at once.
@@ -197,21 +202,10 @@ class Columns:
     def __len__(self) -> int:
         return len(self.faces)
 
-    @cached_property
-    def line(self) -> list[int]:
-        return self.lines.tolist()
-
-    @cached_property
-    def column(self) -> list[int]:
-        return self.columns.tolist()
-
-    @cached_property
-    def face(self) -> list[int]:
-        return self.faces.tolist()
-
-    @cached_property
-    def value(self) -> list[float]:
-        return self.values.tolist()
+    line = _listed("lines")
+    column = _listed("columns")
+    face = _listed("faces")
+    value = _listed("values")
 
     @cached_property
     def level(self) -> list[str]:
