@@ -265,8 +265,9 @@ def crease_bound(texture, low_corner: np.ndarray, high_corner: np.ndarray, shift
     with np.errstate(invalid="ignore"):
         bound = range_bound(low, high, normal_map)
         if not normal_map:
-            _, steepest = box_extremes(texture.slopes, low_corner, high_corner)
-            bound = np.minimum(bound, steepest[:, 0] * shifts[:, 0] + steepest[:, 1] * shifts[:, 1])
+            (_, across_columns), (_, across_rows) = (box_extremes(slopes, low_corner, high_corner)
+                                                     for slopes in texture.slopes)
+            bound = np.minimum(bound, across_columns[:, 0] * shifts[:, 0] + across_rows[:, 0] * shifts[:, 1])
     bound[~np.isfinite(low).all(axis=1)] = np.nan
     return bound
 
