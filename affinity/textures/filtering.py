@@ -19,23 +19,44 @@ def texel_coordinates(uv: np.ndarray, width: int, height: int) -> np.ndarray:
 
 def _corners(width: int, height: int, uv: np.ndarray):
     """The four texels bilinear filtering reads at OpenGL uv (N, 2) with repeat wrapping, as flat indices
-    (N,) int64 each (top-left, top-right, bottom-left, bottom-right), and the weights (N, 1) float32 of the
-    right and bottom ones."""
-    xy = texel_coordinates(uv, width, height)
-    x0, y0 = np.floor(xy[:, 0]), np.floor(xy[:, 1])
-    fx, fy = (xy[:, 0] - x0).astype(np.float32)[:, None], (xy[:, 1] - y0).astype(np.float32)[:, None]
-    x0 = x0.astype(np.int64) % width
-    y0 = y0.astype(np.int64) % height
-    x1, y1 = (x0 + 1) % width, (y0 + 1) % height
+    (4, N) int64 (top-left, top-right, bottom-left, bottom-right), and the weights (N, 1) float32 of the
+    right and bottom ones (:func:`texel_coordinates`' x, y, computed column by column)."""
+    uv = np.asarray(uv, dtype=np.float64)
+    x, y = uv[:, 0] * width - 0.5, (1.0 - uv[:, 1]) * height - 0.5
+    x0, y0 = np.floor(x), np.floor(y)
+    fx, fy = (x - x0).astype(np.float32)[:, None], (y - y0).astype(np.float32)[:, None]
+    x0, y0 = _wrapped_texels(x0, width), _wrapped_texels(y0, height)
+    x1, y1 = _wrapped_texels(x0 + 1, width), _wrapped_texels(y0 + 1, height)
     row0, row1 = y0 * width, y1 * width
-    return (row0 + x0, row0 + x1, row1 + x0, row1 + x1), fx, fy
+    index = np.empty((4, len(x0)), dtype=np.int64)
+    for out, (row, column) in zip(index, ((row0, x0), (row0, x1), (row1, x0), (row1, x1))):
+        np.add(row, column, out=out)
+    return index, fx, fy
+
+
+def _wrapped_texels(texel: np.ndarray, size: int) -> np.ndarray:
+    """(N,) int64: integer texel indices ``texel`` (N,) (float or int) repeated into [0, size); a bit mask for
+    a power-of-two size (the common case: no division per texel)."""
+    texel = texel.astype(np.int64, copy=False)
+    if size & (size - 1) == 0:
+        return texel & (size - 1)
+    return texel % size
 
 
 def _blend(texels, fx: np.ndarray, fy: np.ndarray) -> np.ndarray:
+    """Bilinear blend of the four texels (top-left, top-right, bottom-left, bottom-right), each (N, C) float32
+    (overwritten), by the weights ``fx``, ``fy`` (N, 1): a + (b - a) f, left to right, then top to bottom."""
     top_left, top_right, bottom_left, bottom_right = texels
-    top = top_left + (top_right - top_left) * fx
-    bottom = bottom_left + (bottom_right - bottom_left) * fx
-    return top + (bottom - top) * fy
+    top = np.subtract(top_right, top_left, out=top_right)
+    top *= fx
+    top += top_left
+    bottom = np.subtract(bottom_right, bottom_left, out=bottom_right)
+    bottom *= fx
+    bottom += bottom_left
+    bottom -= top
+    bottom *= fy
+    bottom += top
+    return bottom
 
 
 def sample_bilinear(image: np.ndarray, uv: np.ndarray) -> np.ndarray:
@@ -146,10 +167,12 @@ class RangePyramid:
         extent = np.maximum(x1 - x0, y1 - y0) + 1
         level = np.minimum(np.ceil(np.log2(np.maximum(extent, 1))).astype(np.int64), self.levels - 1)
         lows, highs = np.empty((len(x0), channels)), np.empty((len(x0), channels))
-        for k in np.unique(level).tolist():  # one pass per pyramid level (at most ~14), not per box
+        for k in np.flatnonzero(np.bincount(level)).tolist():  # one pass per pyramid level (at most ~14)
             rows = np.flatnonzero(level == k)
             bx0, bx1, by0, by1 = x0[rows] >> k, x1[rows] >> k, y0[rows] >> k, y1[rows] >> k
-            self._build(k, np.unique(np.concatenate([by0, by1]) // self._band_rows[k]))
+            reached = np.zeros(len(self._built[k]), dtype=bool)
+            reached[by0 // self._band_rows[k]] = reached[by1 // self._band_rows[k]] = True
+            self._build(k, np.flatnonzero(reached))
             low, high = self._levels[k]
             blocks = [(by, bx) for by in (by0, by1) for bx in (bx0, bx1)]
             lows[rows] = _combined(low, blocks, np.minimum)[:, :channels] if self.minima else 0
