@@ -73,3 +73,42 @@ def test_decoded_texels_are_the_images_and_the_step_pyramids_its_wrapped_steps(t
         for k in range(pyramid.levels):
             pyramid._build(k, np.arange(len(pyramid._built[k])))
             np.testing.assert_array_equal(pyramid._levels[k][1], block_extremes(step.astype(np.uint8), k)[1])
+
+
+@pytest.mark.parametrize("mode,interlace", [("RGB", False), ("RGBA", False), ("RGB", True)])
+def test_a_png_decodes_in_place_into_the_texels_as_pillow_decodes_it(tmp_path, mode, interlace):
+    """The PNG path that has Pillow decode straight into the texels' buffer (no copy out of Pillow) is taken
+    on this Pillow and gives the written pixels, as Pillow's own ``np.asarray`` reads them, interlaced (Adam7)
+    or not."""
+    from PIL import Image, PngImagePlugin
+
+    from affinity.textures.decode import _decoded_in_place
+
+    array = np.random.default_rng(8).integers(0, 256, (33, 47, len(mode)), dtype=np.uint8)
+    path = tmp_path / "t.png"
+    if interlace:  # Pillow does not write Adam7: a minimal interlaced PNG by hand, Pillow's decoder reads it
+        path.write_bytes(adam7_png(array))
+    else:
+        Image.fromarray(array, mode).save(path)
+    with open(path, "rb") as file, PngImagePlugin.PngImageFile(file) as image:
+        texels = _decoded_in_place(image)
+    assert texels is not None
+    np.testing.assert_array_equal(texels[..., :len(mode)], array)
+    with Image.open(path) as image:
+        np.testing.assert_array_equal(texels[..., :len(mode)], np.asarray(image))
+
+
+def adam7_png(array: np.ndarray) -> bytes:
+    """An 8-bit RGB PNG of ``array`` (H, W, 3) with Adam7 interlacing (filter 0 on every row)."""
+    import struct
+    import zlib
+
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+
+    height, width = array.shape[:2]
+    passes = [(0, 0, 8, 8), (4, 0, 8, 8), (0, 4, 4, 8), (2, 0, 4, 4), (0, 2, 2, 4), (1, 0, 2, 2), (0, 1, 1, 2)]
+    raw = b"".join(b"\0" + row.tobytes() for x0, y0, dx, dy in passes
+                   for row in array[y0::dy, x0::dx] if row.size)
+    header = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 1)
+    return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b"")

@@ -177,20 +177,23 @@ def crease_difference(texture: PackedTexture, tables: CreaseTables, rows: np.nda
     weights = bilinear_weights(st)  # (M, 4) or (q, M, 4)
     exact = weights @ tables.uv[rows]  # (q, M, 2)
     reference = texture.sample(exact.reshape(-1, 2))
+    reference = reference.reshape(*exact.shape[:2], -1)  # (q, M, C)
     worst = np.zeros(exact.shape[:2])
     diagonals = tables.diagonals[rows]
     for diagonal, ((bary_first, uv_first), (bary_second, uv_second)) in tables.triangles.items():
-        picked = np.flatnonzero((diagonals == diagonal) | (diagonals == BOTH_DIAGONALS))
-        if not len(picked):
+        reads = (diagonals == diagonal) | (diagonals == BOTH_DIAGONALS)
+        if reads.all():  # every quad (the default reads both diagonals): no copies of the points
+            picked, own, per_quad = slice(None), rows, weights
+        elif reads.any():
+            picked = np.flatnonzero(reads)
+            own, per_quad = rows[picked], weights if weights.ndim == 2 else weights[picked]
+        else:
             continue
-        own = rows[picked]
-        split = split_uv(weights if weights.ndim == 2 else weights[picked], bary_first[own], bary_second[own],
-                         uv_first[own], uv_second[own])
+        split = split_uv(per_quad, bary_first[own], bary_second[own], uv_first[own], uv_second[own])
         split = np.where(np.isnan(split), exact[picked], split)  # both triangles degenerate: nothing measured
         seen = texture.sample(split.reshape(-1, 2))
-        difference = channel_difference(seen, reference.reshape(len(rows), -1, reference.shape[-1])[picked]
-                                        .reshape(-1, reference.shape[-1]), normal_map)
-        worst[picked] = np.maximum(worst[picked], difference.reshape(len(picked), -1))
+        difference = channel_difference(seen, reference[picked].reshape(len(seen), -1), normal_map)
+        worst[picked] = np.maximum(worst[picked], difference.reshape(len(own), -1))
     return worst
 
 
