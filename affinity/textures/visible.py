@@ -53,7 +53,7 @@ MAX_CELL_SAMPLES = 32
 #: out: C is then known to within it (the values are meant to be right to one step).
 TOLERANCE = 0.5
 #: Sample points evaluated together (each costs three bilinear lookups).
-POINTS_PER_CHUNK = 1 << 17
+POINTS_PER_CHUNK = 1 << 15
 
 
 def grid(n: int) -> np.ndarray:
