@@ -86,12 +86,15 @@ class DecodedTexture:
         Whole four-byte texels are subtracted: contiguous, and no reduction per texel."""
         texels = self.texels
         rows = texels[start:stop]
-        if axis == 1:
-            neighbours = np.concatenate([rows[:, 1:], rows[:, :1]], axis=1)  # the last column wraps to the first
-        else:
-            neighbours = np.concatenate([texels[start + 1:stop], texels[stop % len(texels)][None]])
-        steps = np.maximum(rows, neighbours)
-        steps -= np.minimum(rows, neighbours)  # |a - b| in uint8
+        steps = np.empty_like(rows)
+        if axis == 1:  # the last column wraps to the first
+            pairs = ((rows[:, :-1], rows[:, 1:], steps[:, :-1]), (rows[:, -1:], rows[:, :1], steps[:, -1:]))
+        else:  # the last row wraps to the first
+            pairs = ((rows[:-1], texels[start + 1:stop], steps[:-1]),
+                     (rows[-1:], texels[stop % len(texels)][None], steps[-1:]))
+        for texel, neighbour, out in pairs:  # |a - b| in uint8, no copy of the neighbours
+            np.maximum(texel, neighbour, out=out)
+            out -= np.minimum(texel, neighbour)
         return steps
 
     def _largest_step(self, steps: np.ndarray) -> np.ndarray:
