@@ -380,7 +380,7 @@ def visible_values(texture, xy: np.ndarray, uv: np.ndarray, diagonals: np.ndarra
         quads = quads[values[quads] < limits.error]
         # Cells whose texels cannot differ by more than the quad's best so far are left out.
         surviving = []
-        for part in _chunks(len(quads), len(origins) * 16):
+        for part in _chunks(len(quads), len(origins) * 4):  # a cell's bound costs about four sample points
             rows = quads[part]
             low, high, shifts = cell_boxes(tables, rows, corners, width, height)
             bound = crease_bound(texture, low.reshape(-1, 2), high.reshape(-1, 2), shifts.reshape(-1, 2),
