@@ -143,7 +143,12 @@ def channel_difference(a: np.ndarray, b: np.ndarray, normal_map: bool) -> np.nda
     uint8 texture (0-255 units), in 1/255 steps; for a normal map the angle between the decoded normals
     (2 c / 255 - 1 per channel, first three channels), in degrees."""
     if not normal_map:
-        return -_smallest(-np.abs(a - b)).astype(np.float64)
+        difference = np.subtract(a, b)
+        np.abs(difference, out=difference)
+        largest = difference[:, 0].copy()
+        for channel in range(1, difference.shape[1]):  # elementwise: faster than a reduction over a short axis
+            np.maximum(largest, difference[:, channel], out=largest)
+        return largest.astype(np.float64)
     n_a, n_b = a[:, :3].astype(np.float64) / 127.5 - 1.0, b[:, :3].astype(np.float64) / 127.5 - 1.0
     sine = np.linalg.norm(np.cross(n_a, n_b), axis=1)
     return np.degrees(np.arctan2(sine, np.einsum("ij,ij->i", n_a, n_b)))
@@ -190,7 +195,9 @@ def crease_difference(texture: PackedTexture, tables: CreaseTables, rows: np.nda
         else:
             continue
         split = split_uv(per_quad, bary_first[own], bary_second[own], uv_first[own], uv_second[own])
-        split = np.where(np.isnan(split), exact[picked], split)  # both triangles degenerate: nothing measured
+        unheld = np.isnan(split)
+        if unheld.any():  # both triangles degenerate: nothing measured
+            split = np.where(unheld, exact[picked], split)
         seen = texture.sample(split.reshape(-1, 2))
         difference = channel_difference(seen, reference[picked].reshape(len(seen), -1), normal_map)
         worst[picked] = np.maximum(worst[picked], difference.reshape(len(own), -1))
