@@ -281,9 +281,13 @@ def crease_bound(texture, low_corner: np.ndarray, high_corner: np.ndarray, shift
     with np.errstate(invalid="ignore"):
         bound = range_bound(low, high, normal_map)
         if not normal_map:
-            (_, across_columns), (_, across_rows) = (box_extremes(slopes, low_corner, high_corner)
+            # A box whose texels are all alike is bounded by 0 whatever its steps (finite shifts): only the
+            # others read the step pyramids (a flat texture, or a checker's flat squares, reduce none of them).
+            rows = np.flatnonzero(~((bound == 0) & np.isfinite(shifts).all(axis=1)))
+            (_, across_columns), (_, across_rows) = (box_extremes(slopes, low_corner[rows], high_corner[rows])
                                                      for slopes in texture.slopes)
-            bound = np.minimum(bound, across_columns[:, 0] * shifts[:, 0] + across_rows[:, 0] * shifts[:, 1])
+            bound[rows] = np.minimum(bound[rows], across_columns[:, 0] * shifts[rows, 0]
+                                     + across_rows[:, 0] * shifts[rows, 1])
     bound[~np.isfinite(low).all(axis=1)] = np.nan
     return bound
 
