@@ -121,8 +121,12 @@ class RangePyramid:
     a level whose blocks are taller), straight from the rows of level 0 they cover, when a query
     first reaches them: boxes over a small part of a texture reduce only that part, and a
     block's values do not depend on which bands were built (one pass over the image answers
-    a box spanning it). Memory: at most two pyramids of about 1/3 of the image each (uint8 like the image); with
-    ``minima=False`` the maxima only (the minima :meth:`channel_bounds` gives are then 0).
+    a box spanning it).
+
+    Memory, allocated up front but touched only where bands are built: two pyramids of about
+    1/3 of the image each above level 0 (uint8 like the image); with ``minima=False`` the maxima
+    only (the minima :meth:`channel_bounds` gives are then 0); level 0 itself when it is
+    computed by ``rows``.
 
     Parameters
     ----------
