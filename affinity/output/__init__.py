@@ -319,13 +319,14 @@ def _visible_fields(hits: RuleHits, take: np.ndarray, path: str) -> list[dict]:
 
     columns = hits.visible
     folder = os.path.dirname(os.path.abspath(path))
+    relative = [os.path.relpath(os.path.abspath(texture), folder) for texture in columns.textures]  # once each
     rows = []
     for shift, bound, pick in zip(columns.shifts[take].tolist(), columns.bounds[take].tolist(),
                                   columns.picks[take].tolist()):
         if pick < 0 or shift != shift:  # no texture read (NaN shift)
             rows.append({})
             continue
-        texture = os.path.relpath(os.path.abspath(columns.textures[pick]), folder)
+        texture = relative[pick]
         rows.append({"threshold": columns.limits[1], "unit": columns.units[pick], "shift": shift,
                      "bound": BOUND_NAMES.get(bound), "texture": texture, "role": columns.roles[pick],
                      "remark": visible_remark(columns.roles[pick], texture, shift)})
