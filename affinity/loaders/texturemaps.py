@@ -33,7 +33,9 @@ class TextureMap:
     path : the file, resolved (it may hold a UDIM token)
     name : the file as the material spells it
     source : what names it, for messages: ``"map_Kd"``, ``"UsdUVTexture /Looks/Wood/Tex"``
-    scale, offset : the texture is read at ``uv * scale + offset`` (MTL ``-s``/``-o``)
+    scale, offset, rotation : the texture is read at ``R(rotation) (uv * scale) + offset``, R a rotation by
+        ``rotation`` degrees counter-clockwise (MTL ``-s``/``-o``; MaterialX ``uvtiling``/``uvoffset``; USD
+        ``UsdTransform2d``: scale, then rotate, then translate)
     """
 
     role: str | None
@@ -42,16 +44,26 @@ class TextureMap:
     source: str
     scale: tuple[float, float] = (1.0, 1.0)
     offset: tuple[float, float] = (0.0, 0.0)
+    rotation: float = 0.0
 
     @property
     def udim(self) -> bool:
         return any(token in self.path for token in _UDIM_TOKENS)
 
     def texture_uv(self, uv: np.ndarray) -> np.ndarray:
-        """(..., 2) float64: where the texture is read for mesh uv ``uv`` (..., 2)."""
-        if self.scale == (1.0, 1.0) and self.offset == (0.0, 0.0):
+        """(..., 2) float64: where the texture is read for mesh uv ``uv`` (..., 2).
+
+        >>> TextureMap(role="base colour", path="t.png", name="t.png", source="UsdUVTexture", scale=(2.0, 0.5),
+        ...            rotation=90.0, offset=(0.25, 0.1)).texture_uv(np.array([0.1, 0.2])).round(12).tolist()
+        [0.15, 0.3]
+        """
+        if self.scale == (1.0, 1.0) and self.offset == (0.0, 0.0) and self.rotation == 0.0:
             return uv
-        return uv * np.asarray(self.scale) + np.asarray(self.offset)
+        uv = uv * np.asarray(self.scale)
+        if self.rotation:
+            cosine, sine = np.cos(np.radians(self.rotation)), np.sin(np.radians(self.rotation))
+            uv = np.stack([cosine * uv[..., 0] - sine * uv[..., 1], sine * uv[..., 0] + cosine * uv[..., 1]], axis=-1)
+        return uv + np.asarray(self.offset)
 
 
 def udim_tiles(path: str) -> dict[int, str]:

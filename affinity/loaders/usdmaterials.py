@@ -54,7 +54,8 @@ def preview_surface_maps(material, uv_primvar: str) -> list[TextureMap]:
     maps = []
     for shader_input in shader.GetInputs():
         for texture in _upstream_textures(shader_input):
-            if _primvar_read(texture) not in (None, uv_primvar):
+            varname, transform = _st_source(texture)
+            if varname not in (None, uv_primvar):
                 continue  # the texture reads another uv set
             file_input = texture.GetInput("file")
             asset = file_input.Get() if file_input else None
@@ -62,7 +63,7 @@ def preview_surface_maps(material, uv_primvar: str) -> list[TextureMap]:
                 continue
             maps.append(TextureMap(role=ROLE_OF_INPUT.get(shader_input.GetBaseName(), "scalar"),
                                    path=_resolved(file_input.GetAttr(), asset), name=asset.path,
-                                   source=f"UsdUVTexture {texture.GetPath()}"))
+                                   source=f"UsdUVTexture {texture.GetPath()}", **transform))
     return maps
 
 
@@ -78,20 +79,42 @@ def _upstream_textures(shader_input) -> list:
     return found
 
 
-def _primvar_read(texture) -> str | None:
-    """The primvar a ``UsdUVTexture``'s ``st`` is read from (its primvar reader's ``varname``), None when
-    unconnected."""
+def _st_source(texture) -> tuple[str | None, dict]:
+    """The primvar a ``UsdUVTexture``'s ``st`` is read from (its primvar reader's ``varname``; None when
+    unconnected) and the ``UsdTransform2d`` between them as :class:`TextureMap` fields (``scale``,
+    ``rotation``, ``offset``; none when there is no transform)."""
+    transform: dict = {}
+    shader = _connected_shader(texture.GetInput("st"))
+    if shader is not None and shader.GetIdAttr().Get() == "UsdTransform2d":
+        # UsdPreviewSurface: result = rotate(in * scale, rotation degrees) + translation.
+        scale, rotation, translation = (_input_value(shader, name) for name in ("scale", "rotation", "translation"))
+        transform = {"scale": (1.0, 1.0) if scale is None else (float(scale[0]), float(scale[1])),
+                     "rotation": 0.0 if rotation is None else float(rotation),
+                     "offset": (0.0, 0.0) if translation is None else (float(translation[0]), float(translation[1]))}
+        shader = _connected_shader(shader.GetInput("in"))
+    varname = shader.GetInput("varname") if shader is not None else None
+    if not varname or varname.Get() is None:
+        return None, transform
+    return str(varname.Get()), transform
+
+
+def _connected_shader(shader_input):
+    """The shader an input is connected to (the first source), None when unconnected."""
     from pxr import UsdShade
 
-    st = texture.GetInput("st")
-    if not st:
+    if not shader_input:
         return None
-    for info in st.GetConnectedSources()[0]:
-        reader = UsdShade.Shader(info.source.GetPrim())
-        varname = reader.GetInput("varname") if reader else None
-        if varname and varname.Get() is not None:
-            return str(varname.Get())
+    for info in shader_input.GetConnectedSources()[0]:
+        shader = UsdShade.Shader(info.source.GetPrim())
+        if shader:
+            return shader
     return None
+
+
+def _input_value(shader, name: str):
+    """The authored value of a shader input, None when it has none (the input's fallback then holds)."""
+    shader_input = shader.GetInput(name)
+    return shader_input.Get() if shader_input else None
 
 
 def _resolved(attribute, asset) -> str:

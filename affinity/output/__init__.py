@@ -23,8 +23,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..findings import FileReport, RuleHits
-from ..rules import LEVELS, RULES, number_text, number_texts, with_unit
+from ..rules import LEVELS, RULES, number_spec, number_text, with_unit
 from ..settings import Settings
+from . import rows
 from .names import printable
 
 if TYPE_CHECKING:
@@ -156,19 +157,28 @@ def finding_dict(f: Finding) -> dict:
             if (value := getattr(f, name)) is not None or name not in OPTIONAL_FIELDS}
 
 
+def _listed(array: str) -> cached_property:
+    """A :class:`Columns` attribute: its array ``array`` as a list, made on first use."""
+    return cached_property(lambda columns: getattr(columns, array).tolist())
+
+
 @dataclass(eq=False)
 class Columns:
     """Findings of one rule in one file as columns, for the formats that write many rows at once.
 
     ``path``, ``code``, ``name``, ``unit`` and ``threshold`` (None for rules
     without one: Q204, Q205, Q302 measure something else) are shared; the rest
-    are lists of n, one entry a finding: ``line``, ``column``, ``face`` (within
-    its prim in USD), ``value``, ``level``, ``group``, ``message`` (the rule's
-    summary, with the finding's detail) and ``prim`` (None outside USD and for
-    file-level findings). ``shared`` is None unless some of the findings lie on
-    geometry several prims reference: then one dict (the :data:`SHARED_FIELDS`) or
-    None a finding. ``visible`` is None unless Q101's visible reading read C for
-    some: then one dict a finding, empty where C was not read, else the
+    hold one entry a finding: the arrays ``lines`` (n,) int64, ``columns`` (n,)
+    int64, ``faces`` (n,) int64 (within its prim in USD), ``values`` (n,) float64
+    and ``level_ranks`` (n,) int8 (0 ``error``), for formats that convert a
+    column at a time; as lists (:attr:`line`, :attr:`column`, :attr:`face`,
+    :attr:`value`, :attr:`level`, made on first use) for those that write a
+    finding at a time; and the lists ``group``, ``message`` (the rule's summary,
+    with the finding's detail) and ``prim`` (None outside USD and for file-level
+    findings). ``shared`` is None unless some of the findings lie on geometry
+    several prims reference: then one dict (the :data:`SHARED_FIELDS`) or None a
+    finding. ``visible`` is None unless Q101's visible reading read C for some:
+    then one dict a finding, empty where C was not read, else the
     :data:`VISIBLE_FIELDS` and the ``threshold`` and ``unit`` of C (the shared
     ones are the texel reading's).
     """
@@ -178,11 +188,11 @@ class Columns:
     name: str
     unit: str
     threshold: float | None
-    line: list[int]
-    column: list[int]
-    face: list[int]
-    value: list[float]
-    level: list[str]
+    lines: np.ndarray
+    columns: np.ndarray
+    faces: np.ndarray
+    values: np.ndarray
+    level_ranks: np.ndarray
     group: list[str]
     message: list[str]
     prim: list[str | None]
@@ -190,18 +200,37 @@ class Columns:
     visible: list[dict] | None = None
 
     def __len__(self) -> int:
-        return len(self.face)
+        return len(self.faces)
+
+    line = _listed("lines")
+    column = _listed("columns")
+    face = _listed("faces")
+    value = _listed("values")
 
     @cached_property
-    def number_texts(self) -> tuple[list[str], list[str], list[str]]:
-        """``line``, ``column`` and ``face`` as text, (n,) str each, converted a column at a time (once for the
-        formats that write a number twice)."""
-        return int_texts(self.line), int_texts(self.column), int_texts(self.face)
+    def level(self) -> list[str]:
+        return np.asarray(LEVELS)[self.level_ranks].tolist()
+
+    @cached_property
+    def line_digits(self) -> np.ndarray:
+        """``lines`` as text (:func:`.rows.integers`), converted once for the formats that write them twice."""
+        return rows.integers(self.lines)
+
+    @cached_property
+    def face_digits(self) -> np.ndarray:
+        """``faces`` as text (:func:`.rows.integers`), converted once for the formats that write them twice."""
+        return rows.integers(self.faces)
 
     @property
     def plain(self) -> bool:
         """Whether every finding has the shared unit and threshold and no USD sharing (the fast formats' case)."""
         return self.shared is None and self.visible is None
+
+    @property
+    def on_faces(self) -> bool:
+        """Whether these are plain measured findings on mesh faces, outside USD (the rows whose every text
+        is shared or a number: written a column at a time)."""
+        return bool(self.plain and self.unit and self.prim[0] is None and self.faces.min(initial=0) >= 0)
 
     def findings(self) -> list[Finding]:
         shared = self.shared or [None] * len(self)
@@ -218,9 +247,10 @@ class Columns:
         """One finding as columns."""
         where = shared_fields(f)
         read = {name: getattr(f, name) for name in VISIBLE_FIELDS} if f.shift is not None else None
-        return cls(f.path, f.code, f.name, f.unit, f.threshold, [f.line], [f.column], [f.face], [f.value], [f.level],
-                   [f.group], [f.message], [f.prim], None if where is None else [where],
-                   None if read is None else [read])
+        return cls(f.path, f.code, f.name, f.unit, f.threshold, np.array([f.line]), np.array([f.column]),
+                   np.array([f.face]), np.array([f.value], dtype=float),
+                   np.array([LEVELS.index(f.level)], dtype=np.int8), [f.group], [f.message], [f.prim],
+                   None if where is None else [where], None if read is None else [read])
 
 
 def writer(name: str):
@@ -233,8 +263,9 @@ def group_name(report: FileReport, index: int) -> str:
     return report.group_names[index] if 0 <= index < len(report.group_names) else ""
 
 
-def columns(report: FileReport, hits: RuleHits, take: np.ndarray) -> Columns:
-    """The findings ``take`` (k,) int64 of ``hits`` as :class:`Columns`."""
+def columns(report: FileReport, hits: RuleHits, take: np.ndarray, ranks: np.ndarray | None = None) -> Columns:
+    """The findings ``take`` (k,) int64 of ``hits`` as :class:`Columns`; ``ranks`` (n,) int8 is
+    ``hits.level_ranks()`` where a caller taking many blocks has it already."""
     rule = RULES[hits.code]
     faces, groups, lines = hits.faces[take], hits.groups[take], hits.lines[take]
     usd = report.prim_face_start is not None
@@ -255,8 +286,8 @@ def columns(report: FileReport, hits: RuleHits, take: np.ndarray) -> Columns:
         path=report.path, code=hits.code, name=rule.name,
         unit=hits.unit if hits.unit is not None else rule.unit,
         threshold=None if rule.default_threshold is None else hits.threshold,
-        line=lines.tolist(), column=(lines > 0).astype(np.int64).tolist(), face=faces.tolist(),
-        value=hits.values[take].tolist(), level=hits.levels()[take].tolist(), group=group, message=message, prim=prim,
+        lines=lines, columns=(lines > 0).astype(np.int64), faces=faces, values=hits.values[take],
+        level_ranks=(hits.level_ranks() if ranks is None else ranks)[take], group=group, message=message, prim=prim,
         shared=shared, visible=visible if visible is not None and any(visible) else None,
     )
 
@@ -288,13 +319,14 @@ def _visible_fields(hits: RuleHits, take: np.ndarray, path: str) -> list[dict]:
 
     columns = hits.visible
     folder = os.path.dirname(os.path.abspath(path))
+    relative = [os.path.relpath(os.path.abspath(texture), folder) for texture in columns.textures]  # once each
     rows = []
     for shift, bound, pick in zip(columns.shifts[take].tolist(), columns.bounds[take].tolist(),
                                   columns.picks[take].tolist()):
         if pick < 0 or shift != shift:  # no texture read (NaN shift)
             rows.append({})
             continue
-        texture = os.path.relpath(os.path.abspath(columns.textures[pick]), folder)
+        texture = relative[pick]
         rows.append({"threshold": columns.limits[1], "unit": columns.units[pick], "shift": shift,
                      "bound": BOUND_NAMES.get(bound), "texture": texture, "role": columns.roles[pick],
                      "remark": visible_remark(columns.roles[pick], texture, shift)})
@@ -355,30 +387,60 @@ class Selection:
         """The findings at ``positions`` (k,) of the order, in that order."""
         return Selection(self.report, self.parts, self.order[positions], self.omitted)
 
-    def formatted(self, format_rows, block: int = 16384, along: np.ndarray | None = None) -> Iterator[list]:
-        """``format_rows(columns) -> list`` (one entry a finding, :class:`Columns`) over the findings, yielded
-        in order, ``block`` at a time (a format's rows of a big file are never all held at once). With
-        ``along`` (n,), values in the selection's order, ``format_rows(columns, values)`` gets those of its rows."""
+    def _blocks(self, block: int, along: np.ndarray | None):
+        """The findings in order, ``block`` at a time (a format's rows of a big file are never all held at
+        once): per block its size and, per rule in it, the positions (k,) int64 of its rows in the block, their
+        :class:`Columns` and their values of ``along`` (n,) (None without)."""
         starts = np.cumsum([0] + [len(take) for _, take in self.parts])
+        ranks = [hits.level_ranks() for hits, _ in self.parts]
         for begin in range(0, len(self.order), block):
             index = self.order[begin : begin + block]
             part = np.searchsorted(starts, index, side="right") - 1
             present = np.flatnonzero(np.bincount(part, minlength=len(self.parts))).tolist()
-            out = None if len(present) == 1 else np.empty(len(index), dtype=object)
+            rules = []
             for p in present:
                 where = np.flatnonzero(part == p)
                 hits, take = self.parts[p]
-                found = columns(self.report, hits, take[index[where] - starts[p]])
-                rows = format_rows(found) if along is None else format_rows(found, along[begin + where])
-                if out is None:  # one rule in the block: its rows are the block, in order
-                    yield rows
-                else:
-                    out[where] = np.fromiter(rows, dtype=object, count=len(where))
-            if out is not None:
-                yield out.tolist()
+                rules.append((where, columns(self.report, hits, take[index[where] - starts[p]], ranks[p]),
+                              None if along is None else along[begin + where]))
+            yield len(index), rules
+
+    def formatted(self, format_rows, block: int = 16384, along: np.ndarray | None = None) -> Iterator[list]:
+        """``format_rows(columns) -> list`` (one entry a finding, :class:`Columns`) over the findings, yielded
+        in order, ``block`` at a time. With ``along`` (n,), values in the selection's order,
+        ``format_rows(columns, values)`` gets those of its rows."""
+        for n, rules in self._blocks(block, along):
+            made = [format_rows(c) if values is None else format_rows(c, values) for _, c, values in rules]
+            yield made[0] if len(made) == 1 else _interleaved(n, [where for where, _, _ in rules], made)
+
+    def written(self, format_rows, block: int = 4096, along: np.ndarray | None = None) -> Iterator[str]:
+        """The text of ``format_rows(columns)`` over the findings, in order, a block at a time (``along`` as in
+        :meth:`formatted`). ``format_rows`` gives its rows whole, separators included: as a grid
+        (:func:`.rows.grid`), or as a list of texts (findings whose rows take other shapes)."""
+        for n, rules in self._blocks(block, along):
+            made = [format_rows(c) if values is None else format_rows(c, values) for _, c, values in rules]
+            places = [where for where, _, _ in rules]
+            if len(made) == 1:
+                yield "".join(made[0]) if isinstance(made[0], list) else rows.text(made[0])
+            elif all(isinstance(grid, np.ndarray) for grid in made):
+                together = np.zeros((n, max(grid.shape[1] for grid in made)), dtype=np.uint8)
+                for where, grid in zip(places, made):
+                    together[where, : grid.shape[1]] = grid
+                yield rows.text(together)
+            else:  # rare: grids beside rows of other shapes (a USD prim's shared geometry), one row at a time
+                yield "".join(_interleaved(n, places, [made_rows if isinstance(made_rows, list) else
+                                                       [rows.text(row) for row in made_rows] for made_rows in made]))
 
     def findings(self) -> list[Finding]:
-        return [f for rows in self.formatted(Columns.findings) for f in rows]
+        return [f for block in self.formatted(Columns.findings) for f in block]
+
+
+def _interleaved(n: int, places: list[np.ndarray], made: list[list]) -> list:
+    """The ``n`` rows of a block from each rule's ``made`` rows, which go at its ``places`` (k,) int64."""
+    out = np.empty(n, dtype=object)
+    for where, made_rows in zip(places, made):
+        out[where] = np.fromiter(made_rows, dtype=object, count=len(where))
+    return out.tolist()
 
 
 def select(report: FileReport, limit: int | None = None, order: str = "file") -> Selection:
@@ -459,7 +521,7 @@ def rule_counts(reports: list[FileReport]) -> dict[str, int]:
     return {code: n for code, n in counts.items() if n}
 
 
-def _measured(c: Columns) -> tuple[str, str]:
+def measurement_suffixes(c: Columns) -> tuple[str, str]:
     """What follows a value in a description: its unit (``" texels"``, ``"/255"``) where there is no threshold,
     else ``" vs 0.5 texels"``."""
     unit = with_unit("", c.unit)  # what follows the number: " texels", "/255"
@@ -476,8 +538,8 @@ def descriptions(c: Columns) -> list[str]:
     if not c.unit:
         return list(c.message)
     if c.visible is None:
-        unit, against = _measured(c)
-        return [f"{m} ({v}{unit}{against})" for m, v in zip(c.message, number_texts(c.value))]
+        unit, against = measurement_suffixes(c)
+        return [f"{m} ({number_text(v)}{unit}{against})" for m, v in zip(c.message, c.value)]
     return [_described(m, v, read.get("bound"), read.get("threshold", c.threshold), read.get("unit", c.unit))
             for m, v, read in zip(c.message, c.value, c.visible)]
 
@@ -501,12 +563,18 @@ def face_label(f: Finding) -> str:
     return f"face {f.face}" if f.prim is None else f"{f.prim} face {f.face}"
 
 
+def text_rows(c: Columns) -> np.ndarray | list[str]:
+    """The text lines of ``c``, each ended by a newline: a grid of rows (:func:`.rows.grid`) for findings on
+    faces (:attr:`Columns.on_faces`), else a list (:func:`text_lines`)."""
+    if c.on_faces:
+        return rows.grid([*face_line_pieces(c), b"\n"], len(c))
+    return [line + "\n" for line in text_lines(c)]
+
+
 def text_lines(c: Columns) -> list[str]:
     """The ruff-style lines ``path:line:col: CODE level name: message (value vs threshold unit) [face F]``
-    (design.md); ``path:prim:face N: CODE level ...`` in USD; no ``[face]`` for file-level findings."""
-    lines = face_lines(c)
-    if lines is not None:
-        return lines
+    (design.md); ``path:prim:face N: CODE level ...`` in USD; no ``[face]`` for file-level findings. A finding
+    at a time: :func:`face_line_pieces` writes the lines of findings on faces a column at a time."""
     path, code, name = printable(c.path), c.code, c.name
     described = descriptions(c)
     where = [""] * len(c) if c.shared is None else [authored_where(s) for s in c.shared]
@@ -518,25 +586,27 @@ def text_lines(c: Columns) -> list[str]:
     ]
 
 
-def face_lines(c: Columns, escape=str) -> list[str] | None:
-    """The text lines of measured findings on mesh faces, their texts (path, name, unit, messages) passed
-    through ``escape`` (XML for JUnit); None for findings whose lines take another shape (read through a
-    texture, in USD, file-level, without a unit). The numbers are converted a column at a time."""
-    if not (c.unit and c.visible is None and c.prim[0] is None and min(c.face, default=0) >= 0):
-        return None
-    unit, against = _measured(c)
-    path, code, name, measured = escape(printable(c.path)), c.code, escape(c.name), escape(unit + against)
-    escaped = {message: escape(message) for message in set(c.message)}
-    return [f"{path}:{line}:{column}: {code} {level} {name}: {escaped[message]} ({value}{measured}) [face {face}]"
-            for line, column, level, message, value, face in zip(
-                *c.number_texts[:2], c.level, c.message, number_texts(c.value), c.number_texts[2])]
+def face_line_pieces(c: Columns, escape=str) -> list[rows.Piece]:
+    """The pieces (:mod:`.rows`) of the text lines of findings on faces (:attr:`Columns.on_faces`), without
+    line ends, their texts (path, name, unit, messages) passed through ``escape`` (XML for JUnit); each
+    number column converted at once, each distinct text encoded once."""
+    unit, against = measurement_suffixes(c)
+    which, messages = distinct(c.message)
+    return [f"{escape(printable(c.path))}:".encode(), c.line_digits, b":", rows.integers(c.columns),
+            f": {c.code} ".encode(), rows.choice(c.level_ranks, LEVELS), f" {escape(c.name)}: ".encode(),
+            rows.choice(which, [escape(m) for m in messages]), b" (", rows.floats(c.value, number_spec()),
+            f"{escape(unit + against)}) [face ".encode(), c.face_digits, b"]"]
 
 
-def int_texts(numbers: list[int]) -> list[str]:
-    """(n,) ``str`` of each int, converted in one call (a list's text, split)."""
-    if numbers and numbers.count(numbers[0]) == len(numbers):  # one number (a column of 1s): one conversion
-        return [str(numbers[0])] * len(numbers)
-    return str(numbers)[1:-1].split(", ") if numbers else []
+def distinct(entries: list) -> tuple[np.ndarray, list]:
+    """(n,) intp: the index of each of ``entries`` (texts, or tuples of them) into the distinct entries (in
+    order of first appearance), and those entries. One entry throughout (a rule's summary) takes no look-up a
+    row."""
+    if not entries or entries.count(entries[0]) == len(entries):
+        return np.zeros(len(entries), dtype=np.intp), entries[:1]
+    unique = list(dict.fromkeys(entries))
+    lookup = {entry: i for i, entry in enumerate(unique)}
+    return np.fromiter(map(lookup.__getitem__, entries), dtype=np.intp, count=len(entries)), unique
 
 
 def authored_where(shared: dict | None) -> str:
@@ -563,7 +633,7 @@ def working_relative(path: str) -> str | None:
 
 
 #: The format of :func:`value_token`, for formatting many values at once.
-VALUE_TOKEN = "{:.6g}"
+VALUE_TOKEN = "%.6g"
 
 
 def value_token(value: float) -> str:
@@ -573,5 +643,5 @@ def value_token(value: float) -> str:
     this token (with rule, file and group) identifies a finding across face
     reordering and edits elsewhere in the file (baseline, SARIF fingerprints).
     """
-    return VALUE_TOKEN.format(value)
+    return VALUE_TOKEN % value
 

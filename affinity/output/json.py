@@ -52,11 +52,23 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import math
 from typing import TextIO
 
+import numpy as np
+
 from ..findings import FileReport
-from . import CheckRun, Columns, finding_dict, level_counts, rule_counts, statistics, truncation
+from ..rules import LEVELS
+from . import (
+    CheckRun,
+    Columns,
+    distinct,
+    finding_dict,
+    level_counts,
+    rows,
+    rule_counts,
+    statistics,
+    truncation,
+)
 
 SCHEMA = "quad-affinity-check"
 VERSION = 1
@@ -74,47 +86,44 @@ def _file_entry(report: FileReport) -> dict:
 
 
 def _finding_rows(settings):
-    """The JSON text of each finding of a :class:`Columns`, written from per-rule pieces encoded once (the
-    keys of :class:`Finding`, in its order, then ``measure``)."""
+    """The JSON text of each finding of a :class:`Columns`, each after a comma: a grid of rows
+    (:mod:`.rows`) laid out from per-rule pieces encoded once (the keys of :class:`Finding`, in its order,
+    then ``measure``); whole findings encoded one by one where several prims share geometry or a value was
+    read through a texture."""
 
-    def rows(c: Columns) -> list[str]:
+    def finding_rows(c: Columns) -> np.ndarray | list[str]:
         encode = json.dumps
-        if not c.plain:  # geometry several prims reference, values read through a texture: whole findings
-            extra = {} if (measure := settings.measure_of(c.code)) is None else {"measure": measure}
-            return [encode({**finding_dict(f), **extra}, separators=(",", ":")) for f in c.findings()]
-        head = f'{{"path":{encode(c.path)},"line":'.replace("%", "%%")
-        rule = f',"code":{encode(c.code)},"name":{encode(c.name)},"face":'.replace("%", "%%")
-        unit = f',"threshold":{encode(c.threshold)},"unit":{encode(c.unit)},"level":"'
         measure = settings.measure_of(c.code)
-        tail = "}" if measure is None else f',"measure":{encode(measure)}}}'
-        ends = _ends(c, unit, tail)
-        # One '%'-format a row, the constant parts joined in the template; the values' repr is json's.
-        if set(c.column) == {1} and math.isfinite(sum(c.value)):  # faces on source lines, finite values
-            template = f'{head}%d,"column":1{rule}%d,"value":%r%s'
-            return [template % row for row in zip(c.line, c.face, c.value, ends)]
-        template = f'{head}%d,"column":%d{rule}%d,"value":%s%s'
-        return [template % row for row in zip(c.line, c.column, c.face, map(encode, c.value), ends)]
+        if not c.plain:
+            extra = {} if measure is None else {"measure": measure}
+            return ["," + encode({**finding_dict(f), **extra}, separators=(",", ":")) for f in c.findings()]
+        which, ends = _ends(c, f',"threshold":{encode(c.threshold)},"unit":{encode(c.unit)},"level":"',
+                            "}" if measure is None else f',"measure":{encode(measure)}}}')
+        return rows.grid([f',{{"path":{encode(c.path)},"line":'.encode(), rows.integers(c.lines), b',"column":',
+                          rows.integers(c.columns),
+                          f',"code":{encode(c.code)},"name":{encode(c.name)},"face":'.encode(),
+                          c.face_digits, b',"value":', json_values(c), rows.choice(which, ends)], len(c))
 
-    return rows
+    return finding_rows
 
 
-def _ends(c: Columns, unit: str, tail: str) -> list[str]:
-    """Each finding's JSON from its threshold to its end: a few texts (level, group, message, prim), each
-    encoded once; the rows whose group, message or prim differ from the first row's looked up one by one."""
-    first = (c.group[0], c.message[0], c.prim[0])
-    by_level = {level: unit + _after_level(level, *first) + tail for level in set(c.level)}
-    ends = list(map(by_level.__getitem__, c.level))
-    differ = set()
-    for column, common in zip((c.group, c.message, c.prim), first):
-        if column.count(common) != len(column):
-            differ.update(row for row, text in enumerate(column) if text != common)
-    known: dict[tuple, str] = {}
-    for row in sorted(differ):
-        key = (c.level[row], c.group[row], c.message[row], c.prim[row])
-        if key not in known:
-            known[key] = unit + _after_level(*key) + tail
-        ends[row] = known[key]
-    return ends
+def json_values(c: Columns) -> np.ndarray:
+    """(n, w) uint8: the values as JSON text (:func:`.rows.formatted`): a finite float as repr writes it, as
+    ``json`` does; NaN and the infinities as ``NaN``, ``Infinity``, ``-Infinity``."""
+    if np.isfinite(c.values).all():
+        return rows.floats(c.value, "%r")
+    return rows.formatted(list(map(json.dumps, c.value)), "%s")
+
+
+def _ends(c: Columns, unit: str, tail: str) -> tuple[np.ndarray, list[str]]:
+    """Each finding's JSON from its threshold to its end, as (n,) intp indices into the distinct ends: a few
+    texts (level, group, message, prim), each encoded once."""
+    texts = (c.group, c.message, c.prim)
+    if all(column.count(column[0]) == len(column) for column in texts):  # one group, message, prim: by level
+        which, keys = c.level_ranks, [(rank, *(column[0] for column in texts)) for rank in range(len(LEVELS))]
+    else:
+        which, keys = distinct(list(zip(c.level_ranks.tolist(), *texts)))
+    return which, [unit + _after_level(LEVELS[rank], *rest) + tail for rank, *rest in keys]
 
 
 def _after_level(level: str, group: str, message: str, prim: str | None) -> str:
@@ -136,11 +145,11 @@ def write(run: CheckRun, out: TextIO) -> None:
     head = {"schema": SCHEMA, "version": VERSION, "settings": dataclasses.asdict(run.settings),
             "files": [_file_entry(r) for r in run.reports]}
     out.write(json.dumps(head, **compact)[:-1] + ',"findings":[')
-    rows, separator = _finding_rows(run.settings), ""
+    finding_rows, first = _finding_rows(run.settings), True
     for report in run.reports:
-        for block in run.kept(report).formatted(rows):
-            out.write(separator + ",".join(block))
-            separator = ","
+        for block in run.kept(report).written(finding_rows):
+            out.write(block[1:] if first else block)  # every row follows a comma but the first
+            first = False
     tail = {"summary": _summary(run)}
     if run.max_findings is not None:
         tail["truncated"] = truncation(run, run.max_findings)

@@ -22,14 +22,14 @@ from __future__ import annotations
 import re
 from typing import TextIO
 
+import numpy as np
+
 from ..findings import FileReport
 from ..rules import LEVELS, RULES, UNREADABLE
-from . import CheckRun, Columns, Selection, face_lines, statistics, text_lines
+from . import CheckRun, Columns, Selection, face_line_pieces, rows, statistics, text_lines
 
 # Characters XML 1.0 cannot carry at all (control characters, lone surrogates from undecodable file names).
 _NOT_XML = re.compile("[^\t\n\r\x20-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
-#: What an attribute value or character data cannot hold as it is.
-_SPECIAL = re.compile("[&<>\"\t\n\r]|" + _NOT_XML.pattern)
 
 
 def xml_text(text: str) -> str:
@@ -43,35 +43,27 @@ def xml_attribute(text: str) -> str:
             .replace("\r", "&#13;"))
 
 
-def _needs_escaping(c: Columns) -> bool:
-    """Whether the texts a :class:`Columns` is written from hold anything XML must escape or cannot carry."""
-    texts = {c.path, *c.message, *c.group, *(p for p in c.prim if p is not None)}
-    return any(_SPECIAL.search(text) for text in texts)
-
-
 def _attributes(**values) -> str:
     return "".join(f' {name}="{xml_attribute(str(value))}"' for name, value in values.items())
 
 
 def _finding_cases(fail_on: str):
-    """The ``<testcase>`` text of each finding of a :class:`Columns`: failing at ``fail_on`` and above."""
+    """The ``<testcase>`` text of each finding of a :class:`Columns` (a grid of rows, :mod:`.rows`, for
+    findings on faces): failing at ``fail_on`` and above."""
     failing = set(LEVELS[: LEVELS.index(fail_on) + 1])
 
-    def cases(c: Columns) -> list[str]:
+    def cases(c: Columns) -> np.ndarray | list[str]:
         path = xml_attribute(c.path)
         rule = f"{xml_attribute(c.code)} {xml_attribute(c.name)}"
         failure = f'<failure type="{xml_attribute(c.code)}" message="{rule}: {xml_attribute(RULES[c.code].summary)}">'
-        lines = face_lines(c, xml_text)
-        if lines is not None:  # measured faces of a mesh file: one shape for every case
-            case, where = f'<testcase classname="{path}" name="{rule} face ', f'" file="{path}" line="'
-            opens = {level: f'">{failure}' if level in failing else '"><system-out>' for level in LEVELS}
-            closes = {level: "</failure></testcase>\n" if level in failing else "</system-out></testcase>\n"
-                      for level in LEVELS}
-            return [f"{case}{face}{where}{line}{opens[level]}{t}{closes[level]}"
-                    for face, line, level, t in zip(c.number_texts[2], c.number_texts[0], c.level, lines)]
-        lines = text_lines(c)
-        if _needs_escaping(c):  # numbers never do: only the path, messages, groups and prims can
-            lines = list(map(xml_text, lines))
+        if c.on_faces:  # measured faces of a mesh file: one shape for every case, laid out a column at a time
+            fails = c.level_ranks <= LEVELS.index(fail_on)
+            return rows.grid([f'<testcase classname="{path}" name="{rule} face '.encode(), c.face_digits,
+                              f'" file="{path}" line="'.encode(), c.line_digits,
+                              rows.choice(fails, ['"><system-out>', f'">{failure}']),
+                              *face_line_pieces(c, xml_text),
+                              rows.choice(fails, ["</system-out></testcase>\n", "</failure></testcase>\n"])], len(c))
+        lines = list(map(xml_text, text_lines(c)))  # a bound reads "<=", texts may hold "&"
         names = [rule if face < 0 else f"{rule} face {face}" if prim is None
                  else f"{rule} {xml_attribute(prim)} face {face}" for face, prim in zip(c.face, c.prim)]
         return [f'<testcase classname="{path}" name="{name}" file="{path}" line="{line}">'
@@ -103,8 +95,8 @@ def _suite(run: CheckRun, selection: Selection, counts: dict[str, int], out: Tex
                   f"<skipped{_attributes(message=report.skipped)}/></testcase>\n")
     elif not report.hits:
         out.write(f'    <testcase classname="{path}" name="affinity check"/>\n')
-    for block in selection.formatted(_finding_cases(run.fail_on)):
-        out.write("".join(block))
+    for block in selection.written(_finding_cases(run.fail_on)):
+        out.write(block)
     out.write("  </testsuite>\n")
 
 

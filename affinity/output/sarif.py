@@ -55,7 +55,7 @@ import numpy as np
 
 from .. import __version__
 from ..findings import FileReport
-from ..rules import RULES, UNREADABLE, rule_page
+from ..rules import LEVELS, RULES, UNREADABLE, number_spec, rule_page
 from . import (
     VALUE_TOKEN,
     VISIBLE_FIELDS,
@@ -64,12 +64,15 @@ from . import (
     Selection,
     authored_where,
     descriptions,
+    distinct,
+    measurement_suffixes,
+    rows,
     statistics,
     truncation,
-    value_token,
     working_relative,
 )
 from .cap import cap_findings
+from .json import json_values
 
 SARIF_VERSION = "2.1.0"
 SARIF_SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
@@ -115,18 +118,18 @@ def _physical(location: dict, line: int, column: int = 0) -> dict:
     return physical
 
 
-def fingerprint(code: str, uri: str, group: str, value: float, ordinal: int) -> str:
-    """The stable identity of a finding (see the module docstring)."""
-    text = "\0".join((code, uri, group, value_token(value), str(ordinal)))
-    return hashlib.sha256(text.encode("utf-8")).hexdigest()[:32]
+def fingerprints(code: str, uri: str, groups: list[str], values: list[float], ordinals: list[int]) -> list[str]:
+    """The stable identity of each finding of one rule in one file (see the module docstring); the value
+    tokens made in one ``%``."""
+    tokens = ((VALUE_TOKEN + "\0") * len(values) % tuple(values)).split("\0")
+    return [hashlib.sha256(f"{code}\0{uri}\0{group}\0{token}\0{ordinal}".encode()).hexdigest()[:32]
+            for group, token, ordinal in zip(groups, tokens, ordinals)]
 
 
 def _ordinals(selection: Selection) -> np.ndarray:
     """(n,) int64: each finding's ordinal among the file's findings of the same rule, group and value token,
     in file order (the selection's order)."""
-    ids: dict[str, int] = {}  # value token -> a number, equal for equal tokens
-    token = np.array([ids.setdefault(t, len(ids)) for hits, take in selection.parts
-                      for t in map(VALUE_TOKEN.format, hits.values[take].tolist())], dtype=np.int64)[selection.order]
+    token = token_ids(np.concatenate([hits.values[take] for hits, take in selection.parts]))[selection.order]
     code = np.concatenate([np.full(len(take), i) for i, (_, take) in enumerate(selection.parts)])[selection.order]
     group = np.concatenate([hits.groups[take] for hits, take in selection.parts])[selection.order]
     position = np.arange(len(selection))
@@ -139,31 +142,62 @@ def _ordinals(selection: Selection) -> np.ndarray:
     return ordinals
 
 
+def token_ids(values: np.ndarray) -> np.ndarray:
+    """(n,) int64: a number for each of ``values`` (n,) float64, equal where their :func:`value_token` texts
+    are equal.
+
+    The token is |x| rounded to 6 significant digits: the digits rint(m), m = |x| 10^(5 - e) in [1e5, 1e6),
+    e = floor(log10 |x|), with the exponent e and the sign. Rounding keeps the order, so equal tokens are
+    neighbours among the sorted distinct values. Where m is computed within 1e-3 of a rounding tie or of the
+    ends of its decade (the relative error of m is about 1e-16), and for zeros, subnormals, infinities and
+    NaN, the neighbours' texts are made and compared instead; -0.0 (token ``-0``) is its own.
+    """
+    distinct, inverse = np.unique(values, return_inverse=True)  # sorted, NaNs as one, last
+    with np.errstate(all="ignore"):
+        exponent = np.floor(np.log10(np.abs(distinct)))
+        mantissa = np.abs(distinct) * 10.0 ** (5 - exponent)
+        sure = (np.isfinite(mantissa) & (mantissa > 1e5 + 1e-3) & (mantissa < 1e6 - 0.5 - 1e-3)
+                & (np.abs(mantissa - np.floor(mantissa) - 0.5) > 1e-3))
+    key = np.stack([np.signbit(distinct), exponent, np.rint(mantissa)])  # (3, k)
+    same = (key[:, 1:] == key[:, :-1]).all(axis=0)
+    unsure = np.flatnonzero(~(sure[1:] & sure[:-1]))
+    if len(unsure):
+        tokens = rows.floats([*distinct[unsure].tolist(), *distinct[unsure + 1].tolist()], VALUE_TOKEN)
+        same[unsure] = (tokens[: len(unsure)] == tokens[len(unsure) :]).all(axis=1)
+    ids = np.concatenate([[0], np.cumsum(~same)])[inverse.ravel()]
+    ids[(values == 0) & np.signbit(values)] = len(distinct)
+    return ids
+
+
 PRIM = ',"prim":'
 
 
 def _result_rows(location: dict, rule_index: dict[str, int]):
-    """The SARIF results of a :class:`Columns` as JSON text, each with its fingerprint (from its ``ordinals``,
-    :func:`_ordinals`); the pieces every result of a rule shares are encoded once."""
+    """The SARIF results of a :class:`Columns` as JSON text, each after a comma and with its fingerprint (from
+    its ``ordinals``, :func:`_ordinals`): a grid of rows (:mod:`.rows`) for findings on faces, the pieces
+    every result of a rule shares encoded once; else a list, a result at a time."""
     encode = json.dumps
     # One encoder for every result (json.dumps with options builds a new encoder a call: most of the time here).
     compact = json.JSONEncoder(separators=(",", ":")).encode
 
-    def rows(c: Columns, ordinals: np.ndarray) -> list[str]:
-        head = f'{{"ruleId":{encode(c.code)},"ruleIndex":{rule_index[c.code]},"level":"'
+    def result_rows(c: Columns, ordinals: np.ndarray) -> np.ndarray | list[str]:
+        head = f',{{"ruleId":{encode(c.code)},"ruleIndex":{rule_index[c.code]},"level":"'
         shared = f',"threshold":{encode(c.threshold)},"unit":{encode(c.unit)},"level":"'
+        identities = fingerprints(c.code, location["uri"], c.group, c.value, ordinals.tolist())
+        if c.on_faces and ((c.lines > 0).all() or (c.lines == 0).all()):
+            return _face_results(c, location, compact, head, shared, identities)
         results = []
-        for line, column, face, value, level, group, prim, text, ordinal, where, read in zip(
-                c.line, c.column, c.face, c.value, c.level, c.group, c.prim, descriptions(c), ordinals.tolist(),
+        for line, column, face, value, level, group, prim, text, identity, where, read in zip(
+                c.line, c.column, c.face, c.value, c.level, c.group, c.prim, descriptions(c), identities,
                 c.shared or [None] * len(c), c.visible or [{}] * len(c)):
             located: dict = {"physicalLocation": _physical(location, line, column)}
             logical, label = _logical_location(prim, group, face)
             if logical:
                 located["logicalLocations"] = [logical]
-            identity = fingerprint(c.code, location["uri"], group, value, ordinal)
             if where is not None or read:  # shared geometry, or C read through a texture: a result of its own
-                results.append(compact(_rich_result(c, located, where, read, identity, rule_index[c.code], face,
-                                                    value, level, group, prim, f"{text}, {label}" if label else text)))
+                results.append("," + compact(_rich_result(c, located, where, read, identity, rule_index[c.code], face,
+                                                          value, level, group, prim,
+                                                          f"{text}, {label}" if label else text)))
                 continue
             results.append(
                 f'{head}{sarif_level(level)}","message":{{"text":{encode(f"{text}, {label}" if label else text)}}},'
@@ -173,7 +207,31 @@ def _result_rows(location: dict, rule_index: dict[str, int]):
                 f'"group":{encode(group)}{"" if prim is None else PRIM + encode(prim)}}}}}')
         return results
 
-    return rows
+    return result_rows
+
+
+def _face_results(c: Columns, location: dict, compact, head: str, shared: str, identities: list[str]) -> np.ndarray:
+    """The results of findings on faces (:attr:`Columns.on_faces`) whose lines are all known or all 0 (binary
+    PLY), as a grid of rows (:mod:`.rows`): what :func:`_result_rows` writes a result at a time, laid out a
+    column at a time. A JSON text splits where a text does (``dumps(a + b) == dumps(a)[:-1] + dumps(b)[1:]``),
+    so each distinct message and group is encoded once, around the numbers."""
+    encode = json.dumps
+    unit, against = measurement_suffixes(c)
+    which_message, messages = distinct(c.message)
+    which_group, groups = distinct(c.group)
+    region = [b',"region":{"startLine":', c.line_digits, b',"startColumn":', rows.integers(c.columns), b"}"]
+    return rows.grid([
+        head.encode(), rows.choice(c.level_ranks, [sarif_level(level) for level in LEVELS]),
+        b'","message":{"text":', rows.choice(which_message, [encode(m + " (")[:-1] for m in messages]),
+        rows.floats(c.value, number_spec()), encode(f"{unit}{against}), face ")[1:-1].encode(), c.face_digits,
+        f'"}},"locations":[{{"physicalLocation":{{"artifactLocation":{compact(location)}'.encode(),
+        *(region if (c.lines > 0).all() else []),
+        b'},"logicalLocations":[{"name":"face ', c.face_digits, b'","fullyQualifiedName":',
+        rows.choice(which_group, [encode(f"{g}/face " if g else "face ")[:-1] for g in groups]), c.face_digits,
+        f'","kind":"element"}}]}}],"partialFingerprints":{{"{FINGERPRINT}":"'.encode(),
+        rows.formatted(identities, "%s"), f'"}},"properties":{{"name":{encode(c.name)},"face":'.encode(),
+        c.face_digits, b',"value":', json_values(c), shared.encode(), rows.choice(c.level_ranks, LEVELS),
+        b'","group":', rows.choice(which_group, [encode(g) for g in groups]), b"}}"], len(c))
 
 
 def _rich_result(c: Columns, located: dict, where: dict | None, read: dict, identity: str, rule_index: int,
@@ -198,7 +256,7 @@ def _rich_result(c: Columns, located: dict, where: dict | None, read: dict, iden
     return result
 
 
-def _results(run: CheckRun) -> tuple[list[str], str | None]:
+def _results(run: CheckRun) -> tuple[str, str | None]:
     """The run's results as JSON text (capped, :func:`affinity.output.cap.cap_findings`, unless
     ``--max-findings``), and the truncation notice (None: nothing cut)."""
     selections = [run.kept(report) for report in run.reports]
@@ -208,14 +266,13 @@ def _results(run: CheckRun) -> tuple[list[str], str | None]:
         kept, notice = capped.kept, capped.note("SARIF results")
     rule_index = {code: i for i, code in enumerate(RULES)}  # registered rules, as the driver lists them
     results = []
-    for selection, rows in zip(selections, kept):
-        if len(rows) == 0:
+    for selection, taken in zip(selections, kept):
+        if len(taken) == 0:
             continue
         location = artifact_location(selection.report.path)
-        for block in selection.subset(rows).formatted(_result_rows(location, rule_index),
-                                                      along=_ordinals(selection)[rows]):
-            results += block
-    return results, notice
+        results += selection.subset(taken).written(_result_rows(location, rule_index),
+                                                   along=_ordinals(selection)[taken])
+    return "".join(results)[1:], notice  # every result follows a comma but the first
 
 
 def _prim_location(prim: str) -> dict:
@@ -257,7 +314,7 @@ def _folder_uri(folder: Path) -> str:
     return uri if uri.endswith("/") else uri + "/"
 
 
-def document(run: CheckRun) -> tuple[dict, list[str]]:
+def document(run: CheckRun) -> tuple[dict, str]:
     """The SARIF log as Python objects, its results standing in as ``[RESULTS]``, and the results as JSON text."""
     properties: dict = {}
     if run.max_findings is not None:
@@ -300,4 +357,4 @@ RESULTS = "\0results\0"
 def write(run: CheckRun, out: TextIO) -> None:
     log, results = document(run)
     head, tail = json.dumps(log, separators=(",", ":")).split(json.dumps(RESULTS), 1)
-    out.write(head + ",".join(results) + tail + "\n")
+    out.write(head + results + tail + "\n")

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from typing import TextIO
 
-from . import CheckRun, level_counts, select, statistics, text_lines
+from . import CheckRun, level_counts, select, statistics, text_rows
 from .names import printable
 
 #: Findings shown per file and rule before "... and N more" (design.md, Clarifications).
@@ -33,8 +33,8 @@ def write_findings(run: CheckRun, out: TextIO, verbose: bool = False) -> None:
     verbose."""
     for report in run.reports:
         selection = select(report, None if verbose else TEXT_LIMIT, order="severity")
-        for lines in selection.formatted(text_lines):
-            out.write("".join(line + "\n" for line in lines))
+        for lines in selection.written(text_rows):
+            out.write(lines)
         path = printable(report.path)
         out.write("".join(f"{path}: ... and {n} more {code} (use --verbose or --format json for all)\n"
                           for code, n in selection.omitted.items()))

@@ -14,7 +14,7 @@ read :data:`RULES`.
 """
 
 from . import affinity, file, shape, texture  # noqa: F401  each registers its rules
-from .docs import SECTIONS, number_text, number_texts, rule_page, rules_table, threshold_text, with_unit
+from .docs import SECTIONS, number_spec, number_text, rule_page, rules_table, threshold_text, with_unit
 from .file import UNREADABLE
 from .registry import (
     LEVELS,
@@ -38,6 +38,6 @@ def find_rule(key: str) -> Rule | None:
     return None
 
 
-__all__ = ["LEVELS", "RULES", "SECTIONS", "UNREADABLE", "Measured", "Rule", "find_rule", "number_text", "number_texts",
+__all__ = ["LEVELS", "RULES", "SECTIONS", "UNREADABLE", "Measured", "Rule", "find_rule", "number_spec", "number_text",
            "page_fields", "register",
            "resolve_codes", "rule", "rule_page", "rules_table", "threshold_text", "unregister", "with_unit"]

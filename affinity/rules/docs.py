@@ -40,22 +40,19 @@ def level_text(rule: Rule) -> str:
 DIGITS = 4
 
 
+def number_spec(digits: int = DIGITS) -> str:
+    """The ``%`` format of a measured number with ``digits`` significant digits, for :func:`number_text` and
+    for writers that format a column of numbers at once (:func:`affinity.output.rows.floats`)."""
+    return f"%.{digits}g"
+
+
 def number_text(value: float, digits: int = DIGITS) -> str:
     """A measured number for people: ``digits`` significant digits, no exponent for everyday sizes.
 
     >>> number_text(175.6854), number_text(2.0), number_text(1e-9), number_text(0.12345, digits=3)
     ('175.7', '2', '1e-09', '0.123')
     """
-    return f"{value:.{digits}g}"
-
-
-def number_texts(values: list[float], digits: int = DIGITS) -> list[str]:
-    """(n,) :func:`number_text` of each of ``values``, converted in one call (a million findings' values).
-
-    >>> number_texts([175.6854, 2.0, 1e-9])
-    ['175.7', '2', '1e-09']
-    """
-    return (f"%.{digits}g," * len(values) % tuple(values)).split(",")[:-1]
+    return number_spec(digits) % value
 
 
 def with_unit(number: str, unit: str) -> str:

@@ -2,11 +2,12 @@
 
 A texture whose header claims more than :data:`DECODE_BUDGET` pixels is never
 decoded (a 100,000 x 100,000 PNG header would ask for 30 GB); decoded textures
-are kept as (H, W, C) uint8, at most :data:`CACHE_BYTES` of them at a time
+are kept as (H, W, 4) uint8 (four bytes a texel, as Pillow holds them), at most :data:`CACHE_BYTES` of them at a time
 (least recently used dropped first), keyed by path, size and modification time,
 so each texture is decoded once per run however many meshes or rules read it.
 Peak memory for textures: :data:`CACHE_BYTES` plus one texture being decoded
-(at most ``DECODE_BUDGET x 4`` bytes) and its min/max pyramid (2/3 of it).
+(at most ``DECODE_BUDGET x 4`` bytes, twice while Pillow hands its copy over) and its min/max
+pyramids (2/3 of it at most, built only over the rows the lint's queries reach).
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ import os
 import threading
 from collections import OrderedDict
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cached_property, partial
 
 import numpy as np
 
@@ -25,7 +26,6 @@ from ..loaders.imagesize import ImageHeader, ImageUnreadable, open_image_file, r
 DECODE_BUDGET = 1 << 26
 #: Decoded texture bytes kept between meshes of one run.
 CACHE_BYTES = 1 << 29
-#: Formats Pillow decodes; an EXR's size comes from its header, its texels are not read.
 
 
 class TextureUnusable(Exception):
@@ -45,50 +45,73 @@ class DecodedTexture:
     ----------
     path : the file
     header : what its header says (format and size)
-    pixels : (H, W, C) uint8, read-only; C is 1 (grey), 2 (grey, alpha), 3 (RGB) or 4 (RGBA); row 0 the top
+    texels : (H, W, 4) uint8, C-contiguous, read-only: one 32-bit word a texel, as Pillow holds an image
+        (the sampler gathers words); its first ``channels`` bytes are the texture's; row 0 the top
+    channels : C, 1 (grey), 2 (grey, alpha), 3 (RGB) or 4 (RGBA)
     """
 
     path: str
     header: ImageHeader
-    pixels: np.ndarray
+    texels: np.ndarray
+    channels: int
+
+    @property
+    def pixels(self) -> np.ndarray:
+        """(H, W, C) uint8, read-only: the texture's channels of :attr:`texels` (a view)."""
+        return self.texels[..., :self.channels]
 
     @cached_property
     def pyramid(self):
-        """The texture's min/max pyramid (:class:`~affinity.textures.filtering.RangePyramid`), built once."""
+        """The texture's min/max pyramid (:class:`~affinity.textures.filtering.RangePyramid`), reduced as
+        queries reach its parts."""
         from .filtering import RangePyramid
 
-        return RangePyramid(self.pixels)
+        return RangePyramid(self.texels, channels=self.channels)
 
     @cached_property
     def slopes(self):
-        """The pyramid of the texture's steps (:class:`~affinity.textures.filtering.RangePyramid` of (H, W, 2)
-        uint8): the largest channel difference from each texel to the next column and to the next row,
-        wrapping; bilinear filtering changes by at most their sum per texel moved."""
+        """The pyramids of the texture's steps to the next column and to the next row, wrapping
+        (:class:`~affinity.textures.filtering.RangePyramid` of (H, W, 1) uint8, maxima): the largest channel
+        difference from each texel to that neighbour; bilinear filtering changes by at most their sum per
+        texel moved. The steps are computed for the rows queries reach."""
         from .filtering import RangePyramid
 
-        pixels = self.pixels
-        steps = np.empty((*pixels.shape[:2], 2), dtype=np.uint8)
+        height, width = self.texels.shape[:2]
+        return tuple(RangePyramid(minima=False, rows=partial(self._channel_steps, axis=axis),
+                                  fold=self._largest_step, shape=(height, width, 1)) for axis in (1, 0))
 
-        def largest_step(a: np.ndarray, b: np.ndarray, out: np.ndarray) -> None:
-            step = np.maximum(a, b)
-            step -= np.minimum(a, b)  # |a - b| in uint8
-            largest = step[..., 0].copy()
-            for channel in range(1, step.shape[2]):  # elementwise: faster than a reduction over a short axis
-                np.maximum(largest, step[..., channel], out=largest)
-            out[...] = largest
+    def _channel_steps(self, start: int, stop: int, axis: int) -> np.ndarray:
+        """(stop - start, W, 4) uint8: per channel of :attr:`texels`, |difference| from each texel of rows
+        ``start`` to ``stop`` to the next one along ``axis`` (1: the next column, 0: the next row), wrapping.
+        Whole four-byte texels are subtracted: contiguous, and no reduction per texel."""
+        texels = self.texels
+        rows = texels[start:stop]
+        steps = np.empty_like(rows)
+        if axis == 1:  # the last column wraps to the first
+            pairs = ((rows[:, :-1], rows[:, 1:], steps[:, :-1]), (rows[:, -1:], rows[:, :1], steps[:, -1:]))
+        else:  # the last row wraps to the first
+            pairs = ((rows[:-1], texels[start + 1:stop], steps[:-1]),
+                     (rows[-1:], texels[stop % len(texels)][None], steps[-1:]))
+        for texel, neighbour, out in pairs:  # |a - b| in uint8, no copy of the neighbours
+            np.maximum(texel, neighbour, out=out)
+            out -= np.minimum(texel, neighbour)
+        return steps
 
-        largest_step(pixels[:, :-1], pixels[:, 1:], steps[:, :-1, 0])
-        largest_step(pixels[:, -1:], pixels[:, :1], steps[:, -1:, 0])  # the last column wraps to the first
-        largest_step(pixels[:-1], pixels[1:], steps[:-1, :, 1])
-        largest_step(pixels[-1:], pixels[:1], steps[-1:, :, 1])
-        return RangePyramid(steps, minima=False)
+    def _largest_step(self, steps: np.ndarray) -> np.ndarray:
+        """(..., 1) uint8: the largest of :meth:`_channel_steps`'s (..., 4) over the texture's channels
+        (elementwise: faster than a reduction over a short axis)."""
+        largest = steps[..., :1].copy()
+        for channel in range(1, self.channels):
+            np.maximum(largest, steps[..., channel:channel + 1], out=largest)
+        return largest
 
     @cached_property
     def packed(self):
-        """The texels packed for sampling (:class:`~affinity.textures.filtering.PackedTexture`), built once."""
+        """The texels packed for sampling (:class:`~affinity.textures.filtering.PackedTexture`): the
+        :attr:`texels` themselves."""
         from .filtering import PackedTexture
 
-        return PackedTexture(self.pixels)
+        return PackedTexture(self.texels, self.channels)
 
     @cached_property
     def looks_like_normal_map(self) -> bool:
@@ -146,16 +169,17 @@ def decode(path: str, budget: int = DECODE_BUDGET) -> DecodedTexture:
         if key in _cache:
             _cache.move_to_end(key)
             return _cache[key]
-    texture = DecodedTexture(path, header, _decode_pixels(path, header))
+    texture = DecodedTexture(path, header, *_decode_texels(path, header))
     with _cache_lock:
         _cache[key] = texture
-        while sum(t.pixels.nbytes for t in _cache.values()) > CACHE_BYTES and len(_cache) > 1:
+        while sum(t.texels.nbytes for t in _cache.values()) > CACHE_BYTES and len(_cache) > 1:
             _cache.popitem(last=False)
     return texture
 
 
 #: Pillow's image class per header format, opened directly: ``Image.open`` would first import every common
-#: plug-in (JPEG's imports subprocess), a tenth of a second of a small check.
+#: plug-in (JPEG's imports subprocess), a tenth of a second of a small check. The formats Pillow decodes: an
+#: EXR's size comes from its header, its texels are not read.
 _PLUGINS = {"PNG": ("PngImagePlugin", "PngImageFile"), "JPEG": ("JpegImagePlugin", "JpegImageFile"),
             "BMP": ("BmpImagePlugin", "BmpImageFile"), "TGA": ("TgaImagePlugin", "TgaImageFile"),
             "TIFF": ("TiffImagePlugin", "TiffImageFile"), "DDS": ("DdsImagePlugin", "DdsImageFile")}
@@ -169,8 +193,10 @@ def _opened(file, header: ImageHeader):
     return getattr(importlib.import_module(f"PIL.{module}"), name)(file)
 
 
-def _decode_pixels(path: str, header: ImageHeader) -> np.ndarray:
-    """(H, W, C) uint8 of an image whose header was checked against the budget."""
+def _decode_texels(path: str, header: ImageHeader) -> tuple[np.ndarray, int]:
+    """(H, W, 4) uint8 texels (:attr:`DecodedTexture.texels`) and the channel count C of an image whose
+    header was checked against the budget. Colour images come from Pillow four bytes a texel, as it holds
+    them (no copy past its own); grey ones are padded."""
     from PIL import Image, UnidentifiedImageError
 
     try:
@@ -181,6 +207,14 @@ def _decode_pixels(path: str, header: ImageHeader) -> np.ndarray:
             mode = ("RGBA" if "A" in bands else "RGB") if len(bands) >= 3 else ("LA" if "A" in bands else "L")
             if image.mode in ("I;16", "I;16B", "I;16L", "I"):  # 16-bit grey: keep the top 8 bits
                 array = (np.asarray(image, dtype=np.uint32) >> 8).astype(np.uint8)
+            elif mode in ("RGB", "RGBA"):
+                texels = _decoded_in_place(image) if header.format == "PNG" and image.mode == mode else None
+                if texels is not None:
+                    return texels, len(mode)
+                image = image if image.mode == mode else image.convert(mode)
+                raw = image.tobytes("raw", "RGBX" if mode == "RGB" else "RGBA")
+                texels = np.frombuffer(raw, dtype=np.uint8).reshape(image.height, image.width, 4)
+                return texels, len(mode)  # frombuffer of bytes: already read-only
             else:
                 array = np.asarray(image if image.mode == mode else image.convert(mode), dtype=np.uint8)
     except TextureUnusable:
@@ -188,5 +222,25 @@ def _decode_pixels(path: str, header: ImageHeader) -> np.ndarray:
     except (UnidentifiedImageError, OSError, ValueError, SyntaxError, Image.DecompressionBombError) as err:
         raise TextureUnusable(f"does not decode ({err.__class__.__name__})", header) from None
     array = array.reshape(*array.shape[:2], -1)
-    array.flags.writeable = False
-    return array
+    texels = np.zeros((*array.shape[:2], 4), dtype=np.uint8)
+    texels[..., :array.shape[2]] = array
+    texels.flags.writeable = False
+    return texels, array.shape[2]
+
+
+def _decoded_in_place(image) -> np.ndarray | None:
+    """(H, W, 4) uint8: the PNG ``image`` (mode RGB or RGBA, not loaded yet) decoded by Pillow straight into a
+    numpy buffer laid out as Pillow holds such images (four bytes a texel), saving the copy out of Pillow's
+    memory (a fifth of the decode's time at 2048 x 2048); None where this Pillow does not map a buffer
+    (``Image.core.map_buffer`` is its own, not public: the copying path then decodes)."""
+    from PIL import Image
+
+    width, height = image.size
+    texels = np.empty((height, width, 4), dtype=np.uint8)
+    try:
+        image.im = Image.core.map_buffer(texels, image.size, "raw", 0, (image.mode, width * 4, 1))
+    except (AttributeError, TypeError, ValueError):
+        return None
+    image.load()
+    texels.flags.writeable = False
+    return texels

@@ -38,8 +38,9 @@ def split_diagonals(mesh, faces: np.ndarray, diagonal: str) -> np.ndarray:
 
 def prepare_textures(mesh) -> threading.Thread | None:
     """Start decoding, in a background thread, every texture the mesh's quads read that the budget lets
-    decode, with its pyramids and packed texels (:class:`~affinity.textures.decode.DecodedTexture`), so that
-    the work overlaps the lint's; join the thread before reading C. None when there is nothing to decode."""
+    decode (:class:`~affinity.textures.decode.DecodedTexture`; its pyramids are reduced later, where the
+    flagged quads' queries reach), so that the work overlaps the lint's; join the thread before reading C.
+    None when there is nothing to decode."""
     quads = np.flatnonzero(mesh.face_sizes == 4)
     paths = list(dict.fromkeys(bound.path for bound in bound_textures(mesh, quads)))
     paths = [path for path in paths if why_not_decoded(path) is None]
@@ -49,10 +50,9 @@ def prepare_textures(mesh) -> threading.Thread | None:
     def warm() -> None:
         for path in paths:
             try:
-                texture = decode(path)
+                decode(path)
             except TextureUnusable:
                 continue  # the reading says why
-            texture.pyramid, texture.slopes, texture.packed  # noqa: B018 (built once, here)
 
     thread = threading.Thread(target=warm, name="affinity-textures", daemon=True)
     thread.start()
