@@ -96,10 +96,3 @@ def material_node_tree(material):
     if version() < (5, 0, 0) and not material.use_nodes:
         return None
     return material.node_tree
-
-
-def install_extension(zip_path: str, repo: str = "user_default") -> None:
-    """Install and enable an extension zip (``bpy.ops.extensions``, Blender 4.2+)."""
-    import bpy
-
-    bpy.ops.extensions.package_install_files(filepath=str(zip_path), repo=repo, enable_on_install=True)
