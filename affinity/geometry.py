@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
+from numpy.typing import NDArray
 
 #: A triangle or quad whose area is at most this fraction of the square of its
 #: quad's longest edge counts as degenerate (its barycentric coordinates are not
@@ -209,12 +210,12 @@ class PlanarQuads:
         corner i, of 3-D corners (so T_i = C_i . n / |n|); None for 2-D corners.
     """
 
-    areas: np.ndarray
-    size: np.ndarray
-    diagonals: np.ndarray
-    components: np.ndarray
-    normals: np.ndarray | None = None
-    vector_areas: np.ndarray | None = None
+    areas: NDArray[np.float64]
+    size: NDArray[np.float64]
+    diagonals: NDArray[np.float64]
+    components: NDArray[np.float64]
+    normals: NDArray[np.float64] | None = None
+    vector_areas: NDArray[np.float64] | None = None
 
     @cached_property
     def xy(self) -> np.ndarray:

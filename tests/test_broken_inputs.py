@@ -72,14 +72,14 @@ def test_an_exception_inside_one_file_is_that_files_q901(tmp_path, monkeypatch):
     from affinity.settings import Settings
 
     good, other = write(tmp_path, "good.obj", SQUARE), write(tmp_path, "other.obj", TRAPEZOID)
-    real_lint = affinity.lint.lint_mesh
+    real_lint = affinity.lint.lint_pass
 
-    def failing_lint(mesh, settings):
+    def failing_lint(mesh, settings, *args, **kwargs):
         if mesh.path.endswith("good.obj"):
             raise IndexError("index 7 is out of bounds for axis 0 with size 4")
-        return real_lint(mesh, settings)
+        return real_lint(mesh, settings, *args, **kwargs)
 
-    monkeypatch.setattr(affinity.lint, "lint_mesh", failing_lint)
+    monkeypatch.setattr(affinity.lint, "lint_pass", failing_lint)
     reports = check_files([(str(good), Settings()), (str(other), Settings())], jobs=1)
     assert reports[0].error == "internal error: IndexError: index 7 is out of bounds for axis 0 with size 4"
     assert reports[0].error_line == 0

@@ -98,8 +98,8 @@ def missing_resources(context) -> Measured:
         # a material library that is not there
         mtllib missing.mtl
         v 0 0 0
-        v 1 0 0
-        v 1 1 0
+        v 2 0 0
+        v 0 2 0
         f 1 2 3
 
     Prints:
@@ -108,8 +108,8 @@ def missing_resources(context) -> Measured:
     Use instead:
         # the same mesh without the line naming a library it does not need (one file cannot ship one)
         v 0 0 0
-        v 1 0 0
-        v 1 1 0
+        v 2 0 0
+        v 0 2 0
         f 1 2 3
 
     How to fix:
