@@ -19,7 +19,7 @@ ROOT = Path(__file__).resolve().parents[1]
 LAYERS = {
     "render": 0,
     "affinity.draw": 2, "affinity.pipeline": 2,
-    "affinity.study": 3, "affinity.stability": 3, "affinity.blender": 3,
+    "affinity.study": 3, "affinity.view": 3, "affinity.stability": 3, "affinity.blender": 3,
     "affinity.report": 4,
     "affinity.commands": 5,
     "affinity.cli": 6,

@@ -452,8 +452,8 @@ def test_a_big_face_reaches_vtk_as_its_fan_and_cell_f_stays_face_f():
     # took 103 s. A quad, a regular 1,000-gon of circumradius 1 and a triangle: the area is a closed form.
     import numpy as np
 
-    from affinity.draw.view import VTK_POLYGON_CORNERS, polydata
     from affinity.mesh import Mesh
+    from affinity.view import VTK_POLYGON_CORNERS, polydata
 
     n = 1000
     angle = np.linspace(0, 2 * np.pi, n, endpoint=False)

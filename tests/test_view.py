@@ -14,11 +14,11 @@ import pytest
 pv = pytest.importorskip("pyvista")
 
 from affinity.attributes import ATTRIBUTES  # noqa: E402
-from affinity.draw.view import build_scene  # noqa: E402
 from affinity.lint import quad_scores, scored_codes  # noqa: E402
 from affinity.loaders import load  # noqa: E402
 from affinity.rules import RULES  # noqa: E402
 from affinity.settings import MEASURES, Settings  # noqa: E402
+from affinity.view import build_scene  # noqa: E402
 
 #: One trapezoid (side ratio 1/2) carrying each attribute at its corners: uv, vertex colours, normals.
 TRAPEZOID = """v 0 0 0 1 0 0

@@ -44,9 +44,9 @@ def _scores(mesh, path: str, attribute: str | None):
 
 
 def run(args) -> int:
-    from ..draw.view import overview_image, show
     from ..loaders import load
     from ..output.names import printable
+    from ..view import overview_image, show
 
     require(("pyvista",), "view")
     try:

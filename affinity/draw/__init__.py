@@ -7,8 +7,9 @@
 - :mod:`.quads`: the mesh as the renderer's quads (triangles and n-gons fanned);
 - :mod:`.routing`: the hybrid's per-quad choice between ``split`` and ``mvc``;
 - :mod:`.shading`: per-corner inputs, pixel colours, the shared palette;
-- :mod:`.texture`, :mod:`.png`, :mod:`.flat`: images in and out, flat face-id pictures;
-- :mod:`.view`: the 3-D view of ``affinity view`` and the report's overview (pyvista, the ``view`` extra).
+- :mod:`.texture`, :mod:`.png`, :mod:`.flat`: images in and out, flat face-id pictures.
+
+The pyvista scene of ``affinity view`` and the report's overview is ``affinity.view``, a layer above.
 
 ``render`` (the rasterizer) knows nothing of meshes; this package is where meshes
 meet it. Heavy imports (``render``, Pillow) happen inside the functions. The names
@@ -19,16 +20,14 @@ from .closeup import CLOSEUP_SIZE, Closeup, CloseupView, closeup
 from .drawing import RenderOptions, RenderResult, over_render_budget, render_mesh
 from .faces import face_centroids, face_vertices
 from .flat import face_ids
-from .framing import overview_camera, up_axis_of, used_points
+from .framing import UP_AXES, overview_camera, up_axis_of, used_points
 from .png import png_bytes, to_pixels
 from .quads import render_corners
 from .routing import MVC, SPLIT
 from .shading import FLAG_COLOUR, OVERLAY_TINT, flat_normals
 from .texture import TextureError, checker
-from .view import INSTALL_HINT, overview_image, pyvista_installed, score_range
 
-__all__ = ["CLOSEUP_SIZE", "FLAG_COLOUR", "INSTALL_HINT", "MVC", "OVERLAY_TINT", "SPLIT", "Closeup", "CloseupView",
+__all__ = ["CLOSEUP_SIZE", "FLAG_COLOUR", "MVC", "OVERLAY_TINT", "SPLIT", "UP_AXES", "Closeup", "CloseupView",
            "RenderOptions", "RenderResult", "TextureError", "checker", "closeup", "face_centroids", "face_ids",
-           "face_vertices", "flat_normals", "over_render_budget", "overview_camera", "overview_image", "png_bytes",
-           "pyvista_installed", "render_corners", "render_mesh", "score_range", "to_pixels", "up_axis_of",
-           "used_points"]
+           "face_vertices", "flat_normals", "over_render_budget", "overview_camera", "png_bytes", "render_corners",
+           "render_mesh", "to_pixels", "up_axis_of", "used_points"]

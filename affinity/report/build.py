@@ -238,7 +238,7 @@ def overview_picture(mesh: Mesh, scores: QuadScores | None, view: tuple[tuple | 
                      step: StepTimer) -> tuple[np.ndarray | None, str | None]:
     """The pyvista overview of ``mesh`` coloured by ``scores`` from ``view`` (camera, up): the picture, or None
     and why there is none."""
-    from ..draw import INSTALL_HINT, overview_image, pyvista_installed
+    from ..view import INSTALL_HINT, overview_image, pyvista_installed
 
     if not pyvista_installed():
         return None, f"pyvista is not installed (the view extra: {INSTALL_HINT})"

@@ -491,7 +491,7 @@ def overview_section(result: MeshResult) -> Section:
     title = "3-D overview"
     if result.overview is None:
         return leave_out("overview", title, result.overview_note)
-    from ..draw import score_range
+    from ..view import score_range
 
     scores = result.scores.get(result.shown)
     bar = ""

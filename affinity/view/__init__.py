@@ -12,10 +12,9 @@ import importlib.util
 import numpy as np
 
 from ..attributes import attribute_named
+from ..draw import FLAG_COLOUR, UP_AXES, overview_camera, up_axis_of
 from ..lint import QuadScores
 from ..mesh import Mesh
-from .framing import UP_AXES
-from .shading import FLAG_COLOUR
 
 INSTALL_HINT = "pip install 'quad-affinity[view]'"
 SURFACE_GREY = "#d1d5db"
@@ -103,7 +102,6 @@ def build_scene(plotter, mesh: Mesh, scores: QuadScores | None, scalar_bar: bool
 def place_camera(plotter, mesh: Mesh, camera: tuple | None, up: str | None, size: tuple[int, int]) -> None:
     """``camera`` (eye, target, vertical fov) as in ``RenderOptions``; None frames the whole mesh from its
     broad side with its up axis (``affinity.draw.framing.overview_camera``, the report's view)."""
-    from .framing import overview_camera, up_axis_of
 
     up = up_axis_of(mesh, up)
     eye, target, fov = camera or overview_camera(mesh, size[0], size[1], up)
