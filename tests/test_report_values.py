@@ -168,10 +168,11 @@ def test_the_checker_finds_a_reach_into_a_draw_module(tmp_path):
     assert _draw_imports(source) == [("draw.closeup", ["outline"]), ("draw", ["closeup"])]
 
 
-def test_no_rule_code_is_written_into_report_or_draw():
-    """What is shown and how comes from the registries (any file type: templates and scripts too)."""
+def test_no_rule_code_is_written_where_things_are_shown():
+    """What is shown and how comes from the registries (any file type: templates and scripts too): report/,
+    draw/, study/, blender/ and the pyvista view."""
     literal = re.compile(r"[\"']Q10[1-3][\"']")
-    hits = [f"{path.relative_to(ROOT)}:{n}" for package in ("report", "draw")
+    hits = [f"{path.relative_to(ROOT)}:{n}" for package in ("report", "draw", "study", "blender", "view")
             for path in sorted((ROOT / "affinity" / package).rglob("*"))
             if path.is_file() and "vendor" not in path.parts
             for n, line in enumerate(path.read_text(errors="replace").splitlines(), 1) if literal.search(line)]
