@@ -152,6 +152,12 @@ class QuadBatch:
             self._indices[id(array)] = array.take(self.corners)
         return self._indices[id(array)]
 
+    def take(self, rows: np.ndarray) -> QuadBatch:
+        """The quads ``rows`` (n,) int64 of the batch as a batch of their own."""
+        size = self.texture_size
+        size = size if size is None or np.ndim(size) == 1 else np.asarray(size)[rows]
+        return QuadBatch(self.tables, self.settings, self.faces[rows], self.corners[:, rows], size)
+
     def texel_size(self, rows) -> np.ndarray:
         """(2,) or (n, 2) float64 texel grid of the quads ``rows`` (a slice or indices into the batch)."""
         size = np.asarray(self.texture_size, dtype=np.float64)
@@ -305,7 +311,7 @@ def lint_pass(mesh: Mesh, settings: Settings, visible: bool = True, scores: bool
         found, measured = {}, {}
         causes = Unmeasurable(batch)
         for rule in quad_rules + [rule for rule in scored if rule not in quad_rules]:
-            rows, values = _measured(batch, rule, causes)
+            rows, values = _measured(batch, rule, causes, None if rule in scored else thresholds[rule.code])
             if rule in scored:
                 measured[rule.code] = batch.faces[rows], values
             if rule not in quad_rules:
@@ -346,11 +352,17 @@ def lint_pass(mesh: Mesh, settings: Settings, visible: bool = True, scores: bool
     return MeshLint(sorted(hits, key=lambda h: order[h.code]), measured)
 
 
-def _measured(batch: QuadBatch, rule, causes: Unmeasurable) -> tuple[np.ndarray, np.ndarray]:
+def _measured(batch: QuadBatch, rule, causes: Unmeasurable, threshold: float | None = None
+              ) -> tuple[np.ndarray, np.ndarray]:
     """(n,) int64 rows into ``batch`` and (n,) float64 values of the quads ``rule``'s check measures; a scored
-    rule leaves out the quads one of its ``causes`` takes over (one finding per defect)."""
+    rule leaves out the quads one of its ``causes`` takes over (one finding per defect). With a
+    ``threshold``, a rule with a ``bound`` is measured only on the quads whose bound it flags there."""
+    rows = np.arange(len(batch))
+    if rule.bound is not None and threshold is not None:
+        rows = rows[rule.flagged(rule.bound(batch), threshold)]
+        batch = batch.take(rows)
     measured = rule.check(batch)
-    rows, values = np.arange(len(batch))[measured.rows], measured.values
+    rows, values = rows[measured.rows], measured.values
     if rule.scored:
         measured = ~causes.masked(rule)[rows]
         rows, values = rows[measured], values[measured]

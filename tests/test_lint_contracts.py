@@ -115,3 +115,28 @@ def test_no_check_reads_its_own_threshold(code, mixed_quads):
     for measured, taken in zip(readings[1:], rows[1:]):
         np.testing.assert_array_equal(taken, rows[0])
         np.testing.assert_array_equal(measured.values, readings[0].values)
+
+
+@pytest.mark.parametrize("code", [code for code, rule in RULES.items() if rule.bound is not None])
+def test_a_rules_bound_never_hides_a_finding(code, mixed_quads, monkeypatch):
+    """A bound only spares measuring quads it proves unflagged: at every threshold, lint with the bound finds
+    exactly what lint measuring every quad finds (the bound is also a true bound of each measured value)."""
+    from dataclasses import replace
+
+    rule = RULES[code]
+    batch = batch_of(mixed_quads, Settings())
+    measured = rule.check(batch)
+    bound = rule.bound(batch)[np.arange(len(batch))[measured.rows]]
+    assert np.all(measured.values <= bound if rule.flags == "above" else measured.values >= bound)
+    values = np.sort(measured.values)
+    thresholds = [-1e9, 0.0, *values[::40], *np.nextafter(values[::40], np.inf), 179.999, 180.0, 1e9]
+    for threshold in thresholds:
+        settings = Settings(select=[code], thresholds={code: float(threshold)})
+        with_bound = lint_mesh(mixed_quads, settings, visible=False)
+        monkeypatch.setitem(RULES, code, replace(rule, bound=None))
+        everything = lint_mesh(mixed_quads, settings, visible=False)
+        monkeypatch.setitem(RULES, code, rule)
+        assert [(h.code, h.faces.tolist(), h.values.tolist()) for h in with_bound] == \
+               [(h.code, h.faces.tolist(), h.values.tolist()) for h in everything]
+    concave = lint_mesh(mixed_quads, Settings(select=[code]), visible=False)
+    assert concave and 0 < len(concave[0].faces) < 400  # the default threshold flags some quads, not all

@@ -121,6 +121,10 @@ class Rule:
         (:class:`affinity.lint.QuadBatch`); ``"mesh"``, the file itself as face -1
         (:class:`affinity.lint.WholeMesh`: Q205, Q902)
     check : ``check(context) -> Measured``, the measure, vectorized over the context's faces
+    bound : ``bound(context) -> (Q,) float64``, optional and cheap: a bound on each quad's value on the side the
+        rule flags (above: a value is at most its bound), so that a quad whose bound is not flagged cannot be.
+        Lint measures only the quads whose bound is flagged at the threshold; a scored rule measures every
+        quad. The check itself never reads its threshold (Q203: no reflex corner, so at most 180 degrees)
     what, why, fix : the page's *What it does*, *Why it matters*, *How to fix*
     example : a 4- to 8-line OBJ that triggers this rule and no other
     example_output : the text lines ``affinity check`` prints for ``example``
@@ -146,6 +150,7 @@ class Rule:
     readings: Mapping[str, tuple[str, float]] = field(default_factory=dict)
     scope: str = "quad"
     check: Callable | None = None
+    bound: Callable | None = None
     what: str
     why: str
     example: str

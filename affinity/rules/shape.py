@@ -106,7 +106,14 @@ def nonplanar(quads) -> Measured:
     return Measured(slice(None), fold_degrees(quads.planar, quads.settings.diagonal))
 
 
-@rule(code="Q203", name="concave-quad", level="info", unit="degrees", default_threshold=180.0, references=REFERENCES)
+def at_most_straight(quads) -> np.ndarray:
+    """(Q,) float64 bound of Q203's value: 180 degrees where no corner turns clockwise (every interior angle
+    is 180 - atan2(turn, dot) with turn >= 0, turns within the tolerance read as 0), +inf elsewhere."""
+    return np.where(quads.planar.reflex.any(axis=1), np.inf, 180.0)
+
+
+@rule(code="Q203", name="concave-quad", level="info", unit="degrees", default_threshold=180.0,
+      references=REFERENCES, bound=at_most_straight)
 def concave(quads) -> Measured:
     """One corner is reflex.
 
