@@ -31,6 +31,8 @@ from .demo import MeshInput
 
 #: Methods drawn beside the hybrid when it sent quads to mvc (``exact``: the ray / bilinear-patch reference).
 COMPARED_METHODS = ("split", "mvc", "exact")
+#: Why a mesh over the renderer's budget has no overview (pyvista would draw the same stack of faces, for minutes).
+OVER_BUDGET = "the mesh is over the renderer's budget (see the render's line)"
 #: The overview's pyvista and the charts' matplotlib: about 2 s of imports, done on a thread while the
 #: renders run (see :func:`import_in_background`).
 SLOW_IMPORTS = ("pyvista.plotting", "matplotlib.figure", "matplotlib.backends.backend_svg")
@@ -128,7 +130,6 @@ class MeshResult:
     settings: Settings
     seconds: float = 0.0
     mesh: Mesh | None = None
-    scores: dict[str, QuadScores] = field(default_factory=dict)
     shown: str | None = None
     texture: str = ""
     renders: dict = field(default_factory=dict)
@@ -148,6 +149,12 @@ class MeshResult:
     @property
     def readable(self) -> bool:
         return self.file.error is None and self.file.skipped is None
+
+    @property
+    def scores(self) -> dict[str, QuadScores]:
+        """Every quad's scores of each scored rule the mesh has an attribute for, from the one lint
+        (:attr:`FileReport.scores`)."""
+        return self.file.scores
 
     @property
     def drawn(self) -> str:
@@ -342,11 +349,11 @@ def _collect_pictures(item: MeshInput, file: FileReport, mesh: Mesh, settings: S
     from ..draw import checker, over_render_budget
 
     shown = shown_code(file, file.scores)
-    found = {"scores": file.scores, "shown": shown, "texture": _texture_label(mesh, item.view, options.texture)}
+    found = {"shown": shown, "texture": _texture_label(mesh, item.view, options.texture)}
     problem = over_render_budget(mesh)
     if problem:  # no pictures: framing and drawing it would take gigabytes
         return {**found, "render_error": problem,
-                "overview_note": "the mesh is over the renderer's budget (see the render's line)"}
+                "overview_note": OVER_BUDGET}
     view = view_of(mesh, item.view, options)
     checks = item.view.checks and mesh.texcoords is not None
     texture = options.texture or (checker(512, item.view.checks) if checks else None)
@@ -359,7 +366,7 @@ def _collect_pictures(item: MeshInput, file: FileReport, mesh: Mesh, settings: S
         timer("stability")
         stability = render_stability(rendered.renders["hybrid"])
     if rendered.over_budget:
-        overview, note = None, "the mesh is over the renderer's budget (see the render's line)"
+        overview, note = None, OVER_BUDGET
     else:
         overview, note = overview_picture(mesh, file.scores.get(shown), view, options.size, timer)
     places, closeups, dropped = draw_closeups(mesh, file.hits, settings, options, timer) if mesh.n_faces else (
