@@ -130,8 +130,8 @@ class MeshResult:
     settings: Settings
     seconds: float = 0.0
     mesh: Mesh | None = None
-    shown: str | None = None
     texture: str = ""
+    shown: str | None = None
     renders: dict = field(default_factory=dict)
     render_error: str | None = None
     overview: np.ndarray | None = None
