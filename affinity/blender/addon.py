@@ -33,8 +33,9 @@ from ..rules import RULES, number_text, with_unit
 from ..settings import DIAGONALS, MEASURES, Settings
 from . import compat
 from .check import check_object, face_error, finding_units, severity
-from .convert import ERROR_ATTRIBUTE, ERROR_COLOR, base_color_texture, polygon_corners
+from .convert import ERROR_ATTRIBUTE, ERROR_COLOR, polygon_corners
 from .fix import fix_object
+from .materials import material_images
 
 #: Rules the panel offers: the per-face and per-mesh ones (Q9xx are about files).
 PANEL_RULES = [code for code in RULES if not code.startswith("Q9")]
@@ -61,8 +62,8 @@ def _settings_annotations() -> dict:
         ),
         "texture_size": IntProperty(
             name="Texture size", default=0, min=0, soft_max=16384,
-            description="Pixels for the texel unit when the Base Color image is not a file on disk "
-                        f"(0: that image's size, or {defaults.texture_size} without one)",
+            description="Pixels for the texel unit of faces whose material reads no image "
+                        f"(0: {defaults.texture_size})",
         ),
         "use_modifiers": BoolProperty(
             name="With modifiers", default=False,
@@ -373,19 +374,21 @@ class AFFINITY_UL_results(bpy.types.UIList):
 
 
 def texture_line(obj, props) -> str:
-    """What the panel says about the texel unit of the active object.
+    """What the panel says about the texel unit of the active object's active material.
 
-    As in ``affinity check``, an image file wins over the size set here; the set
-    size wins over a packed or generated image's own size.
+    As in ``affinity check``, an image the material reads sets the unit (its size, as a file's
+    header does; Blender reads it, file, packed, generated or UDIM alike); the size set here
+    counts only where no image is read.
     """
-    texture = base_color_texture(obj.active_material) if obj is not None and obj.type == "MESH" else None
-    if texture is not None and texture.path is not None:
-        return f"Texture: {texture.image} {texture.size[0]} x {texture.size[1]} px (file)"
+    material = obj.active_material if obj is not None and obj.type == "MESH" else None
+    image = next((use.image for use in material_images(material)), None) if material is not None else None
+    if image is not None and image.source == "TILED":
+        return f"Texture: {image.name}, {len(image.tiles)} UDIM tiles (read by Blender)"
+    if image is not None:
+        return f"Texture: {image.name} {image.size[0]} x {image.size[1]} px (read by Blender)"
     if props.texture_size > 0:
         return f"Texture size: {props.texture_size} px (set here)"
-    if texture is not None:
-        return f"Texture: {texture.image} {texture.size[0]} x {texture.size[1]} px (not a file)"
-    return f"Texture size: {Settings().texture_size} px (no Base Color image)"
+    return f"Texture size: {Settings().texture_size} px (no image)"
 
 
 class AFFINITY_PT_panel(bpy.types.Panel):

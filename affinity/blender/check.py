@@ -50,31 +50,27 @@ def findings(obj, **settings) -> list[dict]:
 def check_object(obj, **options) -> ObjectCheck:
     """:func:`findings` with the conversion, the raw hits and the notes for the panel.
 
-    Texture size for the texel unit, in order: the image file named by a material
-    (as ``affinity check`` reads ``map_Kd``), an explicit ``texture_size``, the
-    size of the active material's Base Color image (packed or generated), the
-    default of :class:`~affinity.settings.Settings`.
+    Textures are Blender's images that the materials read (:mod:`.texturemaps`), held in memory
+    while the lint runs: each quad's texel unit is its material's image size (a UDIM tile's own), as
+    ``affinity check`` reads a file's header, else ``texture_size``; Q101 is read through them (C).
     """
     from ..findings import settle
     from ..lint import lint_mesh
     from ..rules import RULES, resolve_codes
     from ..settings import Settings
+    from ..textures.held import holding
 
     convert = {k: options.pop(k) for k in _CONVERSION_OPTIONS if k in options}
     conversion = convert_object(obj, **convert)
-    mesh, texture = conversion.mesh, conversion.texture
+    mesh = conversion.mesh
     notes = list(conversion.notes)
     if conversion.uv_layer is None:
         notes.extend(f"{code} skipped: the mesh has no UV map"
                      for code in resolve_codes(options.get("select"), options.get("ignore"))
                      if RULES[code].scored and RULES[code].attribute == "texcoords")
-    if mesh.texture_path() is None and texture is not None and "texture_size" not in options:
-        options["texture_size"] = max(texture.size)
-        if texture.size[0] != texture.size[1]:
-            notes.append(f"texture {texture.image} is not square and not a file: "
-                         f"texels counted at {max(texture.size)} px both ways")
     settings = Settings(**options)
-    hits = settle(lint_mesh(mesh, settings), settings, list(mesh.group_names))  # levels and units, as check does
+    with holding(conversion.textures.held):
+        hits = settle(lint_mesh(mesh, settings), settings, list(mesh.group_names))  # levels and units, as check does
     rows = _finding_dicts(mesh, hits, settings, conversion.original_face if convert.get("evaluated") else None)
     return ObjectCheck(conversion, settings, hits, rows, notes)
 

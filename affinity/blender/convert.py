@@ -19,18 +19,19 @@ drops attributes leaves no mapping at all (``original_face`` is None), which
 turns selection off.
 
 ``bpy`` itself is only imported inside the functions that need the running
-Blender (depsgraph access, ``bpy.path``).
+Blender (depsgraph access). Textures are read from the materials' images by
+:mod:`.texturemaps`, through Blender (:mod:`.images`).
 """
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..mesh import Mesh
 from . import compat
+from .texturemaps import ObjectTextures, object_textures
 
 #: Face attribute that carries original polygon indices (+ 1) through the modifier stack.
 ORIGINAL_FACE = "affinity_original_face"
@@ -38,20 +39,6 @@ ORIGINAL_FACE = "affinity_original_face"
 #: domain) for the viewport's Attribute colouring. The colours are never read back as vertex colours.
 ERROR_ATTRIBUTE = "affinity_error"
 ERROR_COLOR = "affinity_error_color"
-
-
-@dataclass(eq=False)
-class Texture:
-    """The first Image Texture feeding a material's Base Color.
-
-    ``size`` is (width, height) in pixels; ``path`` the absolute file path when
-    the image is a readable file on disk (None for packed or generated images).
-    """
-
-    material: str
-    image: str
-    size: tuple[int, int]
-    path: str | None
 
 
 @dataclass(eq=False)
@@ -69,8 +56,8 @@ class Conversion:
         The uv map that was read, None when the mesh has none.
     color_attribute : str or None
         The colour attribute that was read, None when there is none.
-    texture : Texture or None
-        The image of the active material's Base Color.
+    textures : ObjectTextures
+        The images the materials read through ``uv_layer``, held while the lint runs.
     notes : list of str
         What the conversion could not do, for the user.
     """
@@ -79,7 +66,7 @@ class Conversion:
     original_face: np.ndarray | None
     uv_layer: str | None
     color_attribute: str | None
-    texture: Texture | None
+    textures: ObjectTextures
     notes: list[str] = field(default_factory=list)
 
 
@@ -170,8 +157,8 @@ def _convert(obj, me, uv_layer: str | None) -> Conversion:
 
     materials = [slot.material for slot in obj.material_slots]
     names = [m.name if m is not None else "" for m in materials]
-    textures = {t.material: t for t in (base_color_texture(m) for m in materials if m is not None) if t}
-    active = obj.active_material
+    render_layer = next((uv.name for uv in me.uv_layers if uv.active_render), None)
+    textures = object_textures(materials, layer.name if layer is not None else None, render_layer)
     mesh = Mesh(
         path=obj.name,
         positions=positions,
@@ -188,10 +175,11 @@ def _convert(obj, me, uv_layer: str | None) -> Conversion:
         material_names=names,
         face_material=compat.read_ints(me.polygons, "material_index").astype(np.int32) if names
         else np.full(n_faces, -1, dtype=np.int32),
-        material_textures={name: t.path for name, t in textures.items() if t.path is not None},
+        material_textures=textures.grid_maps,
+        material_maps=textures.maps,
     )
-    texture = textures.get(active.name) if active is not None else None
-    return Conversion(mesh, None, layer.name if layer is not None else None, color_name, texture)
+    return Conversion(mesh, None, layer.name if layer is not None else None, color_name, textures,
+                      list(textures.notes))
 
 
 def polygon_corners(me) -> tuple[np.ndarray, np.ndarray]:
@@ -228,49 +216,3 @@ def _split_by_corner_color(positions, corner_vertex, corner_rgb):
     keys = np.column_stack([corner_vertex.astype(np.float64), corner_rgb])
     unique, inverse = np.unique(keys, axis=0, return_inverse=True)
     return positions[unique[:, 0].astype(np.int64)], inverse.reshape(-1).astype(np.int64), unique[:, 1:]
-
-
-def base_color_texture(material) -> Texture | None:
-    """The first Image Texture node upstream of the Base Color of the material's Principled BSDF.
-
-    The BSDF is the first one found walking up from the active Material Output's
-    Surface input; the image node the first one found walking up (breadth first)
-    from its Base Color. None when the material has no such node or image.
-    """
-    tree = compat.material_node_tree(material)
-    output = tree.get_output_node("ALL") if tree is not None else None
-    if output is None:
-        return None
-    bsdf = _upstream(output.inputs["Surface"], "BSDF_PRINCIPLED", lambda node: True)
-    if bsdf is None:
-        return None
-    node = _upstream(bsdf.inputs["Base Color"], "TEX_IMAGE", lambda node: node.image is not None)
-    if node is None:
-        return None
-    image = node.image
-    return Texture(material.name, image.name, (int(image.size[0]), int(image.size[1])), _image_file(image))
-
-
-def _upstream(socket, node_type: str, accept):
-    """The first node of ``node_type`` that ``accept`` takes, walking links up from ``socket``."""
-    queue = [link.from_node for link in socket.links]
-    seen = set()
-    while queue:
-        node = queue.pop(0)
-        if node.name in seen:
-            continue
-        seen.add(node.name)
-        if node.type == node_type and accept(node):
-            return node
-        queue.extend(link.from_node for s in node.inputs for link in s.links)
-    return None
-
-
-def _image_file(image) -> str | None:
-    """The absolute path of an image that is a readable file on disk, else None."""
-    import bpy
-
-    if image.source != "FILE" or image.packed_file is not None or not image.filepath:
-        return None
-    path = os.path.normpath(bpy.path.abspath(image.filepath, library=image.library))
-    return path if os.path.isfile(path) else None

@@ -22,14 +22,17 @@ def fix_object(obj, faces: np.ndarray | None = None, level: str = "warning", max
     indices, when given); ``options`` are :func:`.check.check_object`'s. Returns the
     :class:`affinity.fix.FixPlan`, faces numbered as the polygons were before the fix."""
     from ..fix import FixSettings, plan_fix, refine_mesh
+    from ..textures.held import holding
     from .check import check_object
 
     checked = check_object(obj, **options)
     mesh = checked.conversion.mesh
     chosen = None if faces is None else np.asarray(faces, dtype=np.int64)
-    plan = plan_fix(mesh, FixSettings(lint=checked.settings, level=level, max_refine=max_refine, faces=chosen))
-    if not plan.empty:
-        _write_back(obj, mesh, refine_mesh(mesh, plan), checked.conversion.uv_layer)
+    with holding(checked.conversion.textures.held):  # the fix lints through the images, as the check did
+        plan = plan_fix(mesh, FixSettings(lint=checked.settings, level=level, max_refine=max_refine, faces=chosen))
+        refined = None if plan.empty else refine_mesh(mesh, plan)
+    if refined is not None:
+        _write_back(obj, mesh, refined, checked.conversion.uv_layer)
     return plan
 
 

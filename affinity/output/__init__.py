@@ -315,11 +315,13 @@ def _shared_geometry(report: FileReport, code: str, prims: list[str | None],
 def _visible_fields(hits: RuleHits, take: np.ndarray, path: str) -> list[dict]:
     """Per finding at ``take``: the Finding fields Q101's visible reading sets (``threshold``, ``unit``,
     ``shift``, ``bound``, ``texture``, ``role``) and the message's ``remark``; empty where C was not read."""
+    from ..textures.held import PREFIX as HELD
     from ..textures.visible import BOUND_NAMES
 
     columns = hits.visible
     folder = os.path.dirname(os.path.abspath(path))
-    relative = [os.path.relpath(os.path.abspath(texture), folder) for texture in columns.textures]  # once each
+    relative = [texture.removeprefix(HELD) if texture.startswith(HELD) else  # a Blender image: its name
+                os.path.relpath(os.path.abspath(texture), folder) for texture in columns.textures]  # once each
     rows = []
     for shift, bound, pick in zip(columns.shifts[take].tolist(), columns.bounds[take].tolist(),
                                   columns.picks[take].tolist()):

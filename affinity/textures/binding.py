@@ -13,8 +13,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..loaders.imagesize import ImageHeader, ImageUnreadable, read_header
+from ..loaders.imagesize import ImageHeader
 from ..loaders.texturemaps import ROLES, TextureMap, udim_tile_of, udim_tiles
+from .decode import header_or_reason
 
 
 @dataclass(frozen=True, eq=False)
@@ -146,10 +147,7 @@ def texel_grid(mesh, texture_size: int, faces: np.ndarray | None = None) -> Texe
     headers: dict[str, ImageHeader | None] = {}
     for bound in reversed(bound_textures(mesh, faces)):  # the base colour map, listed first, is written last
         if bound.path not in headers:
-            try:
-                headers[bound.path] = read_header(bound.path)
-            except ImageUnreadable:
-                headers[bound.path] = None
+            headers[bound.path] = header_or_reason(bound.path)[0]
         if headers[bound.path] is not None:
             sizes[bound.faces] = headers[bound.path].size
             assumed[bound.faces] = False

@@ -21,6 +21,7 @@ from functools import cached_property, partial
 import numpy as np
 
 from ..loaders.imagesize import ImageHeader, ImageUnreadable, open_image_file, read_header
+from .held import held_texture
 
 #: Pixels (width x height) a texture may have to be decoded: 8192 x 8192.
 DECODE_BUDGET = 1 << 26
@@ -128,7 +129,11 @@ _cache_lock = threading.Lock()
 
 
 def header_or_reason(path: str) -> tuple[ImageHeader | None, str | None]:
-    """The header of the texture ``path``, or None and why not (``"missing"``, ``"a Git LFS pointer"``, ...)."""
+    """The header of the texture ``path`` (a held one's, :mod:`~affinity.textures.held`), or None and why not
+    (``"missing"``, ``"a Git LFS pointer"``, ...)."""
+    held = held_texture(path)
+    if held is not None:
+        return held.header, None
     try:
         return read_header(path), None
     except ImageUnreadable as err:
@@ -140,6 +145,8 @@ def why_not_decoded(path: str | None, budget: int = DECODE_BUDGET) -> str | None
     over ``budget``, a format not decoded), else None. A file whose header is fine may still fail to decode."""
     if path is None:
         return "no texture"
+    if held_texture(path) is not None:
+        return None
     header, reason = header_or_reason(path)
     if header is None:
         return reason
@@ -154,8 +161,12 @@ def decode(path: str, budget: int = DECODE_BUDGET) -> DecodedTexture:
     """The texture at ``path`` decoded (cached for the run, see the module's notes).
 
     Raises :class:`TextureUnusable` naming why it is not decoded: no readable header, more pixels
-    than ``budget``, a format not decoded here, or a file that does not decode.
+    than ``budget``, a format not decoded here, or a file that does not decode. A held texture
+    (:mod:`~affinity.textures.held`) is returned as it is held.
     """
+    held = held_texture(path)
+    if held is not None:
+        return held
     header, _ = header_or_reason(path)
     refused = why_not_decoded(path, budget)
     if refused is not None:

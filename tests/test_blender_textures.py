@@ -1,0 +1,223 @@
+"""Textures inside Blender: the add-on reads Blender's own images (never Pillow) and agrees with the command line.
+
+Runs in the bpy venv, which has no Pillow (.ci/run installs it without; the first test says so). The command
+line's side of each comparison runs in a Python that has Pillow: ``AFFINITY_CLI_PYTHON``, else the CI's main
+venv ``.venv-ci/bin/python`` (built by .ci/run before this leg); the comparisons skip, naming why, only where
+neither exists. Both decode the same PNG bytes: Pillow on the command line, Blender here.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+bpy = pytest.importorskip("bpy")
+
+from affinity.blender import addon, findings  # noqa: E402
+from affinity.blender.check import check_object  # noqa: E402
+from affinity.blender.fix import fix_object  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+SPOT = ROOT.parent / "shared" / "meshes" / "textured" / "spot_control_mesh_textured.obj"
+SCORED = ("Q101", "Q102", "Q103")
+LEVELS = ("info", "warning", "error")
+
+
+@pytest.fixture(autouse=True)
+def empty_scene():
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    if not hasattr(bpy.types.Scene, "affinity"):
+        addon.register()
+    yield
+
+
+def cli_python() -> str:
+    """A Python with Pillow that runs this checkout's command line, or a skip saying why there is none."""
+    candidates = [os.environ.get("AFFINITY_CLI_PYTHON"), str(ROOT / ".venv-ci" / "bin" / "python")]
+    for python in filter(None, candidates):
+        if Path(python).is_file():
+            return python
+    pytest.skip("no Python with Pillow for the command line's side: set AFFINITY_CLI_PYTHON or build .venv-ci "
+                "(.ci/run does, before this leg)")
+
+
+def run_cli(*args: str) -> dict:
+    """``affinity ARGS --format json`` of this checkout, run by :func:`cli_python`."""
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    result = subprocess.run([cli_python(), "-m", "affinity.cli", *args, "--format", "json"], capture_output=True,
+                            text=True, env=env, timeout=600, check=False)
+    assert result.returncode in (0, 1), result.stderr
+    return json.loads(result.stdout)
+
+
+def spot():
+    if not SPOT.is_file():
+        pytest.skip(f"{SPOT} not found (the shared meshes)")
+    bpy.ops.wm.obj_import(filepath=str(SPOT))  # Blender's importer binds the MTL's map_Kd as an Image Texture
+    return bpy.context.object
+
+
+def by_face(rows, codes=("Q101",)) -> dict[tuple[str, int], dict]:
+    return {(r["code"], r["face"]): r for r in rows if r["code"] in codes}
+
+
+def test_this_venv_has_no_pillow():
+    """The Blender leg runs where Blender's users are: no Pillow (bpy does not bring it)."""
+    assert importlib.util.find_spec("PIL") is None
+
+
+def test_spot_check_gives_the_command_lines_q101_faces_levels_and_values():
+    obj = spot()
+    rows = findings(obj)
+    assert "PIL" not in sys.modules
+    cli = run_cli("check", str(SPOT))["findings"]
+    ours, theirs = by_face(rows), by_face(cli)
+    assert ours.keys() == theirs.keys()
+    assert len(ours) > 50
+    assert {r["unit"] for r in ours.values()} == {"1/255"}  # C read through the texture on both sides
+    assert {k: r["level"] for k, r in ours.items()} == {k: r["level"] for k, r in theirs.items()}
+    keys = sorted(ours)
+    c_here, c_there = (np.array([found[k]["value"] for k in keys]) for found in (ours, theirs))
+    assert np.abs(c_here - c_there).max() < 1.0  # C to one step of 1/255 (float32 positions against the OBJ's text)
+    assert (c_here >= 8).sum() > 10  # spots' edges: plainly visible creases
+    np.testing.assert_allclose([ours[k]["shift"] for k in keys], [theirs[k]["shift"] for k in keys], rtol=1e-4)
+    assert {ours[k]["texture"] for k in keys} == {"spot_texture.png"}
+    # The other rules agree too (faces are Blender's polygons, the OBJ's faces in order).
+    others = {r["code"] for r in cli} - {"Q101"}
+    assert by_face(rows, others).keys() == by_face(cli, others).keys()
+
+
+def test_spot_fix_then_check_leaves_only_the_faces_fix_lists_as_the_command_line_does():
+    obj = spot()
+    mesh = obj.data
+    tag = mesh.attributes.new("spot_face", "INT", "FACE")  # carried to untouched faces and a new face's pieces
+    tag.data.foreach_set("value", np.arange(len(mesh.polygons), dtype=np.int32))
+    plan = fix_object(obj, level="warning")
+    assert len(plan.refine_faces) > 10
+    cli = run_cli("fix", "--dry-run", str(SPOT))
+    (entry,) = cli["files"] if "files" in cli else [cli]
+    assert sorted(left["face"] for left in entry["left"]) == plan.left_faces.tolist()
+    assert [left["reason"] for left in sorted(entry["left"], key=lambda x: x["face"])] == list(plan.left_reasons)
+    assert sorted(r["face"] for r in entry["refine"]) == plan.refine_faces.tolist()
+
+    after = findings(obj)
+    source = np.zeros(len(obj.data.polygons), dtype=np.int32)
+    obj.data.attributes["spot_face"].data.foreach_get("value", source)
+    flagged = {int(source[r["face"]]) for r in after
+               if r["code"] in SCORED and LEVELS.index(r["level"]) >= LEVELS.index("warning")}
+    assert flagged <= set(plan.left_faces.tolist())
+
+
+def _image_with_texels(name: str, texels: np.ndarray):
+    """A Blender image holding ``texels`` (H, W, 4) uint8, row 0 the top (Blender stores rows bottom-up)."""
+    height, width = texels.shape[:2]
+    image = bpy.data.images.new(name, width, height, alpha=True)
+    image.pixels.foreach_set((texels[::-1].astype(np.float32) / 255).ravel())
+    return image
+
+
+def _stripes(width: int, height: int, seed: int) -> np.ndarray:
+    """(H, W, 4) uint8: sharp-edged blobs, so a uv shift crosses edges (C well above a step)."""
+    rng = np.random.default_rng(seed)
+    y, x = np.mgrid[0:height, 0:width]
+    texels = np.full((height, width, 4), 255, dtype=np.uint8)
+    for _ in range(12):
+        cx, cy, r = rng.uniform(0, width), rng.uniform(0, height), rng.uniform(2, max(width, height) / 4)
+        texels[(x - cx) ** 2 + (y - cy) ** 2 < r * r, :3] = rng.integers(0, 256, 3)
+    return texels
+
+
+def _trapezoids(uv_offsets):
+    """One trapezoid quad per uv offset, each carrying the unit uv square moved by its offset: Q101 flags each."""
+    positions, faces, uv = [], [], []
+    for k, (du, dv) in enumerate(uv_offsets):
+        x = 3.0 * k
+        positions += [(x, 0, 0), (x + 2, 0, 0), (x + 1.5, 1, 0), (x + 0.5, 1, 0)]
+        faces.append(tuple(range(4 * k, 4 * k + 4)))
+        uv += [(du, dv), (du + 1, dv), (du + 1, dv + 1), (du, dv + 1)]
+    mesh = bpy.data.meshes.new("trapezoids")
+    mesh.from_pydata(positions, [], faces)
+    layer = mesh.uv_layers.new(name="UVMap")
+    layer.data.foreach_set("uv", np.array(uv, dtype=np.float32).ravel())
+    obj = bpy.data.objects.new("trapezoids", mesh)
+    bpy.context.scene.collection.objects.link(obj)
+    bpy.context.view_layer.objects.active = obj
+    obj.select_set(True)
+    return obj
+
+
+def _material(obj, image):
+    material = bpy.data.materials.new("Textured")
+    if material.node_tree is None:  # before Blender 5.0 a new material has no nodes
+        material.use_nodes = True
+    tree = material.node_tree
+    node = tree.nodes.new("ShaderNodeTexImage")
+    node.image = image
+    tree.links.new(node.outputs["Color"], tree.nodes["Principled BSDF"].inputs["Base Color"])
+    obj.data.materials.append(material)
+
+
+def _obj_file(obj, folder: Path, map_kd: str) -> Path:
+    """``obj`` written as an OBJ (Blender's exporter) whose MTL names ``map_Kd``."""
+    path = folder / "mesh.obj"
+    bpy.ops.wm.obj_export(filepath=str(path), export_materials=False, export_selected_objects=True,
+                          export_normals=False)
+    (folder / "mesh.mtl").write_text(f"newmtl Textured\nmap_Kd {map_kd}\n")
+    path.write_text("mtllib mesh.mtl\nusemtl Textured\n" + path.read_text())
+    return path
+
+
+def test_packed_image_is_read_through_blender_as_the_command_line_reads_its_png(tmp_path):
+    obj = _trapezoids([(0, 0)])
+    texels = _stripes(48, 32, seed=1)
+    image = _image_with_texels("packed", texels)
+    image.filepath_raw = str(tmp_path / "packed.png")
+    image.file_format = "PNG"
+    image.save()
+    image.pack()
+    (tmp_path / "packed.png").rename(tmp_path / "on_disk.png")  # Blender has only the packed bytes now
+    assert image.packed_file is not None
+    _material(obj, image)
+    ours = by_face(findings(obj, select=["Q101"], thresholds={"Q101": 0}))
+    theirs = by_face(run_cli("check", "--select", "Q101", "--threshold", "Q101=0",
+                             str(_obj_file(obj, tmp_path, "on_disk.png")))["findings"])
+    assert ours.keys() == theirs.keys() == {("Q101", 0)}
+    here, there = ours["Q101", 0], theirs["Q101", 0]
+    assert here["unit"] == there["unit"] == "1/255" and here["texture"] == "packed"
+    assert abs(here["value"] - there["value"]) < 1.0 and there["value"] > 8
+    assert here["shift"] == pytest.approx(there["shift"], rel=1e-5)  # counted in the image's 48 x 32 texels
+
+
+def test_udim_tiles_are_each_read_at_their_own_size(tmp_path):
+    obj = _trapezoids([(0, 0), (1, 0)])  # tile 1001, then 1002
+    image = bpy.data.images.new("tiles", 64, 64, tiled=True)
+    with bpy.context.temp_override(edit_image=image):
+        assert bpy.ops.image.tile_add(number=1002, count=1, fill=True, width=32, height=16) == {"FINISHED"}
+    assert [tuple(t.size) for t in image.tiles] == [(64, 64), (32, 16)]
+    image.filepath_raw = str(tmp_path / "tiles.<UDIM>.png")
+    image.file_format = "PNG"
+    for tile, (width, height), seed in ((1001, (64, 64), 2), (1002, (32, 16), 3)):
+        single = _image_with_texels(f"tile{tile}", _stripes(width, height, seed))
+        single.filepath_raw = str(tmp_path / f"tiles.{tile}.png")
+        single.file_format = "PNG"
+        single.save()
+    image.reload()  # the tiles now hold the files' texels
+    _material(obj, image)
+    ours = by_face(findings(obj, select=["Q101"], thresholds={"Q101": 0}))
+    theirs = by_face(run_cli("check", "--select", "Q101", "--threshold", "Q101=0",
+                             str(_obj_file(obj, tmp_path, "tiles.<UDIM>.png")))["findings"])
+    assert ours.keys() == theirs.keys() == {("Q101", 0), ("Q101", 1)}
+    for key in ours:
+        assert ours[key]["unit"] == theirs[key]["unit"] == "1/255"
+        assert abs(ours[key]["value"] - theirs[key]["value"]) < 1.0
+        assert ours[key]["shift"] == pytest.approx(theirs[key]["shift"], rel=1e-5)
+    # The same uv crease counted in each tile's own texels: tile 1002 is half as wide and a quarter as high.
+    assert ours["Q101", 1]["shift"] < 0.6 * ours["Q101", 0]["shift"]
+    assert max(ours[key]["value"] for key in ours) > 8
