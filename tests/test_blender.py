@@ -6,7 +6,6 @@ one Blender session per process: every test starts from an empty factory scene.
 
 from __future__ import annotations
 
-import json
 import os
 import subprocess
 import sys
@@ -16,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers.blender_cli import run_cli_json
 
 bpy = pytest.importorskip("bpy")
 
@@ -73,15 +73,6 @@ def textured(obj, image_path: Path, size=(512, 256)):
     return material
 
 
-def cli_json(path: Path, *args: str) -> dict:
-    result = subprocess.run(
-        [sys.executable, "-m", "affinity.cli", "check", "--format", "json", *args, str(path)],
-        capture_output=True, text=True, timeout=300, check=False,
-    )
-    assert result.returncode in (0, 1), result.stderr
-    return json.loads(result.stdout)
-
-
 def by_code_and_face(rows) -> dict[tuple[str, int], float]:
     """Each finding's texel shift: Q101's value, or its ``shift`` where the visible reading read C."""
     return {(r["code"], r["face"]): r.get("shift", r["value"]) for r in rows}
@@ -97,7 +88,7 @@ def test_uv_sphere_gives_the_same_findings_as_its_obj_export_checked_by_the_cli(
 
     rows = findings(sphere)
     in_memory = by_code_and_face(rows)
-    document = cli_json(exported)
+    document = run_cli_json("check", str(exported))
     assert set(document["findings"][0]) <= set(rows[0])  # every key of a JSON finding, and more
     # The checker beside the export decodes on both sides: Q101 is read through it (C, design.md's visible
     # reading), the texel shift kept as "shift", and the levels are C's, as the CLI says.
@@ -134,11 +125,12 @@ def test_texel_unit_follows_the_base_color_image(tmp_path):
 def test_panel_names_the_texture_that_sets_the_texel_unit(tmp_path):
     sphere = uv_sphere()
     props = bpy.context.scene.affinity
-    assert addon.texture_line(sphere, props) == "Texture size: 1024 px (no Base Color image)"
+    assert addon.texture_line(sphere, props) == "Texture size: 1024 px (no image)"
     props.texture_size = 300
     assert addon.texture_line(sphere, props) == "Texture size: 300 px (set here)"
     textured(sphere, tmp_path / "checker.png")
-    assert addon.texture_line(sphere, props) == "Texture: checker 512 x 256 px (file)"
+    # As on the command line, the image's own size wins over the size set (which counts where none is read).
+    assert addon.texture_line(sphere, props) == "Texture: checker 512 x 256 px (read by Blender)"
 
 
 def test_world_matrix_is_applied():
@@ -381,19 +373,59 @@ def test_workbench_render_colours_the_flagged_faces(tmp_path):
     assert coloured_rows.size and coloured_rows.min() < 36
 
 
+def bpy_alone(folder: Path) -> Path:
+    """A site folder holding bpy and the distributions it requires, recursively, and nothing else: what a
+    fresh venv with only ``pip install bpy`` has (symbolic links to this venv's copies)."""
+    from importlib import metadata
+
+    folder.mkdir()
+    todo, seen = ["bpy"], set()
+    while todo:
+        name = todo.pop().lower().replace("_", "-")
+        if name in seen:
+            continue
+        seen.add(name)
+        dist = metadata.distribution(name)
+        todo += [r.split(";")[0].split("[")[0].split("<")[0].split(">")[0].split("=")[0].split("!")[0].strip()
+                 for r in dist.requires or [] if "extra ==" not in r]
+        for top in {Path(str(f)).parts[0] for f in dist.files or []} - {"..", "bin"}:
+            source = Path(dist.locate_file(top))
+            if source.exists() and not (folder / top).exists():
+                (folder / top).symlink_to(source)
+    return folder
+
+
 def _run_isolated(script: str, env_extra: dict, cwd: Path) -> subprocess.CompletedProcess:
     """Run ``script`` in this interpreter without site (no .pth files, so no editable install of
-    the project) and without PYTHONPATH: only bpy's site-packages is put on sys.path."""
-    site_packages = sysconfig.get_paths()["purelib"]  # where bpy and NumPy are installed
+    the project) and without PYTHONPATH: only :func:`bpy_alone`'s folder is put on sys.path."""
+    site_packages = bpy_alone(cwd / "bpy-alone")
     env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
     env.update(env_extra)
     return subprocess.run(
-        [sys.executable, "-S", "-c", script, site_packages],
+        [sys.executable, "-S", "-c", script, str(site_packages)],
         capture_output=True, text=True, env=env, cwd=cwd, timeout=600, check=False,
     )
 
 
-def test_extension_zip_installs_into_bpy_and_runs_check(tmp_path):
+#: A UV sphere whose material's Base Color is a packed 256 x 256 generated image (a script: run in a bare bpy).
+PACKED_GRID_SPHERE = """
+bpy.ops.mesh.primitive_uv_sphere_add(segments=16, ring_count=8)
+image = bpy.data.images.new("grid", 256, 256)
+image.generated_type = "COLOR_GRID"
+image.pack()
+material = bpy.data.materials.new("Grid")
+if material.node_tree is None:
+    material.use_nodes = True
+node = material.node_tree.nodes.new("ShaderNodeTexImage")
+node.image = image
+material.node_tree.links.new(node.outputs["Color"], material.node_tree.nodes["Principled BSDF"].inputs["Base Color"])
+bpy.context.object.data.materials.append(material)
+"""
+
+
+def test_extension_zip_installs_into_bpy_and_runs_check_on_a_textured_mesh(tmp_path):
+    """The zip alone, in a Python that has bpy and what bpy requires (no Pillow, pathspec, tqdm): Check reads
+    a packed image's texels through Blender (C in 1/255 steps)."""
     from affinity.blender.build import build
 
     archive = build(tmp_path / "dist")
@@ -405,18 +437,23 @@ bpy.ops.wm.read_factory_settings(use_empty=True)
 bpy.ops.extensions.package_install_files(filepath={str(archive)!r}, repo="user_default", enable_on_install=True)
 import affinity
 print("affinity from", affinity.__file__)
-bpy.ops.mesh.primitive_uv_sphere_add(segments=16, ring_count=8)
+{PACKED_GRID_SPHERE}
 print("check", bpy.ops.affinity.check())
-print("rows", [(r.code, r.count) for r in bpy.context.scene.affinity.results])
+print("rows", [(r.code, r.count, r.unit) for r in bpy.context.scene.affinity.results])
+print("pillow", "PIL" in sys.modules)
 """
     resources = tmp_path / "blender-user"
     result = _run_isolated(script, {"BLENDER_USER_RESOURCES": str(resources)}, tmp_path)
     assert result.returncode == 0, result.stdout + result.stderr
     lines = dict(line.split(" ", 1) for line in result.stdout.splitlines() if line.split(" ", 1)[0] in
-                 ("affinity", "check", "rows"))
+                 ("affinity", "check", "rows", "pillow"))
     assert lines["affinity"].startswith("from " + str(resources))  # the zip's wheel, not this checkout
     assert lines["check"] == "{'FINISHED'}"
-    assert lines["rows"] == "[('Q101', 96)]"
+    exec(PACKED_GRID_SPHERE, {"bpy": bpy})  # the same scene here, checked by this checkout
+    expected = len([r for r in findings(bpy.context.object) if r["code"] == "Q101"])
+    assert expected > 10
+    assert lines["rows"] == f"[('Q101', {expected}, '1/255')]"
+    assert lines["pillow"] == "False"
 
 
 def test_affinity_check_does_not_import_bpy(tmp_path):

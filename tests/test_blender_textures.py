@@ -1,30 +1,25 @@
 """Textures inside Blender: the add-on reads Blender's own images (never Pillow) and agrees with the command line.
 
 Runs in the bpy venv, which has no Pillow (.ci/run installs it without; the first test says so). The command
-line's side of each comparison runs in a Python that has Pillow: ``AFFINITY_CLI_PYTHON``, else the CI's main
-venv ``.venv-ci/bin/python`` (built by .ci/run before this leg); the comparisons skip, naming why, only where
-neither exists. Both decode the same PNG bytes: Pillow on the command line, Blender here.
+line's side of each comparison runs in a Python that has Pillow (:mod:`helpers.blender_cli`). Both decode the
+same PNG bytes: Pillow on the command line, Blender here.
 """
 
 from __future__ import annotations
 
 import importlib.util
-import json
-import os
-import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers.blender_cli import ROOT, run_cli_json
 
 bpy = pytest.importorskip("bpy")
 
 from affinity.blender import addon, findings  # noqa: E402
-from affinity.blender.check import check_object  # noqa: E402
 from affinity.blender.fix import fix_object  # noqa: E402
 
-ROOT = Path(__file__).resolve().parents[1]
 SPOT = ROOT.parent / "shared" / "meshes" / "textured" / "spot_control_mesh_textured.obj"
 SCORED = ("Q101", "Q102", "Q103")
 LEVELS = ("info", "warning", "error")
@@ -36,25 +31,6 @@ def empty_scene():
     if not hasattr(bpy.types.Scene, "affinity"):
         addon.register()
     yield
-
-
-def cli_python() -> str:
-    """A Python with Pillow that runs this checkout's command line, or a skip saying why there is none."""
-    candidates = [os.environ.get("AFFINITY_CLI_PYTHON"), str(ROOT / ".venv-ci" / "bin" / "python")]
-    for python in filter(None, candidates):
-        if Path(python).is_file():
-            return python
-    pytest.skip("no Python with Pillow for the command line's side: set AFFINITY_CLI_PYTHON or build .venv-ci "
-                "(.ci/run does, before this leg)")
-
-
-def run_cli(*args: str) -> dict:
-    """``affinity ARGS --format json`` of this checkout, run by :func:`cli_python`."""
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    result = subprocess.run([cli_python(), "-m", "affinity.cli", *args, "--format", "json"], capture_output=True,
-                            text=True, env=env, timeout=600, check=False)
-    assert result.returncode in (0, 1), result.stderr
-    return json.loads(result.stdout)
 
 
 def spot():
@@ -77,7 +53,7 @@ def test_spot_check_gives_the_command_lines_q101_faces_levels_and_values():
     obj = spot()
     rows = findings(obj)
     assert "PIL" not in sys.modules
-    cli = run_cli("check", str(SPOT))["findings"]
+    cli = run_cli_json("check", str(SPOT))["findings"]
     ours, theirs = by_face(rows), by_face(cli)
     assert ours.keys() == theirs.keys()
     assert len(ours) > 50
@@ -101,7 +77,7 @@ def test_spot_fix_then_check_leaves_only_the_faces_fix_lists_as_the_command_line
     tag.data.foreach_set("value", np.arange(len(mesh.polygons), dtype=np.int32))
     plan = fix_object(obj, level="warning")
     assert len(plan.refine_faces) > 10
-    cli = run_cli("fix", "--dry-run", str(SPOT))
+    cli = run_cli_json("fix", "--dry-run", str(SPOT))
     (entry,) = cli["files"] if "files" in cli else [cli]
     assert sorted(left["face"] for left in entry["left"]) == plan.left_faces.tolist()
     assert [left["reason"] for left in sorted(entry["left"], key=lambda x: x["face"])] == list(plan.left_reasons)
@@ -186,7 +162,7 @@ def test_packed_image_is_read_through_blender_as_the_command_line_reads_its_png(
     assert image.packed_file is not None
     _material(obj, image)
     ours = by_face(findings(obj, select=["Q101"], thresholds={"Q101": 0}))
-    theirs = by_face(run_cli("check", "--select", "Q101", "--threshold", "Q101=0",
+    theirs = by_face(run_cli_json("check", "--select", "Q101", "--threshold", "Q101=0",
                              str(_obj_file(obj, tmp_path, "on_disk.png")))["findings"])
     assert ours.keys() == theirs.keys() == {("Q101", 0)}
     here, there = ours["Q101", 0], theirs["Q101", 0]
@@ -211,7 +187,7 @@ def test_udim_tiles_are_each_read_at_their_own_size(tmp_path):
     image.reload()  # the tiles now hold the files' texels
     _material(obj, image)
     ours = by_face(findings(obj, select=["Q101"], thresholds={"Q101": 0}))
-    theirs = by_face(run_cli("check", "--select", "Q101", "--threshold", "Q101=0",
+    theirs = by_face(run_cli_json("check", "--select", "Q101", "--threshold", "Q101=0",
                              str(_obj_file(obj, tmp_path, "tiles.<UDIM>.png")))["findings"])
     assert ours.keys() == theirs.keys() == {("Q101", 0), ("Q101", 1)}
     for key in ours:

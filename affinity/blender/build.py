@@ -60,7 +60,7 @@ license = ["SPDX:MIT"]
 wheels = ["./wheels/{wheel}"]
 
 [permissions]
-files = "Read the size of texture images that materials use"
+files = "Read the images that materials use (a UDIM image is saved to a temporary folder to read its tiles)"
 '''
 
 

@@ -74,7 +74,7 @@ def decoded_image(image, key: str) -> DecodedTexture:
     Raises ValueError naming why it cannot be read (no pixels, over the decode budget).
     """
     width, height = (int(n) for n in image.size)
-    if width * height == 0 or not image.has_data and not _loads(image):
+    if width * height == 0:  # asking for the size loads the image; a missing file has none
         raise ValueError(f"image {image.name!r} has no pixels (missing file?)")
     if width * height > DECODE_BUDGET:
         raise ValueError(f"image {image.name!r}: {width}x{height} is over the decode budget of "
@@ -89,11 +89,6 @@ def decoded_image(image, key: str) -> DecodedTexture:
         texels[..., 1] = texels[..., 3]
         texels.flags.writeable = False
     return DecodedTexture(key, ImageHeader(width, height, image.file_format), texels, channels)
-
-
-def _loads(image) -> bool:
-    """Whether asking for its pixels loads the image (``has_data`` is False until something reads it)."""
-    return len(image.pixels) > 0
 
 
 def decoded_tiles(image) -> dict[str, DecodedTexture]:
