@@ -18,6 +18,7 @@ from helpers.blender_cli import ROOT, run_cli_json
 bpy = pytest.importorskip("bpy")
 
 from affinity.blender import addon, findings  # noqa: E402
+from affinity.blender.check import check_object  # noqa: E402
 from affinity.blender.fix import fix_object  # noqa: E402
 
 SPOT = ROOT.parent / "shared" / "meshes" / "textured" / "spot_control_mesh_textured.obj"
@@ -197,3 +198,27 @@ def test_udim_tiles_are_each_read_at_their_own_size(tmp_path):
     # The same uv crease counted in each tile's own texels: tile 1002 is half as wide and a quarter as high.
     assert ours["Q101", 1]["shift"] < 0.6 * ours["Q101", 0]["shift"]
     assert max(ours[key]["value"] for key in ours) > 8
+
+
+def test_subdivision_surface_modifier_is_read_and_its_profile_offered():
+    """The Catmull-Clark modifier's levels and smoothing, as the profile and OpenSubdiv rules they draw; the
+    panel's notes say the findings are of the cage."""
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=16, ring_count=8)
+    sphere = bpy.context.object
+    assert check_object(sphere).subdivision is None
+    modifier = sphere.modifiers.new("Smooth", "SUBSURF")
+    modifier.levels, modifier.render_levels = 1, 2
+    modifier.uv_smooth, modifier.boundary_smooth = "PRESERVE_CORNERS", "ALL"
+    found = check_object(sphere).subdivision
+    assert (found.name, found.scheme, found.levels, found.render_levels) == ("Smooth", "catmullClark", 1, 2)
+    assert (found.fvar_interpolation, found.boundary_interpolation) == ("cornersOnly", "edgeOnly")
+    assert (found.profile, found.render_profile) == ("--profile blender-viewport", "--profile blender-render")
+    bpy.ops.affinity.check()
+    assert bpy.context.scene.affinity.notes == (
+        "Sphere: Subdivision Surface 'Smooth' (catmullClark, viewport level 1, render level 2, fvar cornersOnly, "
+        "boundary edgeOnly): findings are of the cage: Blender draws --profile blender-viewport in the viewport, "
+        "--profile blender-render in renders")
+    modifier.subdivision_type, modifier.levels, modifier.show_render = "SIMPLE", 3, False
+    found = check_object(sphere).subdivision
+    assert (found.scheme, found.profile, found.render_profile) == ("bilinear", "--subdivision level:3",
+                                                                    "--profile game")

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .convert import Conversion, convert_object
+from .modifiers import SubdivisionModifier, subdivision_modifier
 
 _CONVERSION_OPTIONS = ("evaluated", "uv_layer")
 
@@ -23,7 +24,8 @@ class ObjectCheck:
     ``hits`` are the lint's :class:`~affinity.findings.RuleHits` (faces numbered
     like the converted mesh's polygons); ``findings`` the same as dicts with the
     keys of a JSON finding plus ``unit`` and ``level`` (and ``original_face`` for
-    an evaluated mesh); ``notes`` say what was skipped and why.
+    an evaluated mesh); ``notes`` say what was skipped and why, and what the object's
+    Subdivision Surface modifier draws (``subdivision``, None without one).
     """
 
     conversion: Conversion
@@ -31,6 +33,7 @@ class ObjectCheck:
     hits: list
     findings: list[dict]
     notes: list[str] = field(default_factory=list)
+    subdivision: SubdivisionModifier | None = None
 
 
 def findings(obj, **settings) -> list[dict]:
@@ -72,7 +75,10 @@ def check_object(obj, **options) -> ObjectCheck:
     with holding(conversion.textures.held):
         hits = settle(lint_mesh(mesh, settings), settings, list(mesh.group_names))  # levels and units, as check does
     rows = _finding_dicts(mesh, hits, settings, conversion.original_face if convert.get("evaluated") else None)
-    return ObjectCheck(conversion, settings, hits, rows, notes)
+    subdivision = subdivision_modifier(obj)
+    if subdivision is not None:
+        notes.append(subdivision.note(bool(convert.get("evaluated"))))
+    return ObjectCheck(conversion, settings, hits, rows, notes, subdivision)
 
 
 def _finding_dicts(mesh, hits, settings, original_face) -> list[dict]:
