@@ -339,15 +339,22 @@ def test_modifier_that_drops_attributes_turns_selection_off():
     assert bpy.ops.affinity.select(index=0) == {"CANCELLED"}
 
 
-def test_error_attribute_holds_the_worst_ratio_per_face():
+@pytest.mark.parametrize("with_texture", [False, True])
+def test_error_attribute_holds_the_worst_ratio_per_face(with_texture, tmp_path):
+    """value / threshold of the face's worst finding, as the JSON gives both: through a texture the value is C
+    and the threshold visible-warning, so a crease that shows nothing (C = 0) reads 0, not 1."""
     sphere = uv_sphere()
+    if with_texture:
+        textured(sphere, tmp_path / "checker.png")
     props = bpy.context.scene.affinity
     props.write_error = True
     bpy.ops.affinity.check()
     error = np.zeros(len(sphere.data.polygons), dtype=np.float32)
     sphere.data.attributes[ERROR_ATTRIBUTE].data.foreach_get("value", error)
     worst = defaultdict(float)
-    for r in findings(sphere):
+    rows = findings(sphere)
+    assert {r["unit"] for r in rows} == ({"1/255"} if with_texture else {"texels"})
+    for r in rows:
         worst[r["face"]] = max(worst[r["face"]], r["value"] / r["threshold"])
     expected = np.zeros_like(error)
     expected[list(worst)] = list(worst.values())

@@ -92,10 +92,11 @@ def test_spot_fix_then_check_leaves_only_the_faces_fix_lists_as_the_command_line
     assert flagged <= set(plan.left_faces.tolist())
 
 
-def _image_with_texels(name: str, texels: np.ndarray):
+def _image_with_texels(name: str, texels: np.ndarray, colorspace: str = "sRGB"):
     """A Blender image holding ``texels`` (H, W, 4) uint8, row 0 the top (Blender stores rows bottom-up)."""
     height, width = texels.shape[:2]
     image = bpy.data.images.new(name, width, height, alpha=True)
+    image.colorspace_settings.name = colorspace  # before the pixels: a change regenerates a generated image
     image.pixels.foreach_set((texels[::-1].astype(np.float32) / 255).ravel())
     return image
 
@@ -222,3 +223,91 @@ def test_subdivision_surface_modifier_is_read_and_its_profile_offered():
     found = check_object(sphere).subdivision
     assert (found.scheme, found.profile, found.render_profile) == ("bilinear", "--subdivision level:3",
                                                                     "--profile game")
+
+
+def _normal_texels(width: int, height: int, seed: int) -> np.ndarray:
+    """(H, W, 4) uint8 tangent-space normals, blue dominant: flat with tilted discs."""
+    rng = np.random.default_rng(seed)
+    y, x = np.mgrid[0:height, 0:width]
+    normals = np.zeros((height, width, 3))
+    normals[..., 2] = 1.0
+    for _ in range(10):
+        cx, cy, r = rng.uniform(0, width), rng.uniform(0, height), rng.uniform(2, width / 4)
+        tilt = rng.uniform(-0.6, 0.6, 2)
+        normals[(x - cx) ** 2 + (y - cy) ** 2 < r * r, :2] = tilt
+    normals /= np.linalg.norm(normals, axis=-1, keepdims=True)
+    texels = np.full((height, width, 4), 255, dtype=np.uint8)
+    texels[..., :3] = np.rint((normals + 1) * 127.5)
+    return texels
+
+
+def test_normal_map_and_mapping_node_read_as_the_mtl_norm_and_scale_are(tmp_path):
+    """A Normal Map node's image is a normal map (C in degrees, as MTL ``norm``); a Mapping node's scale and
+    location are the map's ``-s`` and ``-o``."""
+    obj = _trapezoids([(0, 0)])
+    texels = _normal_texels(40, 40, seed=4)
+    image = _image_with_texels("bumps", texels, "Non-Color")
+    image.filepath_raw, image.file_format = str(tmp_path / "bumps.png"), "PNG"
+    image.save()
+    material = bpy.data.materials.new("Textured")
+    if material.node_tree is None:
+        material.use_nodes = True
+    tree = material.node_tree
+    node = tree.nodes.new("ShaderNodeTexImage")
+    node.image = image
+    mapping = tree.nodes.new("ShaderNodeMapping")
+    mapping.inputs["Scale"].default_value = (2.0, 1.5, 1.0)
+    mapping.inputs["Location"].default_value = (0.25, 0.1, 0.0)
+    uv = tree.nodes.new("ShaderNodeUVMap")
+    uv.uv_map = "UVMap"
+    tree.links.new(uv.outputs["UV"], mapping.inputs["Vector"])
+    tree.links.new(mapping.outputs["Vector"], node.inputs["Vector"])
+    normal_map = tree.nodes.new("ShaderNodeNormalMap")
+    tree.links.new(node.outputs["Color"], normal_map.inputs["Color"])
+    tree.links.new(normal_map.outputs["Normal"], tree.nodes["Principled BSDF"].inputs["Normal"])
+    obj.data.materials.append(material)
+    ours = by_face(findings(obj, select=["Q101"], thresholds={"Q101": 0}))
+    path = _obj_file(obj, tmp_path, "")
+    (tmp_path / "mesh.mtl").write_text("newmtl Textured\nnorm -s 2 1.5 1 -o 0.25 0.1 0 bumps.png\n")
+    theirs = by_face(run_cli_json("check", "--select", "Q101", "--threshold", "Q101=0", str(path))["findings"])
+    assert ours.keys() == theirs.keys() == {("Q101", 0)}
+    here, there = ours["Q101", 0], theirs["Q101", 0]
+    assert here["unit"] == there["unit"] == "degrees" and here["role"] == there["role"] == "normal"
+    assert abs(here["value"] - there["value"]) < 0.5 and there["value"] > 2
+    assert here["shift"] == pytest.approx(there["shift"], rel=1e-5)
+
+
+def test_an_image_on_another_uv_map_is_left_out_and_said(tmp_path):
+    obj = _trapezoids([(0, 0)])
+    obj.data.uv_layers.new(name="Second")
+    _material(obj, _image_with_texels("blobs", _stripes(32, 32, seed=5)))
+    node = next(n for n in obj.data.materials[0].node_tree.nodes if n.type == "TEX_IMAGE")
+    uv = obj.data.materials[0].node_tree.nodes.new("ShaderNodeUVMap")
+    uv.uv_map = "Second"
+    obj.data.materials[0].node_tree.links.new(uv.outputs["UV"], node.inputs["Vector"])
+    result = check_object(obj, select=["Q101"], thresholds={"Q101": 0})
+    assert result.notes == ["Textured: image 'blobs' (base colour) reads UV map 'Second', not the linted "
+                            "'UVMap': not read"]
+    assert {r["unit"] for r in result.findings} == {"texels"}
+    assert {r["unit"] for r in findings(obj, select=["Q101"], thresholds={"Q101": 0}, uv_layer="Second")} \
+        == {"1/255"}
+
+
+def test_results_picture_shows_the_textured_spot_and_the_panels_rows(tmp_path):
+    from affinity.blender.picture import render_results_picture
+
+    if not SPOT.is_file():
+        pytest.skip(f"{SPOT} not found (the shared meshes)")
+    path = tmp_path / "spot.png"
+    lines = render_results_picture(str(path), str(SPOT), width=240, height=140)
+    rows = bpy.context.scene.affinity.results
+    assert lines[0].startswith(f"Q101 uv-disaffine   {rows[0].count}   worst ") and lines[0].count("/255") == 1
+    image = bpy.data.images.load(str(path))
+    pixels = np.empty(len(image.pixels), dtype=np.float32)
+    image.pixels.foreach_get(pixels)
+    rgb = pixels.reshape(140, 240, 4)[::-1, :, :3]
+    left, right = rgb[:, :120], rgb[:, 120:]
+    dark_grey = (rgb.max(axis=-1) < 0.25) & (np.ptp(rgb, axis=-1) < 0.05)  # Spot's black patches, or text
+    red = (right[..., 0] > 0.6) & (right[..., 1] < 0.3) & (right[..., 2] < 0.2)
+    assert dark_grey[:90, :120].sum() > 30 and red.sum() > 100
+    assert not ((left[..., 0] > 0.6) & (left[..., 1] < 0.3) & (left[..., 2] < 0.2)).any()  # no error colours left

@@ -121,17 +121,23 @@ def severity(hits) -> np.ndarray:
     2.0 is twice the limit for the rules that flag above it, half the limit
     for those that flag at or below it (Q201, Q301), without this module having
     to know which is which. Findings without a threshold, or with a value that
-    is not positive, read 1.0. The worst finding of a rule is the most severe.
+    is not positive, read 1.0. Where Q101's visible reading read C, the limit is
+    ``visible-warning`` (the finding's ``threshold`` in the JSON) and C reads C / t:
+    a quad the shift flags but whose crease shows nothing (C = 0) reads 0. The worst
+    finding of a rule is the most severe.
 
     Parameters
     ----------
-    hits : RuleHits with ``values`` (n,) float64 and ``threshold``
+    hits : RuleHits with ``values`` (n,) float64, ``threshold`` and ``visible`` None or VisibleColumns
     """
     v = hits.values
     ratio = np.ones(len(v))
     if hits.threshold > 0:
         positive = v > 0
         ratio[positive] = np.maximum(v[positive] / hits.threshold, hits.threshold / v[positive])
+    if hits.visible is not None:
+        read = (hits.visible.picks >= 0) & np.isfinite(hits.visible.shifts)
+        ratio[read] = v[read] / hits.visible.limits[1]
     return ratio
 
 
