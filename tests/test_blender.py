@@ -16,6 +16,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 from helpers.blender_cli import run_cli_json
+from helpers.blender_scenes import (
+    base_color_material,
+    empty_scene,  # noqa: F401 (autouse: every test in an empty scene)
+    mesh_object,
+)
 
 bpy = pytest.importorskip("bpy")
 
@@ -24,14 +29,6 @@ from affinity.blender.check import check_object  # noqa: E402
 from affinity.blender.convert import ERROR_ATTRIBUTE, ERROR_COLOR, ORIGINAL_FACE  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
-
-
-@pytest.fixture(autouse=True)
-def empty_scene():
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    if not hasattr(bpy.types.Scene, "affinity"):
-        addon.register()
-    yield
 
 
 def uv_sphere(segments=16, rings=8):
@@ -62,15 +59,7 @@ def textured(obj, image_path: Path, size=(512, 256)):
     image.filepath_raw = str(image_path)
     image.file_format = "PNG"
     image.save()
-    material = bpy.data.materials.new("Checker")
-    if material.node_tree is None:  # before Blender 5.0 a new material has no nodes
-        material.use_nodes = True
-    tree = material.node_tree
-    node = tree.nodes.new("ShaderNodeTexImage")
-    node.image = image
-    tree.links.new(node.outputs["Color"], tree.nodes["Principled BSDF"].inputs["Base Color"])
-    obj.data.materials.append(material)
-    return material
+    return base_color_material(obj, image, "Checker")
 
 
 def by_code_and_face(rows) -> dict[tuple[str, int], float]:
@@ -491,18 +480,9 @@ def trapezoid_strip():
     """Three quads in a row; the middle one a trapezoid carrying a rectangle of uv (Q101), its neighbours affine."""
     positions = [(0, 0, 0), (1, 0, 0), (2, 0, 0), (3, 0, 0), (0, 1, 0), (1.05, 1, 0), (1.95, 1, 0), (3, 1, 0)]
     faces = [(0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6)]
-    mesh = bpy.data.meshes.new("strip")
-    mesh.from_pydata(positions, [], faces)
-    mesh.update()
-    layer = mesh.uv_layers.new(name="UVMap")
     uv = [(x / 3, y) for face in faces for x, y, _ in (positions[v] for v in face)]
     uv[4:8] = [(1 / 3, 0), (2 / 3, 0), (2 / 3, 1), (1 / 3, 1)]  # the middle quad's own rectangle: a uv seam
-    layer.data.foreach_set("uv", np.array(uv, dtype=np.float32).ravel())
-    obj = bpy.data.objects.new("strip", mesh)
-    bpy.context.scene.collection.objects.link(obj)
-    bpy.context.view_layer.objects.active = obj
-    obj.select_set(True)
-    return obj
+    return mesh_object("strip", positions, faces, uv)
 
 
 def boundary_length(obj) -> float:

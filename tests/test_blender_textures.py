@@ -14,24 +14,22 @@ from pathlib import Path
 import numpy as np
 import pytest
 from helpers.blender_cli import ROOT, run_cli_json
+from helpers.blender_scenes import (
+    base_color_material,
+    empty_scene,  # noqa: F401 (autouse: every test in an empty scene)
+    mesh_object,
+    node_material,
+)
 
 bpy = pytest.importorskip("bpy")
 
-from affinity.blender import addon, findings  # noqa: E402
+from affinity.blender import findings  # noqa: E402
 from affinity.blender.check import check_object  # noqa: E402
 from affinity.blender.fix import fix_object  # noqa: E402
 
 SPOT = ROOT.parent / "shared" / "meshes" / "textured" / "spot_control_mesh_textured.obj"
 SCORED = ("Q101", "Q102", "Q103")
 LEVELS = ("info", "warning", "error")
-
-
-@pytest.fixture(autouse=True)
-def empty_scene():
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    if not hasattr(bpy.types.Scene, "affinity"):
-        addon.register()
-    yield
 
 
 def spot():
@@ -120,26 +118,7 @@ def _trapezoids(uv_offsets):
         positions += [(x, 0, 0), (x + 2, 0, 0), (x + 1.5, 1, 0), (x + 0.5, 1, 0)]
         faces.append(tuple(range(4 * k, 4 * k + 4)))
         uv += [(du, dv), (du + 1, dv), (du + 1, dv + 1), (du, dv + 1)]
-    mesh = bpy.data.meshes.new("trapezoids")
-    mesh.from_pydata(positions, [], faces)
-    layer = mesh.uv_layers.new(name="UVMap")
-    layer.data.foreach_set("uv", np.array(uv, dtype=np.float32).ravel())
-    obj = bpy.data.objects.new("trapezoids", mesh)
-    bpy.context.scene.collection.objects.link(obj)
-    bpy.context.view_layer.objects.active = obj
-    obj.select_set(True)
-    return obj
-
-
-def _material(obj, image):
-    material = bpy.data.materials.new("Textured")
-    if material.node_tree is None:  # before Blender 5.0 a new material has no nodes
-        material.use_nodes = True
-    tree = material.node_tree
-    node = tree.nodes.new("ShaderNodeTexImage")
-    node.image = image
-    tree.links.new(node.outputs["Color"], tree.nodes["Principled BSDF"].inputs["Base Color"])
-    obj.data.materials.append(material)
+    return mesh_object("trapezoids", positions, faces, uv)
 
 
 def _obj_file(obj, folder: Path, map_kd: str) -> Path:
@@ -162,7 +141,7 @@ def test_packed_image_is_read_through_blender_as_the_command_line_reads_its_png(
     image.pack()
     (tmp_path / "packed.png").rename(tmp_path / "on_disk.png")  # Blender has only the packed bytes now
     assert image.packed_file is not None
-    _material(obj, image)
+    base_color_material(obj, image)
     ours = by_face(findings(obj, select=["Q101"], thresholds={"Q101": 0}))
     theirs = by_face(run_cli_json("check", "--select", "Q101", "--threshold", "Q101=0",
                              str(_obj_file(obj, tmp_path, "on_disk.png")))["findings"])
@@ -187,7 +166,7 @@ def test_udim_tiles_are_each_read_at_their_own_size(tmp_path):
         single.file_format = "PNG"
         single.save()
     image.reload()  # the tiles now hold the files' texels
-    _material(obj, image)
+    base_color_material(obj, image)
     ours = by_face(findings(obj, select=["Q101"], thresholds={"Q101": 0}))
     theirs = by_face(run_cli_json("check", "--select", "Q101", "--threshold", "Q101=0",
                              str(_obj_file(obj, tmp_path, "tiles.<UDIM>.png")))["findings"])
@@ -249,9 +228,7 @@ def test_normal_map_and_mapping_node_read_as_the_mtl_norm_and_scale_are(tmp_path
     image = _image_with_texels("bumps", texels, "Non-Color")
     image.filepath_raw, image.file_format = str(tmp_path / "bumps.png"), "PNG"
     image.save()
-    material = bpy.data.materials.new("Textured")
-    if material.node_tree is None:
-        material.use_nodes = True
+    material = node_material("Textured")
     tree = material.node_tree
     node = tree.nodes.new("ShaderNodeTexImage")
     node.image = image
@@ -280,7 +257,7 @@ def test_normal_map_and_mapping_node_read_as_the_mtl_norm_and_scale_are(tmp_path
 def test_an_image_on_another_uv_map_is_left_out_and_said(tmp_path):
     obj = _trapezoids([(0, 0)])
     obj.data.uv_layers.new(name="Second")
-    _material(obj, _image_with_texels("blobs", _stripes(32, 32, seed=5)))
+    base_color_material(obj, _image_with_texels("blobs", _stripes(32, 32, seed=5)))
     node = next(n for n in obj.data.materials[0].node_tree.nodes if n.type == "TEX_IMAGE")
     uv = obj.data.materials[0].node_tree.nodes.new("ShaderNodeUVMap")
     uv.uv_map = "Second"
