@@ -117,10 +117,18 @@ def flagged_quads(mesh: Mesh, fix: FixSettings) -> tuple[dict, dict]:
     for h in hits:
         if h.code in SCORED:
             at_level = np.isin(h.levels(), LEVEL_ORDER[lowest:])
-            scored[h.code] = h.faces[at_level], h.values[at_level]
+            scored[h.code] = h.faces[at_level], rule_values(h)[at_level]
         else:
             leaving[h.code] = h.faces
     return scored, leaving
+
+
+def rule_values(hits) -> np.ndarray:
+    """(n,) float64: the values of ``hits`` in their rule's own unit, the one a refinement's pieces are measured
+    in: the texel shift where Q101's visible reading replaced it by C (``visible.shifts``), never the colour."""
+    if hits.visible is None:
+        return hits.values
+    return np.where(np.isfinite(hits.visible.shifts), hits.visible.shifts, hits.values)
 
 
 def pole_quads(mesh: Mesh, faces: np.ndarray) -> np.ndarray:
