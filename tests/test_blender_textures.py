@@ -64,6 +64,11 @@ def test_spot_check_gives_the_command_lines_q101_faces_levels_and_values():
     assert (c_here >= 8).sum() > 10  # spots' edges: plainly visible creases
     np.testing.assert_allclose([ours[k]["shift"] for k in keys], [theirs[k]["shift"] for k in keys], rtol=1e-4)
     assert {ours[k]["texture"] for k in keys} == {"spot_texture.png"}
+    # The panel's row gives the worst C as the JSON does, in 1/255 steps.
+    assert bpy.ops.affinity.check() == {"FINISHED"}
+    (row,) = [row for row in bpy.context.scene.affinity.results if row.code == "Q101"]
+    assert (row.count, row.unit) == (len(theirs), "1/255")
+    assert abs(row.worst - max(r["value"] for r in theirs.values())) < 1.0
     # The other rules agree too (faces are Blender's polygons, the OBJ's faces in order).
     others = {r["code"] for r in cli} - {"Q101"}
     assert by_face(rows, others).keys() == by_face(cli, others).keys()
@@ -252,6 +257,17 @@ def test_normal_map_and_mapping_node_read_as_the_mtl_norm_and_scale_are(tmp_path
     assert here["unit"] == there["unit"] == "degrees" and here["role"] == there["role"] == "normal"
     assert abs(here["value"] - there["value"]) < 0.5 and there["value"] > 2
     assert here["shift"] == pytest.approx(there["shift"], rel=1e-5)
+
+
+def test_extension_and_interpolation_other_than_repeat_and_linear_are_said():
+    obj = _trapezoids([(0, 0)])
+    base_color_material(obj, _image_with_texels("blobs", _stripes(32, 32, seed=6)))
+    node = next(n for n in obj.data.materials[0].node_tree.nodes if n.type == "TEX_IMAGE")
+    node.extension, node.interpolation = "EXTEND", "Closest"
+    result = check_object(obj, select=["Q101"], thresholds={"Q101": 0})
+    assert result.notes == ["Textured: image 'blobs' (base colour) has extension Extend and interpolation Closest: "
+                            "read as Repeat and Linear"]
+    assert {r["unit"] for r in result.findings} == {"1/255"}
 
 
 def test_an_image_on_another_uv_map_is_left_out_and_said(tmp_path):
