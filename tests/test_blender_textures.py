@@ -23,7 +23,7 @@ from helpers.blender_scenes import (
 
 bpy = pytest.importorskip("bpy")
 
-from affinity.blender import findings  # noqa: E402
+from affinity.blender import addon, findings  # noqa: E402
 from affinity.blender.check import check_object  # noqa: E402
 from affinity.blender.fix import fix_object  # noqa: E402
 
@@ -180,6 +180,7 @@ def test_udim_tiles_are_each_read_at_their_own_size(tmp_path):
         assert ours[key]["unit"] == theirs[key]["unit"] == "1/255"
         assert abs(ours[key]["value"] - theirs[key]["value"]) < 1.0
         assert ours[key]["shift"] == pytest.approx(theirs[key]["shift"], rel=1e-5)
+    assert addon.texture_line(obj, bpy.context.scene.affinity) == "Texture: tiles, 2 UDIM tiles (read by Blender)"
     # The same uv crease counted in each tile's own texels: tile 1002 is half as wide and a quarter as high.
     assert ours["Q101", 1]["shift"] < 0.6 * ours["Q101", 0]["shift"]
     assert max(ours[key]["value"] for key in ours) > 8
@@ -304,3 +305,35 @@ def test_results_picture_shows_the_textured_spot_and_the_panels_rows(tmp_path):
     red = (right[..., 0] > 0.6) & (right[..., 1] < 0.3) & (right[..., 2] < 0.2)
     assert dark_grey[:90, :120].sum() > 30 and red.sum() > 100
     assert not ((left[..., 0] > 0.6) & (left[..., 1] < 0.3) & (left[..., 2] < 0.2)).any()  # no error colours left
+
+
+def _png16(path: Path, rgb: np.ndarray) -> None:
+    """Write (H, W, 3) uint16 ``rgb`` as a 16-bit RGB PNG (zlib and struct: this venv has no image writer)."""
+    import struct
+    import zlib
+
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+
+    height, width = rgb.shape[:2]
+    rows = b"".join(b"\0" + row.astype(">u2").tobytes() for row in rgb)
+    path.write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 16, 2, 0, 0, 0))
+                     + chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b""))
+
+
+def test_a_16_bit_png_reads_within_a_step_of_the_command_lines_8_bits(tmp_path):
+    """Blender holds a 16-bit PNG as scene-linear floats; encoded back with the sRGB curve and rounded, its
+    texels are within a step of the top 8 bits the command line reads, and so is C."""
+    obj = _trapezoids([(0, 0)])
+    rgb = _stripes(40, 24, seed=7)[..., :3].astype(np.uint16) * 257  # 16-bit values whose top byte is the 8-bit one
+    rgb[::3] += 100  # and low bytes that are not
+    _png16(tmp_path / "deep.png", rgb)
+    image = bpy.data.images.load(str(tmp_path / "deep.png"))
+    assert image.is_float and image.colorspace_settings.name == "sRGB"
+    base_color_material(obj, image)
+    ours = by_face(findings(obj, select=["Q101"], thresholds={"Q101": 0}))
+    theirs = by_face(run_cli_json("check", "--select", "Q101", "--threshold", "Q101=0",
+                                  str(_obj_file(obj, tmp_path, "deep.png")))["findings"])
+    assert ours.keys() == theirs.keys() == {("Q101", 0)}
+    assert ours["Q101", 0]["unit"] == theirs["Q101", 0]["unit"] == "1/255"
+    assert abs(ours["Q101", 0]["value"] - theirs["Q101", 0]["value"]) <= 1.0 and theirs["Q101", 0]["value"] > 8
