@@ -13,13 +13,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from helpers.blender_cli import ROOT, run_cli_json
+from helpers.blender_cli import run_cli_json
 from helpers.blender_scenes import (
     base_color_material,
     empty_scene,  # noqa: F401 (autouse: every test in an empty scene)
     mesh_object,
     node_material,
 )
+from helpers.corpus import SHARED_MESHES
 
 bpy = pytest.importorskip("bpy")
 
@@ -27,7 +28,7 @@ from affinity.blender import addon, findings  # noqa: E402
 from affinity.blender.check import check_object  # noqa: E402
 from affinity.blender.fix import fix_object  # noqa: E402
 
-SPOT = ROOT.parent / "shared" / "meshes" / "textured" / "spot_control_mesh_textured.obj"
+SPOT = SHARED_MESHES / "textured" / "spot_control_mesh_textured.obj"
 SCORED = ("Q101", "Q102", "Q103")
 LEVELS = ("info", "warning", "error")
 
