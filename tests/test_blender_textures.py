@@ -261,14 +261,82 @@ def test_normal_map_and_mapping_node_read_as_the_mtl_norm_and_scale_are(tmp_path
     assert here["shift"] == pytest.approx(there["shift"], rel=1e-5)
 
 
-def test_extension_and_interpolation_other_than_repeat_and_linear_are_said():
+def _bilinear(texels: np.ndarray, uv: np.ndarray, extension: str) -> np.ndarray:
+    """(N, C) float64: ``texels`` (H, W, C) filtered bilinearly at ``uv`` (N, 2), row 0 the top, as Blender's
+    Image Texture node reads outside the image: REPEAT wraps, EXTEND clamps to the edge texels, CLIP reads zero
+    outside, MIRROR reflects (the edge texel repeated)."""
+    height, width = texels.shape[:2]
+    x, y = uv[:, 0] * width - 0.5, (1.0 - uv[:, 1]) * height - 0.5
+    x0, y0 = np.floor(x).astype(int), np.floor(y).astype(int)
+    fx, fy = (x - x0)[:, None], (y - y0)[:, None]
+
+    def texel(i, j):
+        inside = (i >= 0) & (i < width) & (j >= 0) & (j < height)
+        if extension == "REPEAT":
+            i, j = i % width, j % height
+        elif extension == "MIRROR":
+            i, j = i % (2 * width), j % (2 * height)
+            i, j = np.where(i < width, i, 2 * width - 1 - i), np.where(j < height, j, 2 * height - 1 - j)
+        else:
+            i, j = np.clip(i, 0, width - 1), np.clip(j, 0, height - 1)
+        value = texels[j, i].astype(np.float64)
+        return value * inside[:, None] if extension == "CLIP" else value
+
+    top = texel(x0, y0) * (1 - fx) + texel(x0 + 1, y0) * fx
+    bottom = texel(x0, y0 + 1) * (1 - fx) + texel(x0 + 1, y0 + 1) * fx
+    return top * (1 - fy) + bottom * fy
+
+
+def _crease_by_dense_sampling(xy: np.ndarray, uv: np.ndarray, texels: np.ndarray, extension: str) -> float:
+    """C of one planar quad, corners ``xy`` (4, 2) carrying ``uv`` (4, 2), by brute force: 301 x 301 points of its
+    bilinear patch, the split's uv against the bilinear uv, both diagonals, in 1/255 steps (a lower bound)."""
+    s, t = (a.ravel() for a in np.meshgrid(*2 * [np.linspace(0, 1, 301)]))
+    weights = np.stack([(1 - s) * (1 - t), s * (1 - t), s * t, (1 - s) * t], axis=1)
+    points, exact = weights @ xy, weights @ uv
+    seen = _bilinear(texels, exact, extension)
+    worst = 0.0
+    for first, second in (((0, 1, 2), (0, 2, 3)), ((1, 2, 3), (1, 3, 0))):
+        split = np.full_like(exact, np.nan)
+        for triangle in (first, second):
+            a, b, c = xy[list(triangle)]
+            matrix = np.array([b - a, c - a]).T
+            wb, wc = np.linalg.solve(matrix, (points - a).T)
+            inside = (wb >= -1e-12) & (wc >= -1e-12) & (wb + wc <= 1 + 1e-12)
+            uv_a, uv_b, uv_c = uv[list(triangle)]
+            split[inside] = ((1 - wb - wc)[:, None] * uv_a + wb[:, None] * uv_b + wc[:, None] * uv_c)[inside]
+        worst = max(worst, float(np.abs(_bilinear(texels, split, extension) - seen)[:, :3].max()))
+    return worst
+
+
+@pytest.mark.parametrize("extension", ["REPEAT", "EXTEND", "CLIP", "MIRROR"])
+def test_each_extension_reads_as_blender_samples_outside_the_image(extension):
+    """A quad whose uv reach 0.3 to 0.45 images outside [0, 1]: C equals dense sampling through the extension's
+    own rule (and differs from Repeat's where the outside differs)."""
+    obj = _trapezoids([(-0.3, -0.45)])
+    texels = _stripes(32, 24, seed=8)
+    base_color_material(obj, _image_with_texels("blobs", texels))
+    node = next(n for n in obj.data.materials[0].node_tree.nodes if n.type == "TEX_IMAGE")
+    node.extension = extension
+    # visible-error above any C: the reading refines to the maximum instead of stopping at "at least 8"
+    result = check_object(obj, select=["Q101"], thresholds={"Q101": 0}, visible_error=1000.0)
+    assert result.notes == []
+    (row,) = result.findings
+    assert "bound" not in row
+    xy = np.array([(0, 0), (2, 0), (1.5, 1), (0.5, 1)], dtype=np.float64)
+    uv = np.array([(0, 0), (1, 0), (1, 1), (0, 1)], dtype=np.float64) + (-0.3, -0.45)
+    truth = _crease_by_dense_sampling(xy, uv, texels, extension)
+    assert truth - 0.01 <= row["value"] <= truth + 1.0
+    if extension != "REPEAT":
+        assert abs(_crease_by_dense_sampling(xy, uv, texels, "REPEAT") - truth) > 2  # the extension matters here
+
+
+def test_an_interpolation_other_than_linear_is_said():
     obj = _trapezoids([(0, 0)])
     base_color_material(obj, _image_with_texels("blobs", _stripes(32, 32, seed=6)))
     node = next(n for n in obj.data.materials[0].node_tree.nodes if n.type == "TEX_IMAGE")
     node.extension, node.interpolation = "EXTEND", "Closest"
     result = check_object(obj, select=["Q101"], thresholds={"Q101": 0})
-    assert result.notes == ["Textured: image 'blobs' (base colour) has extension Extend and interpolation Closest: "
-                            "read as Repeat and Linear"]
+    assert result.notes == ["Textured: image 'blobs' (base colour) has interpolation Closest: read as Linear"]
     assert {r["unit"] for r in result.findings} == {"1/255"}
 
 

@@ -158,7 +158,7 @@ def _convert(obj, me, uv_layer: str | None) -> Conversion:
     materials = [slot.material for slot in obj.material_slots]
     names = [m.name if m is not None else "" for m in materials]
     render_layer = next((uv.name for uv in me.uv_layers if uv.active_render), None)
-    textures = object_textures(materials, layer.name if layer is not None else None, render_layer)
+    textures = object_textures(materials, layer.name if layer is not None else None, render_layer, texcoords)
     mesh = Mesh(
         path=obj.name,
         positions=positions,
