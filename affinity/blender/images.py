@@ -108,10 +108,10 @@ def decoded_tiles(image) -> dict[str, DecodedTexture]:
             if not os.path.isfile(path):
                 continue
             loaded = bpy.data.images.load(path, check_existing=False)
+            tile_key = key.replace(UDIM_TOKEN, str(tile.number))
             try:
                 loaded.colorspace_settings.name = image.colorspace_settings.name
-                tiles[key.replace(UDIM_TOKEN, str(tile.number))] = decoded_image(
-                    loaded, key.replace(UDIM_TOKEN, str(tile.number)))
+                tiles[tile_key] = decoded_image(loaded, tile_key)
             finally:
                 bpy.data.images.remove(loaded)
     return tiles

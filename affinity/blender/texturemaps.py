@@ -95,7 +95,7 @@ def _laid_out_map(held: dict, texture_map: TextureMap, extension: str,
     map's transform (a rotation with a margin uneven in u and v)."""
     texture = held[texture_map.path]
     height, width = texture.texels.shape[:2]
-    reached = texture_map.texture_uv(uv)
+    reached = texture_map.texture_uv(uv) if len(uv) else np.zeros((1, 2))
     margin, beyond = margins(reached.min(axis=0), reached.max(axis=0), (width, height))
     laid, layout = laid_out(texture, f"{texture_map.path}#{extension.lower()}", extension, margin)
     if texture_map.rotation and layout.scale[0] != layout.scale[1]:
