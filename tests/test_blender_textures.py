@@ -158,7 +158,7 @@ def test_packed_image_is_read_through_blender_as_the_command_line_reads_its_png(
     assert here["shift"] == pytest.approx(there["shift"], rel=1e-5)  # counted in the image's 48 x 32 texels
 
 
-def test_udim_tiles_are_each_read_at_their_own_size(tmp_path):
+def test_packed_udim_tiles_are_each_read_at_their_own_size(tmp_path):
     obj = _trapezoids([(0, 0), (1, 0)])  # tile 1001, then 1002
     image = bpy.data.images.new("tiles", 64, 64, tiled=True)
     with bpy.context.temp_override(edit_image=image):
@@ -172,10 +172,16 @@ def test_udim_tiles_are_each_read_at_their_own_size(tmp_path):
         single.file_format = "PNG"
         single.save()
     image.reload()  # the tiles now hold the files' texels
+    image.pack()
+    cli_folder = tmp_path / "cli"
+    cli_folder.mkdir()
+    for tile in (1001, 1002):  # Blender keeps only the packed tiles; the command line reads the files
+        (tmp_path / f"tiles.{tile}.png").rename(cli_folder / f"tiles.{tile}.png")
+    assert [p.tile_number for p in image.packed_files] == [1001, 1002]
     base_color_material(obj, image)
     ours = by_face(findings(obj, select=["Q101"], thresholds={"Q101": 0}))
     theirs = by_face(run_cli_json("check", "--select", "Q101", "--threshold", "Q101=0",
-                             str(_obj_file(obj, tmp_path, "tiles.<UDIM>.png")))["findings"])
+                                  str(_obj_file(obj, cli_folder, "tiles.<UDIM>.png")))["findings"])
     assert ours.keys() == theirs.keys() == {("Q101", 0), ("Q101", 1)}
     for key in ours:
         assert ours[key]["unit"] == theirs[key]["unit"] == "1/255"
