@@ -48,7 +48,7 @@ def pixels_to_texels(pixels: np.ndarray, width: int, height: int, linear: bool) 
 
     >>> pixels_to_texels(np.array([0, 0, 0, 1, 1, 1, 1, 1], np.float32), 1, 2, False)[:, 0].tolist()
     [[255, 255, 255, 255], [0, 0, 0, 255]]
-    >>> pixels_to_texels(np.array([0.2140411, 0.5, 0.0031308, 1], np.float32), 1, 1, True)[0, 0].tolist()
+    >>> pixels_to_texels(np.array([0.2158605, 0.5028865, 0.0030353, 1], np.float32), 1, 1, True)[0, 0].tolist()
     [128, 188, 10, 255]
     """
     rgba = np.asarray(pixels, dtype=np.float32).reshape(height, width, 4)[::-1]
