@@ -83,8 +83,11 @@ def test_scheduler_from_the_environment_and_from_the_config(client, assets, tmp_
 
 
 def test_a_lost_worker_costs_only_its_tasks(client, assets):
+    """A worker killed mid-batch: the scheduler reruns its batch, and every file's result is the local run's."""
+    from affinity.shards.journal import json_of
+
     tasks = [(str(p), Settings()) for p in sorted(assets.rglob("*.obj"))]
-    expected = [r.n_findings for r in check_files(tasks, jobs=1)]
+    expected = [json_of(r, Settings()) for r in check_files(tasks, jobs=1)]
     seen, killed = [], []
 
     def kill_a_busy_worker(results, total):
@@ -98,10 +101,31 @@ def test_a_lost_worker_costs_only_its_tasks(client, assets):
 
     reports = check_files(tasks, progress=kill_a_busy_worker, cluster=lambda: nullcontext(client))
     assert sorted(seen) == list(range(len(tasks)))
-    assert [r.n_findings for r in reports] == expected and [r.path for r in reports] == [p for p, _ in tasks]
+    assert [json_of(r, Settings()) for r in reports] == expected
     assert not any((r.error or "").startswith("internal error") for r in reports)
     client.wait_for_workers(2, timeout=60)
     assert killed[0] not in client.run(os.getpid).values()  # the nanny started a new worker process
+
+
+def test_files_go_to_the_cluster_in_batches(client, assets):
+    """12 files on 2 workers: fewer tasks than files, at least a few per worker, each file in one."""
+    tasks = [(str(p), Settings()) for p in sorted(assets.rglob("*.obj"))]
+    planned = cluster_module.batches([os.path.getsize(p) for p, _ in tasks], workers=2)
+    assert len(tasks) > len(planned) >= 2 * 2
+    assert sorted(i for batch in planned for i in batch) == list(range(len(tasks)))
+    submitted = []
+    original = client.submit
+
+    def counting(*args, **kwargs):
+        submitted.append(kwargs["key"])
+        return original(*args, **kwargs)
+
+    client.submit = counting
+    try:
+        results = dict(cluster_module.check_on_cluster(client, tasks, check_file))
+    finally:
+        del client.submit
+    assert len(submitted) == len(planned) and sorted(results) == list(range(len(tasks)))
 
 
 def test_a_path_the_worker_cannot_see_is_unreadable_with_the_reason(client, tmp_path):
@@ -227,12 +251,14 @@ def test_check_without_scheduler_never_imports_dask(assets):
     assert run("check", str(assets / "clean.obj")).returncode == 0
 
 
-def test_the_progress_bar_passes_every_result_through(capsys):
-    from affinity.commands.check import _progress_bar
+def test_the_progress_bar_passes_every_result_through():
+    import io
+
     from affinity.findings import FileReport
+    from affinity.pipeline.progress import bar
 
     results = [(2, FileReport("a.obj")), (0, FileReport("b.obj")), (1, FileReport("c.obj", error="x"))]
-    assert list(_progress_bar()(iter(results), 3)) == results
+    assert list(bar(iter(results), 3, io.StringIO())) == results
 
 
 def test_with_every_file_cached_the_scheduler_is_not_reached(assets, tmp_path):

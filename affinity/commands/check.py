@@ -19,7 +19,7 @@ from ..errors import UsageError
 from . import EXIT_CLEAN, EXIT_ERROR, EXIT_FINDINGS
 
 if TYPE_CHECKING:
-    from ..shards.selection import Shard, ShardRecord
+    from ..shards.selection import AutoShard, Shard, ShardRecord
 
 
 def _codes(text: str) -> list[str]:
@@ -65,10 +65,22 @@ def _jobs(text: str) -> int:
     return int(text)
 
 
-def _shard(text: str) -> Shard:
+def _shard(text: str) -> Shard | AutoShard:
     from ..shards.selection import parse_shard
 
     return parse_shard(text)
+
+
+def _resolved_shard(spec: Shard | AutoShard | None) -> Shard | None:
+    """``--shard``'s shard: ``auto`` read from the farm's environment (a UsageError when it names none)."""
+    from ..shards.selection import AutoShard, shard_from_environment
+
+    if not isinstance(spec, AutoShard):
+        return spec
+    try:
+        return shard_from_environment(spec, os.environ)
+    except ValueError as err:
+        raise UsageError(str(err)) from None
 
 
 def _time(text: str) -> float:
@@ -94,6 +106,7 @@ def _measure(text: str) -> str:
 def add_parser(sub) -> None:
     from ..loaders.formats import described
     from ..output import FORMATS
+    from ..pipeline.progress import MODES as PROGRESS_MODES
     from ..settings import DIAGONALS, MEASURES
 
     p = sub.add_parser(
@@ -144,9 +157,18 @@ def add_parser(sub) -> None:
     p.add_argument("--show-files", action="store_true", help="list the files that would be checked and exit")
     p.add_argument("--shard", type=_shard, metavar="K/N",
                    help="check only shard K of N (1-based): each file in exactly one shard, the same on every "
-                        "machine; affinity merge joins the shards' --format json results into one")
+                        "machine; affinity merge joins the shards' --format json results into one. auto[/N]: "
+                        "K (and N) from JOB_COMPLETION_INDEX (Kubernetes; N from /N or AFFINITY_SHARD_COUNT) "
+                        "or CI_NODE_INDEX/CI_NODE_TOTAL (GitLab)")
     p.add_argument("-o", "--output-file", metavar="PATH",
                    help="write the output to PATH (whole or not at all); - is standard output")
+    p.add_argument("--resume", metavar="RESULT.jsonl",
+                   help="keep each file's result in RESULT.jsonl as it finishes (JSON lines, appended); rerun "
+                        "with the same file after a kill to check only the files not yet in it. affinity merge "
+                        "joins the shards' journals")
+    p.add_argument("--progress", choices=PROGRESS_MODES, default="auto",
+                   help="progress on stderr: auto (a bar on a terminal), bar, json (one JSON line a second, for "
+                        "farms) or none")
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="check the files on a Dask cluster: a scheduler address, env (DASK_SCHEDULER_ADDRESS) "
                         "or local:N (N local worker processes); needs the distributed extra. "
@@ -215,34 +237,18 @@ def report_problems(reports, quiet: bool, skips_fail: bool = False) -> None:
             sys.stderr.write(f"{path}: note: {note}\n")
 
 
-def _progress_bar():
-    """A tqdm bar over the stream of ``(index, report)`` pairs: files, findings so far, files per second.
-
-    Imported only when stderr is a terminal.
-    """
-    from tqdm import tqdm
-
-    def progress(results, total):
-        findings = 0
-        with tqdm(total=total, unit="file", delay=1.0, leave=False, file=sys.stderr) as bar:
-            for result in results:
-                findings += result[1].n_findings
-                bar.set_postfix_str(f"{findings} findings", refresh=False)
-                bar.update()
-                yield result
-
-    return progress
-
-
 @contextlib.contextmanager
 def _result_cache(args, run_options: dict):
-    """The result cache, committed and closed at the end; None with ``--no-cache`` or ``cache = false``."""
+    """The result cache, committed and closed at the end; None with ``--no-cache`` or ``cache = false``.
+
+    A shard keeps its own cache file (a farm's workers never share one database over network storage).
+    """
     if args.no_cache or not run_options.get("cache", True):
         yield None
         return
     from ..pipeline.cache import ResultCache, cache_folder
 
-    cache = ResultCache(cache_folder())
+    cache = ResultCache(cache_folder(), shard=args.shard)
     try:
         yield cache
     finally:
@@ -307,6 +313,44 @@ def _shard_tasks(tasks: list, shard: Shard, resolver, baseline: bool) -> tuple[l
     return [tasks[i] for i in positions], record
 
 
+@contextlib.contextmanager
+def _journal(path: str | None, settings, tasks: list, shard: ShardRecord | None):
+    """The journal of ``--resume path`` (:mod:`affinity.shards.journal`), closed at the end; None without it."""
+    if path is None:
+        yield None
+        return
+    from ..output.names import printable
+    from ..shards.journal import Journal, header_of
+    from ..shards.results import ResultError
+    from ..shards.selection import run_digest
+
+    header = header_of(settings, len(tasks), run_digest([p for p, _ in tasks]), shard)
+    try:
+        journal = Journal(path, header)
+    except ResultError as err:
+        raise UsageError(f"--resume {printable(path)}: {err}") from None
+    except OSError as err:
+        raise UsageError(f"--resume {printable(path)}: cannot write it: {err.strerror or err}") from None
+    try:
+        yield journal
+    finally:
+        journal.close()
+
+
+def _journaled(journal, todo: list[int], settings, progress):
+    """A ``progress`` for :func:`check_files` that appends each finished file to ``journal`` (as the file at
+    ``todo[i]`` of the run) before passing it on to ``progress`` (None: to nobody)."""
+
+    def record(results, total):
+        for i, report in results:
+            journal.record(todo[i], report, settings)
+            yield i, report
+
+    if progress is None:
+        return record
+    return lambda results, total: progress(record(results, total), total)
+
+
 def _write_baseline(reports, path: str, quiet: bool) -> None:
     from ..pipeline import baseline
 
@@ -325,11 +369,16 @@ def run(args) -> int:
     from ..loaders.usd import UsdOptions
     from ..output import CheckRun
     from ..pipeline.check import check_files
+    from ..pipeline.progress import progress_for
 
     if args.baseline and args.write_baseline:
         raise UsageError("--baseline and --write-baseline exclude each other")
     if args.shard is not None and args.write_baseline:
         raise UsageError("--write-baseline records the whole run's findings: run it without --shard")
+    if args.resume is not None and (args.baseline or args.write_baseline):
+        raise UsageError("--resume keeps every finding of each file: apply a baseline to the merged result, "
+                         "not to a journal")
+    args.shard = _resolved_shard(args.shard)
     resolver = Resolver(_overrides(args), config=args.config, isolated=args.isolated)
     paths = list(args.paths)
     if args.demo:
@@ -356,17 +405,26 @@ def run(args) -> int:
         _write_output_file(args.output_file, lambda out: out.writelines(printable(path) + "\n" for path, _ in tasks))
         return EXIT_CLEAN
     run_options = resolver.run_options()
-    show_progress = len(tasks) > 1 and sys.stderr.isatty()
-    cluster = _cluster(args, run_options, show_progress)
-    with _result_cache(args, run_options) as cache:
-        reports = check_files(tasks, args.jobs, _progress_bar() if show_progress else None,
-                              usd=UsdOptions(args.time, args.uv_primvar), cache=cache, cluster=cluster)
+    settings = resolver.resolve(os.curdir).settings
+    with _journal(args.resume, settings, tasks, shard) as journal:
+        done = {} if journal is None else journal.done
+        todo = [i for i in range(len(tasks)) if i not in done]
+        progress = progress_for(args.progress, len(todo))
+        cluster = _cluster(args, run_options, len(todo) > 1 and sys.stderr.isatty())
+        if journal is not None:
+            progress = _journaled(journal, todo, settings, progress)
+        with _result_cache(args, run_options) as cache:
+            fresh = check_files([tasks[i] for i in todo], args.jobs, progress,
+                                usd=UsdOptions(args.time, args.uv_primvar), cache=cache, cluster=cluster)
+    reports = [done[i] if i in done else None for i in range(len(tasks))]
+    for i, report in zip(todo, fresh):
+        reports[i] = report
     report_problems(reports, args.quiet, args.fail_on_skip)
     if args.write_baseline:
         _write_baseline(reports, args.write_baseline, args.quiet)
         return EXIT_ERROR if _failed(reports, args.fail_on_skip) else EXIT_CLEAN
 
-    check_run = CheckRun(reports, resolver.resolve(os.curdir).settings,
+    check_run = CheckRun(reports, settings,
                          max_findings=args.max_findings, statistics=args.statistics, shard=shard,
                          fail_on=args.fail_on)
     if args.baseline:

@@ -100,6 +100,19 @@ DAMAGED_SUFFIX = ".damaged"
 _DATABASE_ERRORS = (sqlite3.Error, UnicodeDecodeError)
 
 
+def db_name(shard=None) -> str:
+    """The database's file name: :data:`DB_NAME`, or for shard K of N (``--shard K/N``) a file of its own, so
+    the workers of a farm never write one database over network storage.
+
+    >>> db_name()[-7:], db_name("2/8").endswith("-shard-2-of-8.sqlite")
+    ('.sqlite', True)
+    """
+    if shard is None:
+        return DB_NAME
+    index, count = str(shard).split("/")
+    return DB_NAME.replace(".sqlite", f"-shard-{index}-of-{count}.sqlite")
+
+
 def cache_folder() -> str:
     """``AFFINITY_CACHE_DIR``, else the user cache folder of quad-affinity."""
     folder = os.environ.get("AFFINITY_CACHE_DIR")
@@ -178,9 +191,9 @@ class ResultCache:
     and :meth:`close` at the end of the run (commits and prunes).
     """
 
-    def __init__(self, folder: str, tool: str | None = None):
+    def __init__(self, folder: str, tool: str | None = None, shard=None):
         self.folder = folder
-        self.path = os.path.join(folder, DB_NAME)
+        self.path = os.path.join(folder, db_name(shard))
         self.tool = tool_fingerprint() if tool is None else tool
         self._db: sqlite3.Connection | None = None
         self._pending = 0
@@ -251,7 +264,8 @@ class ResultCache:
             self._warn(f"damaged again ({err})")
             return
         self._set_aside_once = True
-        self._warn(f"damaged ({err}); set aside as {DB_NAME}{DAMAGED_SUFFIX}, starting a new one", off=False)
+        name = os.path.basename(self.path)
+        self._warn(f"damaged ({err}); set aside as {name}{DAMAGED_SUFFIX}, starting a new one", off=False)
         try:
             for suffix in ("", "-wal", "-shm"):
                 if os.path.exists(self.path + suffix):
@@ -460,7 +474,8 @@ class ResultCache:
     def _remove_unused_files(self, old: float) -> None:
         """Delete the databases of other layouts (other versions of the tool) and set-aside ones that
         nothing has written for :data:`MAX_AGE_DAYS` days: an upgrade must not leave 200 MB behind for good."""
-        ours = {DB_NAME, f"{DB_NAME}-wal", f"{DB_NAME}-shm"}
+        name = os.path.basename(self.path)
+        ours = {name, f"{name}-wal", f"{name}-shm"}
         try:
             with os.scandir(self.folder) as entries:
                 unused = [entry.path for entry in entries if entry.name.startswith("results-v")

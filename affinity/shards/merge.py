@@ -3,7 +3,8 @@
 The inputs must be the N shards of one run, each once, each complete:
 
 - each a readable ``affinity check --shard K/N --format json`` result
-  (:func:`~affinity.shards.results.read_result`), not truncated by ``--max-findings``;
+  (:func:`~affinity.shards.results.read_result`), not truncated by ``--max-findings``, or a
+  finished ``--resume`` journal (``.jsonl``, :func:`~affinity.shards.journal.read_journal`);
 - all of one run: the same N, the same count and digest of the run's file list,
   the same tool version, the same settings (but for ``root``, the configuration's
   folder, which differs between checkouts) and the same use of a baseline; the
@@ -23,7 +24,11 @@ from collections import Counter
 
 from ..findings import FileReport
 from ..settings import Settings
+from .journal import read_journal
 from .results import CheckResult, ResultError, read_result
+
+#: The suffix of a ``--resume`` journal (JSON lines); every other input is read as a ``--format json`` result.
+JOURNAL_SUFFIX = ".jsonl"
 
 
 class MergeError(Exception):
@@ -49,7 +54,7 @@ def merge_results(paths: list[str]) -> MergedRun:
     results, problems = [], []
     for path in paths:
         try:
-            result = read_result(path)
+            result = read_journal(path) if path.lower().endswith(JOURNAL_SUFFIX) else read_result(path)
         except ResultError as err:
             problems.append(f"{path}: {err}")
             continue

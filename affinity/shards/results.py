@@ -67,9 +67,9 @@ def read_result(path: str) -> CheckResult:
     try:
         return CheckResult(
             path=path,
-            reports=_reports(doc["files"], doc["findings"], _settings(doc["settings"])),
-            settings=_settings(doc["settings"]),
-            shard=None if "shard" not in doc else _shard_record(doc["shard"]),
+            reports=_reports(doc["files"], doc["findings"], settings_from_json(doc["settings"])),
+            settings=settings_from_json(doc["settings"]),
+            shard=None if "shard" not in doc else shard_record_from_json(doc["shard"]),
             truncated="truncated" in doc,
             baselined=int(doc["summary"]["baselined"]),
         )
@@ -77,7 +77,7 @@ def read_result(path: str) -> CheckResult:
         raise ResultError(f"a damaged affinity check result ({type(err).__name__}: {err})") from None
 
 
-def _shard_record(entry: dict) -> ShardRecord:
+def shard_record_from_json(entry: dict) -> ShardRecord:
     """The :class:`ShardRecord` of a JSON ``shard`` entry, its numbers checked."""
     record = ShardRecord(**entry)
     numbers = (record.index, record.of, record.run_files, *record.positions)
@@ -88,7 +88,7 @@ def _shard_record(entry: dict) -> ShardRecord:
     return record
 
 
-def _settings(entry: dict) -> Settings:
+def settings_from_json(entry: dict) -> Settings:
     """The :class:`Settings` whose ``dataclasses.asdict`` is ``entry``."""
     names = {f.name for f in fields(Settings)}
     if not entry.keys() <= names:
@@ -100,10 +100,10 @@ def _reports(files: list[dict], findings: list[dict], settings: Settings) -> lis
     by_path: dict[str, list[dict]] = {entry["path"]: [] for entry in files}
     for finding in findings:
         by_path[finding["path"]].append(finding)
-    return [_report(entry, by_path[entry["path"]], settings) for entry in files]
+    return [report_from_json(entry, by_path[entry["path"]], settings) for entry in files]
 
 
-def _report(entry: dict, findings: list[dict], settings: Settings) -> FileReport:
+def report_from_json(entry: dict, findings: list[dict], settings: Settings) -> FileReport:
     """The report of one JSON file entry and its findings (in the document's order)."""
     path = entry["path"]
     if "error" in entry:
