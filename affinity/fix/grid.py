@@ -29,17 +29,22 @@ def grid_parameters(n: int) -> np.ndarray:
     return np.stack([s, t], axis=-1)
 
 
-@cache
-def bilinear_weights(n: int) -> np.ndarray:
-    """Weights of the four corners at every grid point of level ``n``.
+def weights_at(st: np.ndarray) -> np.ndarray:
+    """Weights of the four corners at the parameters ``st`` (P, 2) float64 (s, t).
 
     Returns
     -------
-    (P, 4) float64, P = (n + 1)^2 in :func:`grid_parameters` order:
-    ((1-s)(1-t), s(1-t), s t, (1-s) t), summing to 1.
+    (P, 4) float64: ((1-s)(1-t), s(1-t), s t, (1-s) t), summing to 1.
     """
-    s, t = grid_parameters(n).reshape(-1, 2).T
+    s, t = np.asarray(st, dtype=np.float64).T
     return np.stack([(1 - s) * (1 - t), s * (1 - t), s * t, (1 - s) * t], axis=1)
+
+
+@cache
+def bilinear_weights(n: int) -> np.ndarray:
+    """Weights of the four corners at every grid point of level ``n``: (P, 4) float64, P = (n + 1)^2 in
+    :func:`grid_parameters` order (:func:`weights_at`)."""
+    return weights_at(grid_parameters(n).reshape(-1, 2))
 
 
 @cache
@@ -69,9 +74,3 @@ def blend(corner_values: np.ndarray, n: int) -> np.ndarray:
     (Q, P, K) float64, P = (n + 1)^2; NaN where a corner value is NaN.
     """
     return np.einsum("pk,qkd->qpd", bilinear_weights(n), corner_values)
-
-
-def interior_points(n: int) -> np.ndarray:
-    """(n - 1)^2 int64 grid indices of the points strictly inside the quad."""
-    j, i = np.divmod(np.arange((n - 1) ** 2), n - 1)
-    return (j + 1) * (n + 1) + i + 1

@@ -161,3 +161,22 @@ def _export_binary(text: str, out: str) -> None:
     finally:
         if os.path.exists(temporary):
             os.unlink(temporary)
+
+
+def subdivided_notes(path: str, mesh: Mesh, refined: Refined) -> list[str]:
+    """One note per mesh prim the fix changes whose ``subdivisionScheme`` (authored, or USD's default
+    Catmull-Clark) subdivides: the fix refines its cage, so its subdivided surface changes."""
+    from pxr import Usd, UsdGeom
+
+    from ..loaders.usdlayers import SUBDIVIDED
+
+    stage = Usd.Stage.Open(os.fspath(path))
+    time = Usd.TimeCode.EarliestTime()
+    notes = []
+    for group in np.unique(mesh.face_group[refined.replaced]).tolist():
+        prim = stage.GetPrimAtPath(mesh.group_names[group])
+        scheme = str(UsdGeom.Mesh(prim).GetSubdivisionSchemeAttr().Get(time)) if prim else ""
+        if scheme in SUBDIVIDED:
+            notes.append(f"{mesh.group_names[group]}: subdivisionScheme {scheme}: the fix refines the cage (what "
+                         "the check's profile draws), so the subdivided surface of this mesh changes")
+    return notes
