@@ -59,6 +59,9 @@ def test_override_layer_composes_to_the_fixed_mesh_and_leaves_the_input_alone(tm
     result = run("fix", "--max-refine", "24", str(path))
     assert result.returncode == 0, result.stderr
     assert path.read_text() == STAGE
+    # USD's default scheme subdivides the panel: one note says its subdivided surface changes; none for the other
+    notes = [line for line in result.stdout.splitlines() if ": note: " in line]
+    assert len(notes) == 1 and "/World/Panel: subdivisionScheme catmullClark" in notes[0], result.stdout
     out = tmp_path / "stage.fixed.usda"
     layer = Sdf.Layer.FindOrOpen(str(out))
     assert list(layer.subLayerPaths) == ["stage.usda"]
@@ -72,8 +75,9 @@ def test_override_layer_composes_to_the_fixed_mesh_and_leaves_the_input_alone(tm
     original = load(path)
     expected = refine_mesh(original, plan_fix(original, FixSettings(max_refine=24))).mesh
     fixed = load(out)  # composed by pxr, read as the check reads it
-    # the trapezoid in 23 x 23, the square beside it fanned over the 23 segments of their edge, the other mesh
-    assert fixed.n_faces == expected.n_faces == 23 * 23 + (23 + 1) + 1
+    # the trapezoid in 23 x 23, the square beside it cut into quads closing to the 23 segments of their edge,
+    # the other mesh: quads only
+    assert fixed.n_faces == expected.n_faces > 23 * 23 + 2 and (fixed.face_sizes == 4).all()
     for name, index in (("positions", "corner_vertex"), ("texcoords", "corner_texcoord")):
         np.testing.assert_allclose(getattr(fixed, name)[getattr(fixed, index)],
                                    getattr(expected, name)[getattr(expected, index)], atol=1e-5)

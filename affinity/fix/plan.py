@@ -317,14 +317,19 @@ def plan_fix(mesh: Mesh, fix: FixSettings | None = None) -> FixPlan:
         plan = _plan(mesh, found, reasons, np.union1d(found.uncut, quiet), fix)
         flagged, new = verify(mesh, plan, fix, baseline)
         plan.new_findings = new
-        if len(flagged) == 0:
+        adding = np.array(sorted({d["face"] for d in new}), dtype=np.int64)
+        if len(flagged) == 0 and len(adding) == 0:
             break
         still = np.union1d(still, flagged)
-        refined_now = np.isin(found.faces, flagged) & (reasons == "")
-        if not refined_now.any() and not np.isin(flagged, plan.transition_faces).any():
+        earlier = reasons.copy()
+        refined_now = reasons == ""
+        for d in new:  # a refined quad whose pieces add a finding is left for that rule's reason
+            reasons[refined_now & (found.faces == d["face"])] = LEFT_BY_RULE.get(d["code"], "still-flagged")
+        reasons[np.isin(found.faces, flagged) & refined_now] = "still-flagged"
+        cut = np.intersect1d(np.union1d(flagged, adding), plan.transition_faces)
+        if (reasons == earlier).all() and np.isin(cut, quiet).all():  # nothing left to change
             break
-        reasons[refined_now] = "still-flagged"
-        quiet = np.union1d(quiet, np.intersect1d(flagged, plan.transition_faces))
+        quiet = np.union1d(quiet, cut)
     plan.still_flagged = np.intersect1d(still, plan.left_faces)
     missed = np.setdiff1d(flagged, plan.left_faces)
     if len(missed):  # the last round still flags faces it cut: listed, though their lines are gone
