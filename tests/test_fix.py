@@ -271,7 +271,8 @@ def test_neighbours_refined_at_different_levels_meet_point_for_point():
     faces = np.array([[0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6]])
     mesh = mesh_from_polygons("strip", positions, faces, texcoords=positions[:, :2] / 4)
     # quads 0 and 1 carry trapezoids of uv of their own, of different strength; quad 2 stays affine
-    trapezoids = [[[0.0, 0], [0.25, 0], [0.22, 0.25], [0.03, 0.25]], [[0.5, 0], [0.75, 0], [0.745, 0.25], [0.505, 0.25]]]
+    trapezoids = [[[0.0, 0], [0.25, 0], [0.22, 0.25], [0.03, 0.25]],
+                  [[0.5, 0], [0.75, 0], [0.745, 0.25], [0.505, 0.25]]]
     mesh.texcoords = np.vstack([mesh.texcoords, *trapezoids])
     mesh.corner_texcoord = mesh.corner_texcoord.copy()
     mesh.corner_texcoord[:8] = len(positions) + np.arange(8)
