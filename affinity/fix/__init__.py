@@ -26,6 +26,7 @@ input's, which the writers use.
 """
 
 from .apply import Refined, apply_fix, refine_mesh
-from .plan import REASONS, FixPlan, FixSettings, plan_fix
+from .loop import plan_fix
+from .plan import REASONS, FixPlan, FixSettings
 
 __all__ = ["REASONS", "FixPlan", "FixSettings", "Refined", "apply_fix", "plan_fix", "refine_mesh"]
