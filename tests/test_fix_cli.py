@@ -25,6 +25,14 @@ def check_json(path) -> dict:
     return json.loads(result.stdout)
 
 
+def local_copy(path, folder):
+    """``path`` copied into ``folder`` with the MTL and PNG files beside it; the copy's path."""
+    for sibling in path.parent.glob("*"):
+        if sibling.suffix in (".mtl", ".png") or sibling == path:
+            shutil.copy(sibling, folder / sibling.name)
+    return folder / path.name
+
+
 def findings_of(path) -> list[dict]:
     """Every finding of ``affinity check --format json PATH``."""
     return check_json(path)["findings"]
@@ -172,10 +180,7 @@ def test_appended_faces_restate_their_groups(shared_meshes, tmp_path):
 @pytest.mark.parametrize("path", SHARED or [pytest.param(None, marks=pytest.mark.skip("no shared meshes"))],
                          ids=[p.name for p in SHARED] or ["absent"])
 def test_after_fix_check_finds_no_scored_finding_but_on_left_quads_and_the_rest_unchanged(path, tmp_path):
-    for sibling in path.parent.glob("*"):
-        if sibling.suffix in (".mtl", ".png") or sibling == path:
-            shutil.copy(sibling, tmp_path / sibling.name)
-    local = tmp_path / path.name
+    local = local_copy(path, tmp_path)
     result = run("fix", "--dry-run", "--format", "json", str(local))
     plan = json.loads(result.stdout)["files"][0]
     left = {r["face"] for r in plan["left"]}

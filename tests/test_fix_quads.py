@@ -16,6 +16,7 @@ import pytest
 from helpers.cli import TRAPEZOID, run, write
 from helpers.corpus import shared_mesh_paths
 from test_fix import edge_map_agrees, grid_with_one_flagged_quad
+from test_fix_cli import local_copy
 
 from affinity.fix import FixSettings, plan_fix, refine_mesh
 from affinity.fix.patterns import SQUARE, quad_pattern
@@ -140,12 +141,7 @@ def test_the_fix_leaves_no_more_faces_than_the_triangulating_fix_did(shared_mesh
 @pytest.mark.parametrize("path", SHARED or [pytest.param(None, marks=pytest.mark.skip("no shared meshes"))],
                          ids=[p.name for p in SHARED] or ["absent"])
 def test_fix_then_check_flags_only_left_faces_whose_lines_are_byte_identical(path, tmp_path):
-    import shutil
-
-    for sibling in path.parent.glob("*"):
-        if sibling.suffix in (".mtl", ".png") or sibling == path:
-            shutil.copy(sibling, tmp_path / sibling.name)
-    local = tmp_path / path.name
+    local = local_copy(path, tmp_path)
     result = run("fix", "--format", "json", str(local))
     entry = json.loads(result.stdout)["files"][0]
     assert result.returncode == (1 if entry["left"] else 0), result.stderr

@@ -37,14 +37,29 @@ def counted_faces_added(mesh: Mesh, refine_faces: np.ndarray, refine_n: np.ndarr
                for pattern, faces in face_patterns(mesh, placed, replaced))
 
 
+def face_limit(mesh: Mesh, fix) -> int:
+    """The most faces the budget of ``fix`` lets the fix add to ``mesh`` (faces, and bytes per face)."""
+    per_face = estimated_bytes(mesh, fix.max_faces_added) / max(fix.max_faces_added, 1)
+    return min(fix.max_faces_added, int(fix.max_bytes_added // max(per_face, 1)))
+
+
+def beyond_budget(mesh: Mesh, badness: np.ndarray, reasons: np.ndarray, fix) -> np.ndarray:
+    """(k,) int64 rows of the quads to refine (``reasons`` "") that are far past the budget, the least bad
+    first: those whose pieces alone, at the level the 1/n^2 law guesses from ``badness`` (value over
+    threshold), pass twice the budget counting from the worst. Their levels need not be searched."""
+    rows = np.flatnonzero(reasons == "")
+    order = rows[np.argsort(-badness[rows], kind="stable")]
+    guess = np.clip(np.ceil(np.sqrt(badness[order])), 3, fix.cap).astype(np.int64) | 1
+    return order[np.cumsum(guess * guess - 1) > 2 * face_limit(mesh, fix)]
+
+
 def within_budget(mesh: Mesh, found, reasons: np.ndarray, fix) -> None:
     """Leave ``over-budget`` (in ``reasons`` (K,), in place) the least bad quads to refine that do not fit the
     budget of ``fix`` (:class:`affinity.fix.plan.FixSettings`); ``found`` the plan's candidates."""
     rows = np.flatnonzero(reasons == "")
     if len(rows) == 0:
         return
-    per_face = max(estimated_bytes(mesh, 1), 1)
-    limit = min(fix.max_faces_added, fix.max_bytes_added // per_face)
+    limit = face_limit(mesh, fix)
     order = rows[np.argsort(-found.badness[rows], kind="stable")]
     keep = len(order)
     frozen = np.union1d(found.faces[reasons != ""], found.uncut)

@@ -279,12 +279,19 @@ def candidates(mesh: Mesh, fix: FixSettings) -> Candidates:
         reasons[:] = "subdivided"
     need = np.zeros(len(found), dtype=np.int64)
     badness = np.zeros(len(found))
+    at = {}
     for code, (faces, values) in scored.items():
         rows = np.searchsorted(found, faces)
         keep = (rows < len(found)) & (found[np.minimum(rows, len(found) - 1)] == faces)
         threshold = fix.lint.threshold(code)
         ratio = values[keep] / threshold if threshold else values[keep]
         badness[rows[keep]] = np.maximum(badness[rows[keep]], ratio)
+        at[code] = rows, keep
+    from .budget import beyond_budget
+
+    reasons[beyond_budget(mesh, badness, reasons, fix)] = "over-budget"  # not searched: far past the budget
+    for code, (faces, values) in scored.items():
+        rows, keep = at[code]
         keep[keep] &= reasons[rows[keep]] == ""
         need[rows[keep]] = np.maximum(need[rows[keep]], needed_levels(mesh, faces[keep], values[keep], code, fix))
     reasons[(reasons == "") & (need > fix.cap)] = "over-cap"
