@@ -113,3 +113,40 @@ def Mesh "Panel"
     refine = planned["files"][0]["refine"]
     assert [(r["prim"], r["face"]) for r in refine] == [(f["prim"], f["face"]) for f in checked] == [("/Panel", 0)]
     assert refine[0]["where"] == f"{path}:/Panel:face 0"
+
+
+def test_the_shared_knight_is_refined_under_the_default_profile_with_one_note_per_subdividing_mesh(
+        shared_meshes, tmp_path):
+    import shutil
+
+    folder = shutil.copytree(shared_meshes / "usd" / "OpenChessSet" / "assets" / "Knight", tmp_path / "Knight")
+    result = run("fix", str(folder / "Knight.usd"))
+    assert result.returncode in (0, 1), result.stderr
+    notes = [line for line in result.stdout.splitlines() if ": note: " in line]
+    # the knight's one drawn mesh has no authored scheme: USD's default, Catmull-Clark, subdivides it
+    assert len(notes) == 1 and "/Knight/Geom/Render: subdivisionScheme catmullClark" in notes[0], result.stdout
+    fixed = load(folder / "Knight.fixed.usd")
+    original = load(folder / "Knight.usd")
+    assert fixed.n_faces > original.n_faces
+    assert np.count_nonzero(fixed.face_sizes != 4) == np.count_nonzero(original.face_sizes != 4)
+
+
+def test_under_a_subdividing_profile_every_flagged_quad_is_left_subdivided(tmp_path):
+    from types import SimpleNamespace
+
+    from affinity.fix.plan import profile_subdivides
+    from affinity.settings import Settings
+
+    path = tmp_path / "stage.usda"
+    path.write_text(STAGE)
+    mesh = load(path)
+    plan = plan_fix(mesh, FixSettings(subdivided=True))
+    assert plan.empty and plan.left_reasons.tolist() == ["subdivided"] and plan.faces_added == 0
+    # the hook: a check of the cage (today's settings, or a level 0) refines; a subdividing one does not
+    assert not profile_subdivides(Settings())
+    assert not profile_subdivides(SimpleNamespace(subdivision="level:0"))
+    assert profile_subdivides(SimpleNamespace(subdivision="level:2"))
+    assert profile_subdivides(SimpleNamespace(subdivision="limit"))
+    assert profile_subdivides(SimpleNamespace(subdivision="auto", profile="film"))
+    assert not profile_subdivides(SimpleNamespace(subdivision="auto", profile="film"), scheme_subdivides=False)
+    assert not profile_subdivides(SimpleNamespace(subdivision="auto", profile="storm"))

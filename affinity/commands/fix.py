@@ -165,20 +165,16 @@ def _fix_one(path: str, resolver, args) -> dict:
     try:
         plan = plan_fix(mesh, FixSettings(lint=settings, level=args.fix_level, max_refine=args.max_refine,
                                           refine_nonplanar=args.refine_nonplanar, inline=inline,
-                                          subdivided=profile_subdivides(settings),
+                                          subdivided=profile_subdivides(settings, _format(path) == "usd"),
                                           max_faces_added=args.max_faces_added,
                                           max_bytes_added=args.max_bytes_added))
         entry = plan_entry(path, mesh, plan)
-        if _format(path) == "usd" and not plan.empty:
-            from ..fix.usdlayer import subdivided_notes
-
-            entry["notes"] = subdivided_notes(path, mesh, plan.refined)
         refused = plan.new_findings and not args.allow_new_findings
         if not args.dry_run and not plan.empty and not refused:
             from ..fix.write import write_fixed
 
             out = _output_path(path, args)
-            write_fixed(path, out, mesh, plan, f"affinity fix: {summary(plan)}")
+            entry["notes"] = write_fixed(path, out, mesh, plan, f"affinity fix: {summary(plan)}")
             entry["output"] = out
     except OSError as err:
         reason = f"cannot write {_output_path(path, args)}: {err.strerror or err}"

@@ -83,12 +83,19 @@ class FixSettings:
         return self.max_refine | 1
 
 
-def profile_subdivides(settings: Settings) -> bool:
-    """Whether ``settings`` check the subdivided surface rather than the cage (a subdividing profile or a
-    subdivision level above 0): then the fix leaves its candidates ``subdivided``. Settings without a
-    subdivision setting check the cage."""
+#: Profiles that draw the subdivided surface of a mesh whose scheme subdivides (design.md, "Subdivision").
+SUBDIVIDING_PROFILES = ("blender-viewport", "blender-render", "film")
+
+
+def profile_subdivides(settings: Settings, scheme_subdivides: bool = True) -> bool:
+    """Whether ``settings`` check the subdivided surface rather than the cage: an explicit level above 0 or the
+    limit, or ``auto`` under a profile that subdivides for a mesh whose scheme subdivides
+    (``scheme_subdivides``: a USD mesh; OBJ, PLY and OFF have no scheme). Then the fix leaves its candidates
+    ``subdivided``. Settings without a subdivision setting check the cage."""
     subdivision = getattr(settings, "subdivision", "cage")
-    return subdivision not in ("cage", "auto", "level:0", None)
+    if subdivision == "auto":
+        return scheme_subdivides and getattr(settings, "profile", "game") in SUBDIVIDING_PROFILES
+    return subdivision not in ("cage", "level:0")
 
 
 @dataclass(eq=False)
