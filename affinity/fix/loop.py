@@ -30,13 +30,17 @@ def plan_fix(mesh: Mesh, fix: FixSettings | None = None) -> FixPlan:
     if not 1 <= fix.max_refine <= MAX_LEVEL:
         raise ValueError(f"max_refine must be from 1 to {MAX_LEVEL}; got {fix.max_refine}")
     found = candidates(mesh, fix)
-    baseline = flagged_by_rule(mesh, fix)
+    baseline = None
     reasons = found.reasons.copy()
     within_budget(mesh, found, reasons, fix)
     still = np.zeros(0, dtype=np.int64)
     quiet = np.zeros(0, dtype=np.int64)  # faces cut beside a refinement whose pieces the re-check flagged
     for _ in range(max(fix.verify_rounds, 1)):
         plan = _plan(mesh, found, reasons, np.union1d(found.uncut, quiet), fix)
+        if plan.empty:  # nothing refined: the result is the input, as checked
+            flagged = np.zeros(0, dtype=np.int64)
+            break
+        baseline = flagged_by_rule(mesh, fix) if baseline is None else baseline
         flagged, new = verify(mesh, plan, fix, baseline)
         plan.new_findings = new
         adding = np.array(sorted({d["face"] for d in new}), dtype=np.int64)
