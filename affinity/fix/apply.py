@@ -25,7 +25,6 @@ from ..mesh import Mesh
 from .grid import weights_at
 from .layout import Layout, edge_parameters, face_patterns, layout, unique_rows
 from .patterns import face_pattern
-from .plan import FixPlan
 
 
 @dataclass(eq=False)
@@ -143,8 +142,8 @@ def corner_slots(sizes: np.ndarray, order: np.ndarray) -> np.ndarray:
     return np.repeat(starts[order], picked) + np.arange(picked.sum()) - np.repeat(np.cumsum(picked) - picked, picked)
 
 
-def refine_mesh(mesh: Mesh, plan: FixPlan) -> Refined:
-    """Apply ``plan`` to ``mesh`` (module docstring): the fixed mesh and
+def refine_mesh(mesh: Mesh, plan) -> Refined:
+    """Apply ``plan`` (a :class:`affinity.fix.plan.FixPlan`) to ``mesh`` (module docstring): the fixed mesh and
     where its faces came from."""
     if plan.refined is not None:
         return plan.refined
@@ -225,6 +224,6 @@ def _assemble(mesh: Mesh, replaced: np.ndarray, tables: dict, faces: _Faces) -> 
     return Refined(fixed, source, added, replaced)
 
 
-def apply_fix(mesh: Mesh, plan: FixPlan) -> Mesh:
+def apply_fix(mesh: Mesh, plan) -> Mesh:
     """The fixed mesh of ``plan`` (:func:`refine_mesh` without the bookkeeping)."""
     return refine_mesh(mesh, plan).mesh

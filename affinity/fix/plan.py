@@ -23,9 +23,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..mesh import Mesh, mesh_from_polygons
+from ..mesh import Mesh
 from ..settings import Settings
-from . import grid
 
 #: The scored rules a refinement removes.
 SCORED = ("Q101", "Q102", "Q103")
@@ -193,35 +192,54 @@ def pole_quads(mesh: Mesh, faces: np.ndarray) -> np.ndarray:
     return collapsed.sum(axis=1) == 1
 
 
+def quads_alone(mesh: Mesh, faces: np.ndarray) -> Mesh:
+    """The quads ``faces`` (Q,) int64 of ``mesh`` as a mesh of their own: their corners' values only (tables
+    compacted), their materials, lines and groups; quads adjacent in ``mesh`` stay adjacent."""
+    corners = (mesh.face_start[faces, None] + np.arange(4)).reshape(-1)
+
+    def compact(values, index):
+        if values is None or index is None:
+            return values, None
+        used, local = np.unique(index[corners], return_inverse=True)
+        missing = used < 0
+        return values[used[~missing]], np.where(missing[local], -1, local - missing.sum()).reshape(-1)
+
+    positions, corner_vertex = compact(mesh.positions, mesh.corner_vertex)
+    used_vertices = np.unique(mesh.corner_vertex[corners])
+    texcoords, corner_texcoord = compact(mesh.texcoords, mesh.corner_texcoord)
+    normals, corner_normal = compact(mesh.normals, mesh.corner_normal)
+    return replace(mesh, positions=positions, colors=None if mesh.colors is None else mesh.colors[used_vertices],
+                   face_start=4 * np.arange(len(faces) + 1, dtype=np.int64), corner_vertex=corner_vertex,
+                   texcoords=texcoords, corner_texcoord=corner_texcoord, normals=normals, corner_normal=corner_normal,
+                   face_line=mesh.face_line[faces], face_group=mesh.face_group[faces],
+                   face_material=mesh.face_material[faces], prim_face_start=None, notes=[])
+
+
 def piece_scores(mesh: Mesh, faces: np.ndarray, n: int, settings: Settings, code: str) -> np.ndarray:
     """The worst value of rule ``code`` over the n x n pieces of each quad ``faces`` (Q,) int64.
 
-    The pieces are measured by the rule itself (:func:`affinity.lint.quad_scores`), on a mesh
-    made of them alone, each piece in its quad's material (so texels have the size of the texture
-    the quad binds).
+    The pieces are built as the fix builds them (:func:`affinity.fix.apply.build`, the quads alone,
+    each refined at ``n``) and measured by the rule itself (:func:`affinity.lint.quad_scores`), each
+    in its quad's material (so texels have the size of the texture the quad binds).
 
     Returns
     -------
     (Q,) float64, 0 where no piece can be measured.
     """
     from ..lint import quad_scores
+    from .apply import build
+    from .layout import layout
 
     worst = np.zeros(len(faces))
     for first in range(0, len(faces), SCORE_BATCH):
         chosen = faces[first : first + SCORE_BATCH]
-        corners = mesh.face_start[chosen, None] + np.arange(4)
-        points = {name: None if values is None else grid.blend(values, n).reshape(-1, values.shape[-1])
-                  for name in ("positions", "texcoords", "normals", "colors")
-                  for values in [mesh.corner_attribute(name, corners)]}
-        pieces = (grid.sub_quads(n)[None] + (n + 1) ** 2 * np.arange(len(chosen))[:, None, None]).reshape(-1, 4)
-        refined = mesh_from_polygons(mesh.path, points["positions"], pieces, points["texcoords"], points["normals"],
-                                     points["colors"])
-        refined = replace(refined, material_names=mesh.material_names, material_textures=mesh.material_textures,
-                          material_maps=mesh.material_maps, face_material=np.repeat(mesh.face_material[chosen], n * n))
-        scores = quad_scores(refined, settings, code)
-        values = np.zeros(len(pieces))
-        values[scores.faces] = scores.values
-        worst[first : first + SCORE_BATCH] = values.reshape(len(chosen), n * n).max(axis=1)
+        alone = quads_alone(mesh, chosen)
+        every = np.arange(len(chosen))
+        refined = build(alone, layout(alone, every, np.full(len(chosen), n)))
+        scores = quad_scores(refined.mesh, settings, code)
+        values = np.zeros(len(chosen))
+        np.maximum.at(values, refined.source[scores.faces], scores.values)
+        worst[first : first + SCORE_BATCH] = values
     return worst
 
 
