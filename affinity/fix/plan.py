@@ -145,10 +145,10 @@ class FixPlan:
         return len(self.refine_faces) == 0
 
 
-def shift_values(hits) -> np.ndarray:
-    """(n,) float64 the values a refinement must bring under the threshold: the rule's own measure, for uv
-    read through a texture the split's shift in texels (``visible.shifts``), never C (design.md, "One
-    findings table")."""
+def rule_values(hits) -> np.ndarray:
+    """(n,) float64: the values of ``hits`` in their rule's own unit, the one a refinement's pieces are measured
+    in: the texel shift where Q101's visible reading replaced it by C (``visible.shifts``), never the colour
+    (design.md, "One findings table")."""
     if hits.visible is None:
         return hits.values
     return np.where(np.isfinite(hits.visible.shifts), hits.visible.shifts, hits.values)
@@ -160,7 +160,7 @@ def flagged_quads(mesh: Mesh, fix: FixSettings) -> tuple[dict, dict]:
     Returns
     -------
     scored : code -> (faces (n,) int64, values (n,) float64) of Q101-Q103 findings at the level, values
-        in the rule's measure (:func:`shift_values`)
+        in the rule's measure (:func:`rule_values`)
     leaving : code -> faces (n,) int64 of the findings of :data:`LEFT_BY_RULE` and :data:`UNCUT_BY_RULE`
     """
     from ..findings import settle
@@ -175,7 +175,7 @@ def flagged_quads(mesh: Mesh, fix: FixSettings) -> tuple[dict, dict]:
     for h in hits:
         if h.code in SCORED:
             at_level = np.isin(h.levels(), LEVEL_ORDER[lowest:])
-            scored[h.code] = h.faces[at_level], shift_values(h)[at_level]
+            scored[h.code] = h.faces[at_level], rule_values(h)[at_level]
         else:
             leaving[h.code] = h.faces
     return scored, leaving
