@@ -188,3 +188,26 @@ def test_over_budget_refines_the_worst_first(shared_meshes):
     # of every quad left over budget
     badness = dict(zip(full.refine_faces.tolist(), (full.before / 0.5).tolist()))
     assert min(badness[f] for f in plan.refine_faces.tolist()) >= max(badness[f] for f in over.tolist())
+
+
+def test_a_result_adding_another_rules_finding_is_written_only_when_allowed(tmp_path, monkeypatch, capsys):
+    """The re-check is told the result adds a Q203 on a face the fix cannot leave (one it does not cut): the
+    result is refused (exit 1, nothing written, the face named) unless --allow-new-findings (written; exit 1
+    still, the result having the finding)."""
+    import affinity.fix.loop as loop
+    from affinity.cli import main
+
+    real = loop.verify
+
+    def adding(mesh, plan, fix, baseline):
+        flagged, _ = real(mesh, plan, fix, baseline)
+        return flagged, [{"code": "Q203", "face": 1}]
+
+    monkeypatch.setattr(loop, "verify", adding)
+    path = write(tmp_path, "t.obj", TRAPEZOID + "v 3 0 0\nv 4 0 0\nv 4 1 0\nv 3 1 0\nf 5/1 6/2 7/3 8/4\n")
+    assert main(["fix", "--max-refine", "24", "--format", "json", "--isolated", str(path)]) == 1
+    entry = json.loads(capsys.readouterr().out)["files"][0]
+    assert [(d["code"], d["face"]) for d in entry["new_findings"]] == [("Q203", 1)] and entry["refine"]
+    assert "output" not in entry and not (tmp_path / "t.fixed.obj").exists()
+    assert main(["fix", "--max-refine", "24", "--allow-new-findings", "--isolated", str(path)]) == 1
+    assert (tmp_path / "t.fixed.obj").exists() and "adds Q203" in capsys.readouterr().out
