@@ -6,7 +6,7 @@ the input as ``NAME.fixed.EXT`` (``-o`` names it for a single input; ``--in-plac
 replaces the input, atomically). ``--dry-run`` writes nothing and says what would be done.
 A result that adds a finding of another rule at warning or above is not written unless
 ``--allow-new-findings``. Exit codes: 0 every flagged quad fixed (or none flagged), 1 some
-left as they were (listed with the reason) or a result refused, 2 a usage error or an
+left as they were (listed with the reason) or a result that adds findings, 2 a usage error or an
 unreadable input (the other files are still fixed).
 """
 
