@@ -139,20 +139,28 @@ def grid_with_one_flagged_quad(size: int = 5) -> tuple[Mesh, int]:
     return mesh, middle
 
 
-def test_a_grid_with_one_flagged_quad_adds_at_most_n_squared_minus_one_plus_2n_per_shared_edge():
+def test_a_grid_with_one_flagged_quad_becomes_quads_only_and_its_neighbours_close_to_it():
     mesh, middle = grid_with_one_flagged_quad()
     assert [(h.code, h.faces.tolist()) for h in lint_mesh(mesh, Settings())] == [("Q101", [middle])]
     plan = plan_fix(mesh)
     assert plan.refine_faces.tolist() == [middle]
     n = int(plan.refine_n[0])
-    assert n >= 2
+    assert n >= 3 and n % 2 == 1
     # the four edge neighbours share one edge each with it; the diagonal neighbours share only a corner
     neighbours = sorted([middle - 1, middle + 1, middle - 5, middle + 5])
     assert plan.transition_faces.tolist() == neighbours
-    fixed = apply_fix(mesh, plan)
-    added = fixed.n_faces - mesh.n_faces
-    assert added == plan.faces_added
-    assert added <= (n * n - 1) + 4 * 2 * n == plan.faces_added_bound
+    refined = refine_mesh(mesh, plan)
+    fixed = refined.mesh
+    assert (fixed.face_sizes == 4).all()
+    assert fixed.n_faces - mesh.n_faces == plan.faces_added <= plan.faces_added_bound
+    # the refined quad is its n x n grid; each neighbour is cut into the four quads of a 3-to-1 cell per
+    # 3 of its split edge's segments (n = 3: one cell)
+    assert np.count_nonzero(refined.source == middle) == n * n
+    if n == 3:
+        assert all(np.count_nonzero(refined.source == f) == 4 for f in neighbours)
+    corners = fixed.positions[fixed.corner_vertex].reshape(-1, 4, 3)
+    signed = np.cross(corners[:, 2] - corners[:, 0], corners[:, 3] - corners[:, 1])[:, 2] / 2  # a planar quad's area
+    assert (signed > 0).all() and signed.sum() == pytest.approx(25.0, rel=1e-12)  # none folded over another
     assert not lint_mesh(fixed, Settings())
     edge_map_agrees(mesh, fixed)
 
@@ -263,7 +271,8 @@ def test_neighbours_refined_at_different_levels_meet_point_for_point():
     faces = np.array([[0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6]])
     mesh = mesh_from_polygons("strip", positions, faces, texcoords=positions[:, :2] / 4)
     # quads 0 and 1 carry trapezoids of uv of their own, of different strength; quad 2 stays affine
-    trapezoids = [[[0.0, 0], [0.25, 0], [0.23, 0.25], [0.02, 0.25]], [[0.5, 0], [0.75, 0], [0.74, 0.25], [0.51, 0.25]]]
+    trapezoids = [[[0.0, 0], [0.25, 0], [0.22, 0.25], [0.03, 0.25]],
+                  [[0.5, 0], [0.75, 0], [0.745, 0.25], [0.505, 0.25]]]
     mesh.texcoords = np.vstack([mesh.texcoords, *trapezoids])
     mesh.corner_texcoord = mesh.corner_texcoord.copy()
     mesh.corner_texcoord[:8] = len(positions) + np.arange(8)
@@ -275,11 +284,12 @@ def test_neighbours_refined_at_different_levels_meet_point_for_point():
     assert fixed.n_faces - mesh.n_faces == plan.faces_added <= plan.faces_added_bound
     assert not lint_mesh(fixed, Settings())
     edge_map_agrees(mesh, fixed)
-    # the edge x = 1 shared by the two refined quads carries the points of both levels, once each
+    assert (fixed.face_sizes == 4).all()
+    # the edge x = 1 shared by the two refined quads carries the points of the higher level, and the
+    # quad of the lower level closes to them with quads
     on_edge = np.unique(fixed.positions[np.isclose(fixed.positions[:, 0], 1)][:, 1])
     n0, n1 = plan.refine_n.tolist()
-    expected = np.unique(np.concatenate([np.arange(n0 + 1) / n0, np.arange(n1 + 1) / n1]))
-    np.testing.assert_allclose(on_edge, expected, atol=1e-12)
+    np.testing.assert_allclose(on_edge, np.arange(max(n0, n1) + 1) / max(n0, n1), atol=1e-12)
 
 
 @pytest.mark.parametrize("seed", range(8))

@@ -59,6 +59,9 @@ def test_override_layer_composes_to_the_fixed_mesh_and_leaves_the_input_alone(tm
     result = run("fix", "--max-refine", "24", str(path))
     assert result.returncode == 0, result.stderr
     assert path.read_text() == STAGE
+    # USD's default scheme subdivides the panel: one note says its subdivided surface changes; none for the other
+    notes = [line for line in result.stdout.splitlines() if ": note: " in line]
+    assert len(notes) == 1 and "/World/Panel: subdivisionScheme catmullClark" in notes[0], result.stdout
     out = tmp_path / "stage.fixed.usda"
     layer = Sdf.Layer.FindOrOpen(str(out))
     assert list(layer.subLayerPaths) == ["stage.usda"]
@@ -72,8 +75,9 @@ def test_override_layer_composes_to_the_fixed_mesh_and_leaves_the_input_alone(tm
     original = load(path)
     expected = refine_mesh(original, plan_fix(original, FixSettings(max_refine=24))).mesh
     fixed = load(out)  # composed by pxr, read as the check reads it
-    # the trapezoid in 23 x 23, the square beside it fanned over the 23 segments of their edge, the other mesh
-    assert fixed.n_faces == expected.n_faces == 23 * 23 + (23 + 1) + 1
+    # the trapezoid in 23 x 23, the square beside it cut into quads closing to the 23 segments of their edge,
+    # the other mesh: quads only
+    assert fixed.n_faces == expected.n_faces > 23 * 23 + 2 and (fixed.face_sizes == 4).all()
     for name, index in (("positions", "corner_vertex"), ("texcoords", "corner_texcoord")):
         np.testing.assert_allclose(getattr(fixed, name)[getattr(fixed, index)],
                                    getattr(expected, name)[getattr(expected, index)], atol=1e-5)
@@ -109,3 +113,40 @@ def Mesh "Panel"
     refine = planned["files"][0]["refine"]
     assert [(r["prim"], r["face"]) for r in refine] == [(f["prim"], f["face"]) for f in checked] == [("/Panel", 0)]
     assert refine[0]["where"] == f"{path}:/Panel:face 0"
+
+
+def test_the_shared_knight_is_refined_under_the_default_profile_with_one_note_per_subdividing_mesh(
+        shared_meshes, tmp_path):
+    import shutil
+
+    folder = shutil.copytree(shared_meshes / "usd" / "OpenChessSet" / "assets" / "Knight", tmp_path / "Knight")
+    result = run("fix", str(folder / "Knight.usd"))
+    assert result.returncode in (0, 1), result.stderr
+    notes = [line for line in result.stdout.splitlines() if ": note: " in line]
+    # the knight's one drawn mesh has no authored scheme: USD's default, Catmull-Clark, subdivides it
+    assert len(notes) == 1 and "/Knight/Geom/Render: subdivisionScheme catmullClark" in notes[0], result.stdout
+    fixed = load(folder / "Knight.fixed.usd")
+    original = load(folder / "Knight.usd")
+    assert fixed.n_faces > original.n_faces
+    assert np.count_nonzero(fixed.face_sizes != 4) == np.count_nonzero(original.face_sizes != 4)
+
+
+def test_under_a_subdividing_profile_every_flagged_quad_is_left_subdivided(tmp_path):
+    from types import SimpleNamespace
+
+    from affinity.fix.plan import profile_subdivides
+    from affinity.settings import Settings
+
+    path = tmp_path / "stage.usda"
+    path.write_text(STAGE)
+    mesh = load(path)
+    plan = plan_fix(mesh, FixSettings(subdivided=True))
+    assert plan.empty and plan.left_reasons.tolist() == ["subdivided"] and plan.faces_added == 0
+    # the hook: a check of the cage (today's settings, or a level 0) refines; a subdividing one does not
+    assert not profile_subdivides(Settings())
+    assert not profile_subdivides(SimpleNamespace(subdivision="level:0"))
+    assert profile_subdivides(SimpleNamespace(subdivision="level:2"))
+    assert profile_subdivides(SimpleNamespace(subdivision="limit"))
+    assert profile_subdivides(SimpleNamespace(subdivision="auto", profile="film"))
+    assert not profile_subdivides(SimpleNamespace(subdivision="auto", profile="film"), scheme_subdivides=False)
+    assert not profile_subdivides(SimpleNamespace(subdivision="auto", profile="storm"))

@@ -1,11 +1,13 @@
 """``affinity fix PATH... [-o OUT] [--dry-run] [--format json]``: refine the flagged quads (issue 41).
 
 Each file is linted; the quads Q101-Q103 flag at or above ``--fix-level`` are refined
-(:mod:`affinity.fix`) and the result written beside the input as ``NAME.fixed.EXT``
-(``-o`` names it for a single input; ``--in-place`` replaces the input, atomically).
-``--dry-run`` writes nothing and says what would be done. Exit codes: 0 every flagged
-quad fixed (or none flagged), 1 some left as they were (listed with the reason), 2 a
-usage error or an unreadable input (the other files are still fixed).
+with quads only (:mod:`affinity.fix`), the result re-checked in memory, and written beside
+the input as ``NAME.fixed.EXT`` (``-o`` names it for a single input; ``--in-place``
+replaces the input, atomically). ``--dry-run`` writes nothing and says what would be done.
+A result that adds a finding of another rule at warning or above is not written unless
+``--allow-new-findings``. Exit codes: 0 every flagged quad fixed (or none flagged), 1 some
+left as they were (listed with the reason) or a result that adds findings, 2 a usage error or an
+unreadable input (the other files are still fixed).
 """
 
 from __future__ import annotations
@@ -26,7 +28,17 @@ def _level(text: str) -> int:
     return int(text)
 
 
+def _count(text: str) -> int:
+    """A positive count, digits with optional ``_`` or ``,`` separators and an optional K, M or G."""
+    scale = {"k": 10**3, "m": 10**6, "g": 10**9}.get(text[-1:].lower(), 1)
+    digits = (text[:-1] if scale > 1 else text).replace("_", "").replace(",", "")
+    if not digits.isdigit() or int(digits) == 0:
+        raise argparse.ArgumentTypeError(f"not a positive count: {text!r}")
+    return int(digits) * scale
+
+
 def add_parser(sub) -> None:
+    from ..fix.plan import MAX_BYTES_ADDED, MAX_FACES_ADDED
     from ..loaders.formats import described
     from ..settings import DIAGONALS, MEASURES
     from .check import _codes, _measure, _selection, _threshold
@@ -34,8 +46,10 @@ def add_parser(sub) -> None:
     p = sub.add_parser(
         "fix", help="refine the quads the affinity rules flag, crack-free, touching nothing else",
         description=f"Refine the quads of {described()} files that Q101-Q103 flag until the crease is gone: "
-                    "each becomes n x n quads on its own bilinear surface, and the faces beside it are re-cut "
-                    "to meet the new edge points (no T-junction). Writes NAME.fixed.EXT beside each input.",
+                    "each becomes n x n quads on its own bilinear surface (n odd), and the faces beside it are "
+                    "cut into quads to meet the new edge points (no T-junction, no triangle); a face it leaves "
+                    "keeps its line. The result is re-checked before it is written. Writes NAME.fixed.EXT "
+                    "beside each input.",
     )
     p.add_argument("paths", nargs="+", metavar="PATH",
                    help="mesh files or directories (searched as check searches them; NAME.fixed.EXT files "
@@ -47,9 +61,17 @@ def add_parser(sub) -> None:
     p.add_argument("--format", choices=("text", "json"), default="text", help="output of --dry-run and the summary")
     p.add_argument("--fix-level", choices=("info", "warning", "error"), default="warning",
                    help="the lowest level of a Q101-Q103 finding that is fixed (default: warning)")
-    p.add_argument("--max-refine", type=_level, default=8, metavar="N",
-                   help="refine a quad into at most N x N quads (default 8); one that needs more is left "
-                        "and reported as needing a re-UV")
+    p.add_argument("--max-refine", type=_level, default=9, metavar="N",
+                   help="refine a quad into at most N x N quads, N rounded up to odd (default 9); one that needs "
+                        "more is left and reported as needing a re-UV")
+    p.add_argument("--max-faces-added", type=_count, default=MAX_FACES_ADDED, metavar="N",
+                   help=f"the output budget in faces added per file (default {MAX_FACES_ADDED:,}); past it the "
+                        "worst quads are refined first and the rest left over-budget")
+    p.add_argument("--max-bytes-added", type=_count, default=MAX_BYTES_ADDED, metavar="N",
+                   help=f"the output budget in bytes added per file, estimated (default {MAX_BYTES_ADDED:,}; "
+                        "K, M, G allowed)")
+    p.add_argument("--allow-new-findings", action="store_true",
+                   help="write a result even where it adds a finding of another rule at warning or above")
     p.add_argument("--refine-nonplanar", action="store_true",
                    help="refine the quads Q202 flags too: their pieces follow the quad's bilinear surface, "
                         "not the folded split the input draws (default: left)")
@@ -120,13 +142,14 @@ def run(args) -> int:
         sys.stdout.write("\n")
     if any("error" in r for r in results):
         return EXIT_ERROR
-    return EXIT_FINDINGS if any(r.get("left") for r in results) else EXIT_CLEAN
+    return EXIT_FINDINGS if any(r.get("left") or r.get("new_findings") for r in results) else EXIT_CLEAN
 
 
 def _fix_one(path: str, resolver, args) -> dict:
     """Fix (or, with --dry-run, plan) one file; its entry of the JSON document. Never raises for bad input."""
     from ..errors import MeshError, SkippedFile
     from ..fix import FixSettings, plan_fix
+    from ..fix.plan import profile_subdivides
     from ..loaders import load
 
     try:
@@ -141,13 +164,17 @@ def _fix_one(path: str, resolver, args) -> dict:
         return {"path": path, "error": err.reason, "line": err.line}
     try:
         plan = plan_fix(mesh, FixSettings(lint=settings, level=args.fix_level, max_refine=args.max_refine,
-                                          refine_nonplanar=args.refine_nonplanar, inline=inline))
+                                          refine_nonplanar=args.refine_nonplanar, inline=inline,
+                                          subdivided=profile_subdivides(settings, _format(path) == "usd"),
+                                          max_faces_added=args.max_faces_added,
+                                          max_bytes_added=args.max_bytes_added))
         entry = plan_entry(path, mesh, plan)
-        if not args.dry_run and not plan.empty:
+        refused = plan.new_findings and not args.allow_new_findings
+        if not args.dry_run and not plan.empty and not refused:
             from ..fix.write import write_fixed
 
             out = _output_path(path, args)
-            write_fixed(path, out, mesh, plan, f"affinity fix: {summary(plan)}")
+            entry["notes"] = write_fixed(path, out, mesh, plan, f"affinity fix: {summary(plan)}")
             entry["output"] = out
     except OSError as err:
         reason = f"cannot write {_output_path(path, args)}: {err.strerror or err}"
@@ -173,8 +200,8 @@ def _inline_ignores(path: str, mesh) -> list:
 def summary(plan) -> str:
     """One line: quads refined, faces re-cut, faces added, quads left."""
     left = f", {len(plan.left_faces)} flagged quads left" if len(plan.left_faces) else ""
-    return (f"{len(plan.refine_faces)} quads refined, {len(plan.transition_faces)} faces re-cut to meet them, "
-            f"{plan.faces_added:+d} faces{left}")
+    return (f"{len(plan.refine_faces)} quads refined, {len(plan.transition_faces)} faces cut into quads to meet "
+            f"them, {plan.faces_added:+d} faces{left}")
 
 
 def where(path: str, mesh, face: int) -> str:
@@ -212,7 +239,19 @@ def plan_entry(path: str, mesh, plan) -> dict:
                         for f in plan.transition_faces.tolist()],
         "faces_added": plan.faces_added,
         "faces_added_bound": plan.faces_added_bound,
+        "bytes_added": plan.bytes_added,
+        "new_findings": [{**as_in_check(mesh, d["face"]), "code": d["code"], "where": where(path, mesh, d["face"])}
+                         for d in plan.new_findings],
     }
+
+
+#: What a left face's text line says, by reason.
+LEFT_WHY = {
+    "over-cap": "needs more than --max-refine: re-UV it",
+    "over-budget": "past the output budget (--max-faces-added, --max-bytes-added)",
+    "still-flagged": "its refinement still reads over the threshold: left as it was",
+    "subdivided": "the profile draws the subdivided surface",
+}
 
 
 def write_text(entry: dict, dry_run: bool, out, quiet: bool = False) -> None:
@@ -226,12 +265,18 @@ def write_text(entry: dict, dry_run: bool, out, quiet: bool = False) -> None:
         change = f"{number_text(r['before'])} -> {number_text(r['after'])}"
         out.write(f"{r['where']}: {verb} n={r['n']}: {r['code']} {change} {r['unit']} [face {r['face']}]\n")
     for r in [] if quiet else entry["left"]:
-        why = "needs more than --max-refine: re-UV it" if r["reason"] == "over-cap" else "not refined"
+        why = LEFT_WHY.get(r["reason"], "not refined")
         out.write(f"{r['where']}: left ({r['reason']}): {why} [face {r['face']}]\n")
-    done = f"{verb} {len(entry['refine'])} quads, re-cut {len(entry['transitions'])} neighbours"
-    added = f"{entry['faces_added']:+d} faces (at most {entry['faces_added_bound']:+d})"
+    for r in entry["new_findings"]:
+        out.write(f"{r['where']}: the result adds {r['code']} on its new faces [face {r['face']}]\n")
+    for note in entry.get("notes", []):
+        out.write(f"{path}: note: {note}\n")
+    done = f"{verb} {len(entry['refine'])} quads, cut {len(entry['transitions'])} neighbours into quads"
+    added = f"{entry['faces_added']:+d} faces, about {entry['bytes_added']:+,d} bytes"
     if "output" in entry:
         target = f" -> {entry['output']}"
+    elif entry["new_findings"] and entry["refine"]:
+        target = ", not written: it adds findings (--allow-new-findings writes it)"
     else:
         target = "" if dry_run or entry["refine"] else ", nothing to write"
     out.write(f"{path}: {done}, {added}, {len(entry['left'])} left{target}\n")

@@ -4,13 +4,12 @@ Each attribute table (positions with their vertex colours, texture coordinates,
 normals) grows by the values of its new entries, appended after the existing ones so
 no index of the input moves:
 
-* points on edges, one run per distinct (start, end, levels) of table indices, at the
-  edge's parameters (every k/n of the levels of the refined quads on it) along the edge in
-  its canonical direction (so both faces on an edge get bit-identical values) — the
-  bilinear blend restricted to the edge;
-* the (n - 1)^2 inner points of each refined quad, its bilinear blend
-  (:mod:`affinity.fix.grid`);
-* the centre of a transition face that needs one (:mod:`affinity.fix.tessellate`).
+* points on edges, one run per distinct (start, end, count) of table indices, at the
+  edge's parameters (k / count, :mod:`affinity.fix.layout`) along the edge in its canonical
+  direction (so both faces on an edge get bit-identical values) — the bilinear blend
+  restricted to the edge;
+* the inner points of each cut face (:mod:`affinity.fix.patterns`), the bilinear blend of its
+  corners at their (s, t) (:mod:`affinity.fix.grid`).
 
 Normals are scaled back to unit length after blending. A corner without a value
 (index -1) gives its new points none either.
@@ -23,10 +22,9 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..mesh import Mesh
-from . import grid
+from .grid import weights_at
 from .layout import Layout, edge_parameters, face_patterns, layout, unique_rows
-from .plan import FixPlan
-from .tessellate import CENTRE, face_polygons
+from .patterns import face_pattern
 
 
 @dataclass(eq=False)
@@ -85,24 +83,24 @@ def _edge_points(table: _Table, placed: Layout) -> tuple[np.ndarray, np.ndarray]
     Returns
     -------
     start : (C + 1,) int64 corner c's points are ``points[start[c]:start[c + 1]]``
-        (:func:`affinity.fix.layout.edge_parameters` of its edge's levels), in the direction of its face
+        (:func:`affinity.fix.layout.edge_parameters` of its edge's count), in the direction of its face
     points : (S,) int64 indices into the table, -1 where an end of the edge has no value
     """
     per_corner = placed.points
     start = np.concatenate([[0], np.cumsum(per_corner)])
     points = np.full(start[-1], -1, dtype=np.int64)
     split = np.flatnonzero(per_corner > 0)
-    a, b, bits = table.index[split], table.index[placed.following[split]], placed.levels[split]
+    a, b, count = table.index[split], table.index[placed.following[split]], placed.counts[split]
     forward = (placed.start[split] < placed.end[split]) | ((placed.start[split] == placed.end[split]) & (a <= b))
     low, high = np.where(forward, a, b), np.where(forward, b, a)
     valued = (a >= 0) & (b >= 0)
-    ends = np.stack([low, high, bits], axis=1)[valued]
+    ends = np.stack([low, high, count], axis=1)[valued]
     first_row, which = unique_rows(ends)
     keys = ends[first_row]
     first = np.zeros(len(keys), dtype=np.int64)
-    for levels in np.unique(keys[:, 2]).tolist():  # one pass per set of levels on an edge
-        rows = np.flatnonzero(keys[:, 2] == levels)
-        t = np.array([float(p) for p in edge_parameters(levels)])[None, :, None]
+    for count in np.unique(keys[:, 2]).tolist():  # one pass per count of segments on an edge
+        rows = np.flatnonzero(keys[:, 2] == count)
+        t = edge_parameters(count)[None, :, None]
         lerped = table.values[keys[rows, 0]][:, None] * (1 - t) + table.values[keys[rows, 1]][:, None] * t
         first[rows] = table.append(lerped.reshape(-1, table.values.shape[1]))[:: t.shape[1]]
     occurrence = np.flatnonzero(valued)
@@ -144,9 +142,16 @@ def corner_slots(sizes: np.ndarray, order: np.ndarray) -> np.ndarray:
     return np.repeat(starts[order], picked) + np.arange(picked.sum()) - np.repeat(np.cumsum(picked) - picked, picked)
 
 
-def refine_mesh(mesh: Mesh, plan: FixPlan) -> Refined:
-    """Apply ``plan`` to ``mesh`` (module docstring): the fixed mesh and where its faces came from."""
-    placed = layout(mesh, plan.refine_faces, plan.refine_n)
+def refine_mesh(mesh: Mesh, plan) -> Refined:
+    """Apply ``plan`` (a :class:`affinity.fix.plan.FixPlan`) to ``mesh`` (module docstring): the fixed mesh and
+    where its faces came from."""
+    if plan.refined is not None:
+        return plan.refined
+    return build(mesh, layout(mesh, plan.refine_faces, plan.refine_n, plan.frozen_faces))
+
+
+def build(mesh: Mesh, placed: Layout) -> Refined:
+    """The fixed mesh of the refinement ``placed``: the refined quads and the faces beside them cut, the rest kept."""
     positions = mesh.positions if mesh.colors is None else np.hstack([mesh.positions, mesh.colors])
     tables = {"positions": _Table(positions, mesh.corner_vertex, unit=False)}
     if mesh.texcoords is not None and mesh.corner_texcoord is not None:
@@ -155,35 +160,30 @@ def refine_mesh(mesh: Mesh, plan: FixPlan) -> Refined:
         tables["normals"] = _Table(mesh.normals, mesh.corner_normal, unit=True)
     edges = {name: _edge_points(table, placed) for name, table in tables.items()}
     faces = _Faces(list(tables))
-    replaced = np.union1d(plan.refine_faces, placed.transition_faces)
-    for pattern, chosen in face_patterns(mesh, placed, replaced):
-        polygons = face_polygons(*pattern)
-        ids = {name: _local_points(table, edges[name], mesh, chosen, pattern, polygons)
+    replaced = np.union1d(np.flatnonzero(placed.level), placed.transition_faces)
+    for (counts, level), chosen in face_patterns(mesh, placed, replaced):
+        pattern = face_pattern(counts, level)
+        ids = {name: _local_points(table, edges[name], mesh, chosen, counts, pattern.inner)
                for name, table in tables.items()}
-        for size in sorted({len(p) for p in polygons}):
-            picked = np.array([p for p in polygons if len(p) == size])
+        for size in sorted({len(p) for p in pattern.polygons}):
+            picked = np.array([p for p in pattern.polygons if len(p) == size])
             faces.add(np.repeat(chosen, len(picked)),
                       {name: local[:, picked].reshape(-1, size) for name, local in ids.items()})
     return _assemble(mesh, replaced, tables, faces)
 
 
-def _local_points(table: _Table, edge: tuple, mesh: Mesh, faces: np.ndarray, pattern: tuple,
-                  polygons) -> np.ndarray:
-    """(T, L) int64 table indices of the local ids of :func:`~affinity.fix.tessellate.face_polygons` for the
-    faces ``faces`` (T,) of one pattern: the ring (corners, edge points), a refined quad's inner grid
-    points, then the centre when the cut needs one (:data:`CENTRE` = -1 picks the last column)."""
+def _local_points(table: _Table, edge: tuple, mesh: Mesh, faces: np.ndarray, counts: tuple,
+                  inner: np.ndarray) -> np.ndarray:
+    """(T, L) int64 table indices of the local ids of a :class:`~affinity.fix.patterns.Pattern` for the faces
+    ``faces`` (T,) of one pattern: the ring (corners, edge points), then the ``inner`` (K, 2) points, each the
+    bilinear blend of the face's four corners at its (s, t)."""
     start, points = edge
-    level, edge_levels = pattern[0], pattern[1]
-    counts = [len(edge_parameters(bits)) + 1 for bits in edge_levels]
     corners = mesh.face_start[faces, None] + np.arange(len(counts))
     columns = []
     for i, count in enumerate(counts):
         columns += [table.index[corners[:, i, None]], points[start[corners[:, i], None] + np.arange(count - 1)]]
-    if level:
-        inner = grid.bilinear_weights(level)[grid.interior_points(level)]
-        columns.append(table.blend_new(table.index[corners], inner))
-    if any(CENTRE in p for p in polygons):
-        columns.append(table.blend_new(table.index[corners], np.full((1, len(counts)), 1 / len(counts))))
+    if len(inner):
+        columns.append(table.blend_new(table.index[corners], weights_at(inner)))
     return np.concatenate(columns, axis=1)
 
 
@@ -207,7 +207,7 @@ def _assemble(mesh: Mesh, replaced: np.ndarray, tables: dict, faces: _Faces) -> 
     fixed = replace(
         mesh,
         positions=np.ascontiguousarray(vertex_values[:, :3]),
-        colors=None if mesh.colors is None else np.ascontiguousarray(vertex_values[:, 3:]),
+        colors=None if mesh.colors is None else np.clip(vertex_values[:, 3:], 0.0, 1.0),  # blends round past 1
         face_start=np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64),
         corner_vertex=corner_of["positions"],
         face_line=np.where(added, 0, mesh.face_line[source]).astype(np.int64),
@@ -224,6 +224,6 @@ def _assemble(mesh: Mesh, replaced: np.ndarray, tables: dict, faces: _Faces) -> 
     return Refined(fixed, source, added, replaced)
 
 
-def apply_fix(mesh: Mesh, plan: FixPlan) -> Mesh:
+def apply_fix(mesh: Mesh, plan) -> Mesh:
     """The fixed mesh of ``plan`` (:func:`refine_mesh` without the bookkeeping)."""
     return refine_mesh(mesh, plan).mesh

@@ -5,26 +5,24 @@ that meet on a seam (coincident vertices written twice, as OBJ files do where uv
 colour change) still share the edge: splitting it on one side splits it on the other,
 and no crack opens in space where the file had none.
 
-A refined quad of level n puts points at k/n along each of its edges. An edge keeps the
-points of every refined quad on it: its *levels* (a bit set, bit n for level n) decide
-its points, the union of the k/n (:func:`edge_parameters`), the same for every face on
-the edge, so both sides meet point for point. Quads refined at different levels keep
-their own levels; only the cells of their grids along the shared edge take the other's
-points too (:func:`affinity.fix.tessellate.face_polygons`).
+A refined quad of level n (odd) puts points at k/n along each of its edges. An edge takes the
+highest level of the refined quads on it, its *count* c, and its points are the k/c
+(:func:`edge_parameters`), the same for every face on the edge, so both sides meet point for
+point. An edge of a face the fix leaves keeps no point: the face is never re-cut. Every count
+is odd, so every quad's four counts sum to an even number and it closes with quads
+(:mod:`affinity.fix.patterns`).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from fractions import Fraction
-from functools import cache
 
 import numpy as np
 
 from ..mesh import Mesh
 
-#: Levels are kept as bits of an int64.
-MAX_LEVEL = 62
+#: The highest level a refinement takes (a sanity bound: the cap is --max-refine).
+MAX_LEVEL = 63
 
 
 def unique_rows(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -74,12 +72,9 @@ def edge_keys(welded_start: np.ndarray, welded_end: np.ndarray, n_vertices: int)
     return np.where(low == high, own, low * max(n_vertices, 1) + high)
 
 
-@cache
-def edge_parameters(levels: int) -> tuple[Fraction, ...]:
-    """The points of an edge whose refined quads have the level bits ``levels``: every k/n strictly
-    between 0 and 1 for each level n, once, ascending (symmetric: t and 1 - t both appear)."""
-    found = {Fraction(k, n) for n in range(2, MAX_LEVEL + 1) if levels >> n & 1 for k in range(1, n)}
-    return tuple(sorted(found))
+def edge_parameters(count: int) -> np.ndarray:
+    """(count - 1,) float64: the points of an edge cut in ``count`` segments, k / count strictly between 0 and 1."""
+    return np.arange(1, count) / count
 
 
 @dataclass(eq=False)
@@ -90,7 +85,7 @@ class Layout:
     ----------
     following : (C,) int64 the next corner of every corner's face (:func:`next_corners`)
     start, end : (C,) int64 welded ids of the ends of the edge from each corner to the next
-    levels : (C,) int64 level bits of the edge from each corner to the next (0: no point on it)
+    counts : (C,) int64 segments of the edge from each corner to the next (1: no point on it; odd)
     level : (F,) int64 every face's refinement level, 0 for a face not refined
     transition_faces : (T,) int64 faces not refined that share an edge with a refined quad
     """
@@ -98,56 +93,59 @@ class Layout:
     following: np.ndarray
     start: np.ndarray
     end: np.ndarray
-    levels: np.ndarray
+    counts: np.ndarray
     level: np.ndarray
     transition_faces: np.ndarray
 
     @property
     def points(self) -> np.ndarray:
         """(C,) int64: how many points the edge from each corner gets."""
-        bits, which = np.unique(self.levels, return_inverse=True)
-        counts = np.array([len(edge_parameters(b)) for b in bits.tolist()], dtype=np.int64)
-        return counts[which.reshape(-1)]
+        return self.counts - 1
 
 
-def layout(mesh: Mesh, refine_faces: np.ndarray, refine_n: np.ndarray) -> Layout:
-    """Put the points of the quads ``refine_faces`` (R,) int64 refined at levels ``refine_n`` (R,) on their edges."""
+def layout(mesh: Mesh, refine_faces: np.ndarray, refine_n: np.ndarray, frozen: np.ndarray | None = None) -> Layout:
+    """Put the points of the quads ``refine_faces`` (R,) int64 refined at levels ``refine_n`` (R,) on their edges.
+
+    An edge takes the highest level of the refined quads on it (odd levels: every quad's counts are odd, so
+    every quad closes with quads, :mod:`affinity.fix.patterns`); an edge of a face in ``frozen`` (k,) int64
+    (faces left as they are) keeps its ends only, and the refined quad beside it closes to it.
+    """
     if len(refine_n) and int(np.max(refine_n)) > MAX_LEVEL:
         raise ValueError(f"refinement levels go up to {MAX_LEVEL}")
     welded = welded_vertices(mesh.positions)
     following = next_corners(mesh)
     start, end = welded[mesh.corner_vertex], welded[mesh.corner_vertex[following]]
     keys = edge_keys(start, end, len(welded))
+    face_of = np.repeat(np.arange(mesh.n_faces), mesh.face_sizes)
     refined_corners = (mesh.face_start[refine_faces, None] + np.arange(4)).reshape(-1)
     split_keys, edge = np.unique(keys[refined_corners], return_inverse=True)
-    bits = np.zeros(len(split_keys), dtype=np.int64)
-    np.bitwise_or.at(bits, edge.reshape(-1), np.left_shift(1, np.repeat(refine_n, 4)).astype(np.int64))
-    levels = np.zeros(len(keys), dtype=np.int64)
+    most = np.ones(len(split_keys), dtype=np.int64)
+    np.maximum.at(most, edge.reshape(-1), np.repeat(refine_n, 4).astype(np.int64))
+    if frozen is not None and len(frozen) and len(split_keys):
+        frozen_corners = np.flatnonzero(np.isin(face_of, frozen))
+        at = np.minimum(np.searchsorted(split_keys, keys[frozen_corners]), len(split_keys) - 1)
+        most[at[split_keys[at] == keys[frozen_corners]]] = 1
+    counts = np.ones(len(keys), dtype=np.int64)
     if len(split_keys):
         at = np.minimum(np.searchsorted(split_keys, keys), len(split_keys) - 1)
         hit = split_keys[at] == keys
-        levels[hit] = bits[at[hit]]
+        counts[hit] = most[at[hit]]
     level = np.zeros(mesh.n_faces, dtype=np.int64)
     level[refine_faces] = refine_n
-    face_of = np.repeat(np.arange(mesh.n_faces), mesh.face_sizes)
     touched = np.zeros(mesh.n_faces, dtype=bool)
-    touched[face_of[levels > 0]] = True
+    touched[face_of[counts > 1]] = True
     touched[refine_faces] = False
-    return Layout(following, start, end, levels, level, np.flatnonzero(touched))
+    return Layout(following, start, end, counts, level, np.flatnonzero(touched))
 
 
 def face_patterns(mesh: Mesh, placed: Layout, faces: np.ndarray) -> list[tuple[tuple, np.ndarray]]:
-    """The faces ``faces`` (n,) int64 grouped by the pattern of their cut
-    (the arguments of :func:`affinity.fix.tessellate.face_polygons`).
+    """The faces ``faces`` (n,) int64 grouped by their cut: ``(counts per edge, level)``, the arguments of
+    :func:`affinity.fix.patterns.face_pattern` (level 1 for a face not refined).
 
     Returns
     -------
-    list of (pattern, faces): ``pattern`` = (level, edge level bits per edge, which corners may
-    be a fan's apex (every corner, but only the reflex one of a concave quad), which edges are
-    collapsed); ``faces`` (m,) int64 the faces of that pattern in file order.
+    list of (pattern, faces): ``faces`` (m,) int64 the faces of that pattern in file order.
     """
-    from ..geometry import planar_quads
-
     if len(faces) == 0:
         return []
     sizes = mesh.face_sizes[faces]
@@ -155,22 +153,11 @@ def face_patterns(mesh: Mesh, placed: Layout, faces: np.ndarray) -> list[tuple[t
     slot = np.arange(width)
     present = slot < sizes[:, None]
     corners = np.where(present, mesh.face_start[faces, None] + slot, 0)
-    bits = np.where(present, placed.levels[corners], -1)
-    apexes = present.copy()
-    quads = np.flatnonzero(sizes == 4)
-    if len(quads):
-        reflex = planar_quads(mesh.positions[mesh.corner_vertex[corners[quads, :4]]]).reflex
-        concave = reflex.any(axis=1)
-        apexes[quads[concave], :4] = reflex[concave]
-    collapsed = present & (placed.start[corners] == placed.end[corners])
-    refined = placed.level[faces] > 0
-    apexes[refined], collapsed[refined] = False, False  # a refined quad's cut needs neither
-    keys = np.concatenate([placed.level[faces, None], bits, apexes, collapsed], axis=1)
+    counts = np.where(present, placed.counts[corners], 0)
+    keys = np.concatenate([np.maximum(placed.level[faces, None], 1), counts], axis=1)
     first, which = unique_rows(keys)
     found = []
     for p, key in enumerate(keys[first].tolist()):
-        edges = key[1 : 1 + width]
-        size = sum(b >= 0 for b in edges)
-        flags = [tuple(bool(a) for a in key[at : at + size]) for at in (1 + width, 1 + 2 * width)]
-        found.append(((key[0], tuple(edges[:size]), *flags), faces[which == p]))
+        edges = tuple(c for c in key[1:] if c > 0)
+        found.append(((edges, key[0]), faces[which == p]))
     return found

@@ -1,14 +1,20 @@
 """Which quads ``affinity fix`` refines, to which level, and which it leaves (and why).
 
 A quad is a candidate when a scored rule (Q101-Q103) flags it at or above the fix level.
-Its level n is the smallest whose n^2 pieces (:mod:`affinity.fix.grid`) all read under
-the rule's flag threshold, measured by the rule itself on the pieces (the same closed
-form ``affinity check`` uses, in texels, 1/255 steps or degrees). The search starts one
-below the guess of the 1/n^2 law, sqrt(value / threshold), and climbs to the cap. A
-quad that needs more than the cap is left (``over-cap``: its texture wants a re-UV);
-degenerate (pole quads excepted), bow-tie, nonplanar (unless ``refine_nonplanar``) and
-uv-degenerate quads are left without a search. Quads keep their own levels: where two of
-different levels meet, the edge carries both sets of points (:mod:`affinity.fix.layout`).
+Its level n is the smallest odd n whose n^2 pieces (:mod:`affinity.fix.grid`) all read under
+the rule's flag threshold, measured by the rule itself on the pieces (the same closed form
+``affinity check`` uses, in texels, 1/255 steps or degrees; for uv the split's *shift* in
+texels, never the visible reading C in 1/255 steps, which only grades it). Levels are odd
+so every quad beside a refined one closes with quads (:mod:`affinity.fix.layout`); the cap
+is the smallest odd number at or above ``max_refine``. The search starts one below the
+guess of the 1/n^2 law, sqrt(value / threshold), and climbs to the cap.
+
+Left as they are (:data:`REASONS`): quads that need more than the cap (``over-cap``: the
+texture wants a re-UV), degenerate (pole quads excepted), bow-tie, nonplanar (unless
+``refine_nonplanar``) and uv-degenerate quads; every candidate under a profile that draws the
+subdivided surface (``subdivided``); what the output budget does not reach, the least bad
+first (``over-budget``); and what the re-check of the result still flags (``still-flagged``,
+:mod:`affinity.fix.verify`).
 """
 
 from __future__ import annotations
@@ -17,20 +23,23 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..mesh import Mesh, mesh_from_polygons
+from ..mesh import Mesh
 from ..settings import Settings
-from . import grid
-from .layout import MAX_LEVEL, Layout, edge_parameters, face_patterns, layout
-from .tessellate import face_polygons
 
 #: The scored rules a refinement removes.
 SCORED = ("Q101", "Q102", "Q103")
 #: Why a candidate is left, by the rule that says so, checked in this order.
 LEFT_BY_RULE = {"Q201": "degenerate", "Q204": "bowtie", "Q202": "nonplanar", "Q301": "uv-degenerate"}
-REASONS = ("over-cap", *LEFT_BY_RULE.values())
+#: Quads beside a refinement that are never cut (a cut of their bilinear patch would fold): they stay as
+#: they are and the refined quad closes to them.
+UNCUT_BY_RULE = ("Q201", "Q203", "Q204")
+REASONS = ("over-cap", *LEFT_BY_RULE.values(), "subdivided", "still-flagged", "over-budget")
 LEVEL_ORDER = ("info", "warning", "error")
 #: Quads refined together when their pieces are measured: (n + 1)^2 points each.
 SCORE_BATCH = 8192
+#: The default output budget: faces added, and bytes added to the written file (an estimate).
+MAX_FACES_ADDED = 2_000_000
+MAX_BYTES_ADDED = 256 * 2**20
 
 
 @dataclass
@@ -41,21 +50,51 @@ class FixSettings:
     ----------
     lint : the check's settings (thresholds, reading, diagonal, texture size, levels)
     level : the lowest level of a Q101-Q103 finding that is fixed: ``"info"``, ``"warning"``, ``"error"``
-    max_refine : the largest n (n x n pieces per quad); a quad that needs more is left ``over-cap``
+    max_refine : the largest n asked for (n x n pieces per quad); the cap is the smallest odd number at or
+        above it, and a quad that needs more is left ``over-cap``
     faces : (k,) int64 the only faces that may be refined (a Blender selection), None: any
     refine_nonplanar : refine the quads Q202 flags too (their pieces follow the bilinear surface,
         not the split the input draws), instead of leaving them
     inline : ``(codes, faces)`` pairs of findings the file silences where they are
         (:func:`affinity.loaders.suppress.inline_ignores`): such findings are not fixed, as
         ``affinity check`` does not report them
+    subdivided : the check draws the subdivided surface (a profile that subdivides): every candidate is
+        left ``subdivided``, the crease there being the subdivision-aware measure's business. The one hook
+        for the profile setting (:func:`profile_subdivides`).
+    max_faces_added, max_bytes_added : the output budget (faces, and an estimate of the bytes written)
+    verify_rounds : re-checks of the result; a face still flagged is left as it was and the rest re-built
     """
 
     lint: Settings = field(default_factory=Settings)
     level: str = "warning"
-    max_refine: int = 8
+    max_refine: int = 9
     faces: np.ndarray | None = None
     refine_nonplanar: bool = False
     inline: list = field(default_factory=list)
+    subdivided: bool = False
+    max_faces_added: int = MAX_FACES_ADDED
+    max_bytes_added: int = MAX_BYTES_ADDED
+    verify_rounds: int = 3
+
+    @property
+    def cap(self) -> int:
+        """The highest level: the smallest odd number at or above ``max_refine``."""
+        return self.max_refine | 1
+
+
+#: Profiles that draw the subdivided surface of a mesh whose scheme subdivides (design.md, "Subdivision").
+SUBDIVIDING_PROFILES = ("blender-viewport", "blender-render", "film")
+
+
+def profile_subdivides(settings: Settings, scheme_subdivides: bool = True) -> bool:
+    """Whether ``settings`` check the subdivided surface rather than the cage: an explicit level above 0 or the
+    limit, or ``auto`` under a profile that subdivides for a mesh whose scheme subdivides
+    (``scheme_subdivides``: a USD mesh; OBJ, PLY and OFF have no scheme). Then the fix leaves its candidates
+    ``subdivided``. Settings without a subdivision setting check the cage."""
+    subdivision = getattr(settings, "subdivision", "cage")
+    if subdivision == "auto":
+        return scheme_subdivides and getattr(settings, "profile", "game") in SUBDIVIDING_PROFILES
+    return subdivision not in ("cage", "level:0")
 
 
 @dataclass(eq=False)
@@ -65,18 +104,22 @@ class FixPlan:
     Attributes
     ----------
     refine_faces : (R,) int64 quads to refine, ascending
-    refine_n : (R,) int64 their level (n x n pieces)
+    refine_n : (R,) int64 their level (odd)
     codes : (R,) str the rule that reads worst against its threshold on each, before
-    before : (R,) float64 that rule's value on the quad
-    after : (R,) float64 that rule's worst value over the quad's pieces
+    before : (R,) float64 that rule's value on the quad (uv: the shift, texels)
+    after : (R,) float64 that rule's worst value over the quad's grid pieces
     units : (R,) str the unit of ``before`` and ``after``
     left_faces : (L,) int64 flagged quads left as they are, ascending
     left_reasons : (L,) str one of :data:`REASONS`
-    transition_faces : (T,) int64 faces re-cut to meet the refined quads' new edge points
-    faces_added : int faces in the fixed mesh minus faces in the input
-    faces_added_bound : int sum of n^2 - 1 over refined quads plus 2 n per refined edge met by
-        a face that is not refined (issue 41), plus 2 per point that a neighbour refined at
-        another level adds to a refined quad's edge
+    transition_faces : (T,) int64 faces not refined that are cut to meet the refined quads' edge points
+    faces_added : int faces in the fixed mesh minus faces in the input (exact)
+    faces_added_bound : int the output budget's face limit the plan kept to
+    bytes_added : int an estimate of the bytes the written file grows by
+    frozen_faces : (k,) int64 faces never cut: the left quads and the quads a cut would fold
+    still_flagged : (s,) int64 faces the re-check still flags at the fix level (left ``still-flagged``)
+    new_findings : list of ``{"code", "face"}``: findings of other rules at warning or above on new faces
+        whose input face had none of that rule (the result is written only when allowed)
+    refined : the fixed mesh (:class:`affinity.fix.apply.Refined`) the re-check read, None before
     """
 
     refine_faces: np.ndarray
@@ -90,6 +133,11 @@ class FixPlan:
     transition_faces: np.ndarray
     faces_added: int
     faces_added_bound: int
+    bytes_added: int = 0
+    frozen_faces: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    still_flagged: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    new_findings: list = field(default_factory=list)
+    refined: object = None
 
     @property
     def empty(self) -> bool:
@@ -97,20 +145,30 @@ class FixPlan:
         return len(self.refine_faces) == 0
 
 
+def rule_values(hits) -> np.ndarray:
+    """(n,) float64: the values of ``hits`` in their rule's own unit, the one a refinement's pieces are measured
+    in: the texel shift where Q101's visible reading replaced it by C (``visible.shifts``), never the colour
+    (design.md, "One findings table")."""
+    if hits.visible is None:
+        return hits.values
+    return np.where(np.isfinite(hits.visible.shifts), hits.visible.shifts, hits.values)
+
+
 def flagged_quads(mesh: Mesh, fix: FixSettings) -> tuple[dict, dict]:
     """The scored findings at or above the fix level and the faces each leaving rule flags.
 
     Returns
     -------
-    scored : code -> (faces (n,) int64, values (n,) float64) of Q101-Q103 findings at the level
-    leaving : code -> faces (n,) int64 of Q201, Q202, Q204, Q301 findings
+    scored : code -> (faces (n,) int64, values (n,) float64) of Q101-Q103 findings at the level, values
+        in the rule's measure (:func:`rule_values`)
+    leaving : code -> faces (n,) int64 of the findings of :data:`LEFT_BY_RULE` and :data:`UNCUT_BY_RULE`
     """
     from ..findings import settle
     from ..lint import lint_mesh
     from ..rules import resolve_codes
 
     enabled = [code for code in resolve_codes(fix.lint.select, fix.lint.ignore) if code in SCORED]
-    settings = replace(fix.lint, select=[*enabled, *LEFT_BY_RULE], ignore=[])
+    settings = replace(fix.lint, select=[*enabled, *LEFT_BY_RULE, *UNCUT_BY_RULE], ignore=[])
     hits = settle(lint_mesh(mesh, settings), settings, list(mesh.group_names), fix.inline)
     lowest = LEVEL_ORDER.index(fix.level)
     scored, leaving = {}, {}
@@ -142,53 +200,74 @@ def pole_quads(mesh: Mesh, faces: np.ndarray) -> np.ndarray:
     return collapsed.sum(axis=1) == 1
 
 
+def quads_alone(mesh: Mesh, faces: np.ndarray) -> Mesh:
+    """The quads ``faces`` (Q,) int64 of ``mesh`` as a mesh of their own: their corners' values only (tables
+    compacted), their materials, lines and groups; quads adjacent in ``mesh`` stay adjacent."""
+    corners = (mesh.face_start[faces, None] + np.arange(4)).reshape(-1)
+
+    def compact(values, index):
+        if values is None or index is None:
+            return values, None
+        used, local = np.unique(index[corners], return_inverse=True)
+        missing = used < 0
+        return values[used[~missing]], np.where(missing[local], -1, local - missing.sum()).reshape(-1)
+
+    positions, corner_vertex = compact(mesh.positions, mesh.corner_vertex)
+    used_vertices = np.unique(mesh.corner_vertex[corners])
+    texcoords, corner_texcoord = compact(mesh.texcoords, mesh.corner_texcoord)
+    normals, corner_normal = compact(mesh.normals, mesh.corner_normal)
+    return replace(mesh, positions=positions, colors=None if mesh.colors is None else mesh.colors[used_vertices],
+                   face_start=4 * np.arange(len(faces) + 1, dtype=np.int64), corner_vertex=corner_vertex,
+                   texcoords=texcoords, corner_texcoord=corner_texcoord, normals=normals, corner_normal=corner_normal,
+                   face_line=mesh.face_line[faces], face_group=mesh.face_group[faces],
+                   face_material=mesh.face_material[faces], prim_face_start=None, notes=[])
+
+
 def piece_scores(mesh: Mesh, faces: np.ndarray, n: int, settings: Settings, code: str) -> np.ndarray:
     """The worst value of rule ``code`` over the n x n pieces of each quad ``faces`` (Q,) int64.
 
-    The pieces are measured by the rule itself (:func:`affinity.lint.quad_scores`), on a mesh
-    made of them alone with the source's textures (so texels have the same size).
+    The pieces are built as the fix builds them (:func:`affinity.fix.apply.build`, the quads alone,
+    each refined at ``n``) and measured by the rule itself (:func:`affinity.lint.quad_scores`), each
+    in its quad's material (so texels have the size of the texture the quad binds).
 
     Returns
     -------
     (Q,) float64, 0 where no piece can be measured.
     """
     from ..lint import quad_scores
+    from .apply import build
+    from .layout import layout
 
     worst = np.zeros(len(faces))
     for first in range(0, len(faces), SCORE_BATCH):
         chosen = faces[first : first + SCORE_BATCH]
-        corners = mesh.face_start[chosen, None] + np.arange(4)
-        points = {name: None if values is None else grid.blend(values, n).reshape(-1, values.shape[-1])
-                  for name in ("positions", "texcoords", "normals", "colors")
-                  for values in [mesh.corner_attribute(name, corners)]}
-        pieces = (grid.sub_quads(n)[None] + (n + 1) ** 2 * np.arange(len(chosen))[:, None, None]).reshape(-1, 4)
-        refined = mesh_from_polygons(mesh.path, points["positions"], pieces, points["texcoords"], points["normals"],
-                                     points["colors"])
-        refined.material_names, refined.material_textures = mesh.material_names, mesh.material_textures
-        scores = quad_scores(refined, settings, code)
-        values = np.zeros(len(pieces))
-        values[scores.faces] = scores.values
-        worst[first : first + SCORE_BATCH] = values.reshape(len(chosen), n * n).max(axis=1)
+        alone = quads_alone(mesh, chosen)
+        every = np.arange(len(chosen))
+        refined = build(alone, layout(alone, every, np.full(len(chosen), n)))
+        scores = quad_scores(refined.mesh, settings, code)
+        values = np.zeros(len(chosen))
+        np.maximum.at(values, refined.source[scores.faces], scores.values)
+        worst[first : first + SCORE_BATCH] = values
     return worst
 
 
 def needed_levels(mesh: Mesh, faces: np.ndarray, values: np.ndarray, code: str, fix: FixSettings) -> np.ndarray:
-    """The smallest level n in [2, cap] at which no piece of each quad is flagged by ``code``.
+    """The smallest odd level n in [3, cap] at which no piece of each quad is flagged by ``code``.
 
-    faces, values : (Q,) the flagged quads and their values. Returns (Q,) int64,
-    ``max_refine + 1`` where even the cap is not enough.
+    faces, values : (Q,) the flagged quads and their values. Returns (Q,) int64, ``cap + 2`` where even the
+    cap is not enough.
     """
     from ..rules import RULES
 
     threshold = fix.lint.threshold(code)
-    cap = fix.max_refine
-    need = np.full(len(faces), cap + 1, dtype=np.int64)
-    if cap < 2:
+    cap = fix.cap
+    need = np.full(len(faces), cap + 2, dtype=np.int64)
+    if cap < 3:
         return need
     ratio = np.divide(values, threshold, out=np.full(len(values), 4.0), where=threshold > 0)
-    trial = np.clip(np.ceil(np.sqrt(np.maximum(ratio, 0))) - 1, 2, cap).astype(np.int64)
+    trial = np.clip(np.ceil(np.sqrt(np.maximum(ratio, 0))) - 1, 3, cap).astype(np.int64) | 1
     todo = np.ones(len(faces), dtype=bool)
-    for n in range(int(trial.min(initial=cap)), cap + 1):
+    for n in range(int(trial.min(initial=cap)), cap + 1, 2):
         rows = np.flatnonzero(todo & (trial <= n))
         if len(rows) == 0:
             continue
@@ -198,41 +277,64 @@ def needed_levels(mesh: Mesh, faces: np.ndarray, values: np.ndarray, code: str, 
     return need
 
 
-def plan_fix(mesh: Mesh, fix: FixSettings | None = None) -> FixPlan:
-    """Decide which flagged quads of ``mesh`` to refine and how far (module docstring)."""
-    fix = fix or FixSettings()
-    if fix.level not in LEVEL_ORDER:
-        raise ValueError(f"fix level must be one of {', '.join(LEVEL_ORDER)}; got {fix.level!r}")
-    if not 1 <= fix.max_refine <= MAX_LEVEL:
-        raise ValueError(f"max_refine must be from 1 to {MAX_LEVEL}; got {fix.max_refine}")
+@dataclass(eq=False)
+class Candidates:
+    """The flagged quads of a mesh and what the first look decided for each (no refinement built yet).
+
+    Attributes
+    ----------
+    faces : (K,) int64 ascending; reasons : (K,) object "" for a quad to refine, else why it is left
+    need : (K,) int64 the level each needs; badness : (K,) float64 its worst value over its threshold
+    uncut : (u,) int64 quads not flagged that a cut would fold (:data:`UNCUT_BY_RULE`)
+    scored : the findings (:func:`flagged_quads`)
+    """
+
+    faces: np.ndarray
+    reasons: np.ndarray
+    need: np.ndarray
+    badness: np.ndarray
+    uncut: np.ndarray
+    scored: dict
+
+
+def candidates(mesh: Mesh, fix: FixSettings) -> Candidates:
+    """Lint ``mesh``, pick the flagged quads, why each is left or the level it needs (module docstring)."""
     scored, leaving = flagged_quads(mesh, fix)
-    candidates = np.unique(np.concatenate([faces for faces, _ in scored.values()] or [np.zeros(0, np.int64)]))
+    found = np.unique(np.concatenate([faces for faces, _ in scored.values()] or [np.zeros(0, np.int64)]))
     if fix.faces is not None:
-        candidates = np.intersect1d(candidates, np.asarray(fix.faces, dtype=np.int64))
-    reasons = np.full(len(candidates), "", dtype=object)
+        found = np.intersect1d(found, np.asarray(fix.faces, dtype=np.int64))
+    reasons = np.full(len(found), "", dtype=object)
     for code, reason in reversed(LEFT_BY_RULE.items()):  # the first rule in the table wins
         if not (reason == "nonplanar" and fix.refine_nonplanar):
-            reasons[np.isin(candidates, leaving.get(code, []))] = reason
-    reasons[(reasons == "degenerate") & pole_quads(mesh, candidates)] = ""
-    need = np.zeros(len(candidates), dtype=np.int64)
+            reasons[np.isin(found, leaving.get(code, []))] = reason
+    reasons[(reasons == "degenerate") & pole_quads(mesh, found)] = ""
+    if fix.subdivided:
+        reasons[:] = "subdivided"
+    need = np.zeros(len(found), dtype=np.int64)
+    badness = np.zeros(len(found))
+    at = {}
     for code, (faces, values) in scored.items():
-        rows = np.searchsorted(candidates, faces)
-        keep = (rows < len(candidates)) & (candidates[np.minimum(rows, len(candidates) - 1)] == faces)
+        rows = np.searchsorted(found, faces)
+        keep = (rows < len(found)) & (found[np.minimum(rows, len(found) - 1)] == faces)
+        threshold = fix.lint.threshold(code)
+        ratio = values[keep] / threshold if threshold else values[keep]
+        badness[rows[keep]] = np.maximum(badness[rows[keep]], ratio)
+        at[code] = rows, keep
+    from .budget import beyond_budget
+
+    reasons[beyond_budget(mesh, badness, reasons, fix)] = "over-budget"  # not searched: far past the budget
+    for code, (faces, values) in scored.items():
+        rows, keep = at[code]
         keep[keep] &= reasons[rows[keep]] == ""
         need[rows[keep]] = np.maximum(need[rows[keep]], needed_levels(mesh, faces[keep], values[keep], code, fix))
-    reasons[(reasons == "") & (need > fix.max_refine)] = "over-cap"
-    refine = reasons == ""
-    refine_faces = candidates[refine]
-    refine_n = need[refine]
-    codes, before, after, units = _readings(mesh, refine_faces, refine_n, scored, fix)
-    placed = layout(mesh, refine_faces, refine_n)
-    added, bound = _face_counts(mesh, placed, refine_faces)
-    left = ~refine
-    return FixPlan(refine_faces, refine_n, codes, before, after, units, candidates[left],
-                   reasons[left].astype(str), placed.transition_faces, added, bound)
+    reasons[(reasons == "") & (need > fix.cap)] = "over-cap"
+    uncut = np.unique(np.concatenate([leaving.get(code, np.zeros(0, np.int64)) for code in UNCUT_BY_RULE]))
+    uncut = uncut[mesh.face_sizes[uncut] == 4]
+    uncut = uncut[~pole_quads(mesh, uncut)]
+    return Candidates(found, reasons, need, badness, np.setdiff1d(uncut, found), scored)
 
 
-def _readings(mesh: Mesh, faces: np.ndarray, n: np.ndarray, scored: dict, fix: FixSettings) -> tuple:
+def readings(mesh: Mesh, faces: np.ndarray, n: np.ndarray, scored: dict, fix: FixSettings) -> tuple:
     """Per refined quad: the rule worst against its threshold, its value before, its worst over the pieces
     at the chosen level, and its unit."""
     from ..rules import RULES
@@ -252,17 +354,3 @@ def _readings(mesh: Mesh, faces: np.ndarray, n: np.ndarray, scored: dict, fix: F
             after[at] = piece_scores(mesh, faces[at], int(level), fix.lint, code)
     units = np.array([RULES[c].unit_for(fix.lint.measure) if c else "" for c in codes], dtype=object)
     return codes.astype(str), before, after, units.astype(str)
-
-
-def _face_counts(mesh: Mesh, placed: Layout, refine_faces: np.ndarray) -> tuple[int, int]:
-    """Faces the refinement adds, and the bound on them (:attr:`FixPlan.faces_added_bound`)."""
-    added = bound = 0
-    for pattern, faces in face_patterns(mesh, placed, np.union1d(refine_faces, placed.transition_faces)):
-        level, edge_levels = pattern[0], pattern[1]
-        added += (len(face_polygons(*pattern)) - 1) * len(faces)
-        segments = [len(edge_parameters(bits)) + 1 for bits in edge_levels]
-        if level:  # n^2 - 1, and 2 per point another level adds to an edge
-            bound += (level * level - 1 + 2 * sum(m - level for m in segments)) * len(faces)
-        else:  # 2n per edge shared with a quad refined at level n
-            bound += 2 * sum(m for m in segments if m > 1) * len(faces)
-    return added, bound

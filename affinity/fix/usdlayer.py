@@ -56,8 +56,9 @@ def _indexed(values: np.ndarray, index: np.ndarray) -> tuple[np.ndarray, np.ndar
     return values[used], local.reshape(-1)
 
 
-def write_override_layer(path: str, out: str, mesh: Mesh, refined: Refined, header: str) -> None:
-    """Write the override layer of ``refined`` (the fix of ``mesh``, read from the stage ``path``) to ``out``."""
+def write_override_layer(path: str, out: str, mesh: Mesh, refined: Refined, header: str) -> list[str]:
+    """Write the override layer of ``refined`` (the fix of ``mesh``, read from the stage ``path``) to ``out``;
+    returns the notes on the meshes whose subdivided surface changes (:func:`subdivided_notes`)."""
     from pxr import Sdf, Usd, UsdGeom
 
     stage = Usd.Stage.Open(os.fspath(path))
@@ -80,9 +81,10 @@ def write_override_layer(path: str, out: str, mesh: Mesh, refined: Refined, head
     text = layer.ExportToString()
     if os.path.splitext(out)[1].lower() == ".usdc":
         _export_binary(text, out)
-        return
-    with atomic_write(out) as f:
-        f.write(text)
+    else:
+        with atomic_write(out) as f:
+            f.write(text)
+    return subdivided_notes(stage, mesh, refined, time)
 
 
 def override_prim(layer, spec_path, prim, fixed: Mesh, group: int, time, xforms) -> list[str]:
@@ -161,3 +163,20 @@ def _export_binary(text: str, out: str) -> None:
     finally:
         if os.path.exists(temporary):
             os.unlink(temporary)
+
+
+def subdivided_notes(stage, mesh: Mesh, refined: Refined, time) -> list[str]:
+    """One note per mesh prim of ``stage`` the fix changes whose ``subdivisionScheme`` (authored, or USD's
+    default Catmull-Clark) subdivides: the fix refines its cage, so its subdivided surface changes."""
+    from pxr import UsdGeom
+
+    from ..loaders.usdlayers import SUBDIVIDED
+
+    notes = []
+    for group in np.unique(mesh.face_group[refined.replaced]).tolist():
+        prim = stage.GetPrimAtPath(mesh.group_names[group])
+        scheme = str(UsdGeom.Mesh(prim).GetSubdivisionSchemeAttr().Get(time)) if prim else ""
+        if scheme in SUBDIVIDED:
+            notes.append(f"{mesh.group_names[group]}: subdivisionScheme {scheme}: the fix refines the cage (what "
+                         "the check's profile draws), so the subdivided surface of this mesh changes")
+    return notes
