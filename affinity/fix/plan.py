@@ -181,14 +181,6 @@ def flagged_quads(mesh: Mesh, fix: FixSettings) -> tuple[dict, dict]:
     return scored, leaving
 
 
-def rule_values(hits) -> np.ndarray:
-    """(n,) float64: the values of ``hits`` in their rule's own unit, the one a refinement's pieces are measured
-    in: the texel shift where Q101's visible reading replaced it by C (``visible.shifts``), never the colour."""
-    if hits.visible is None:
-        return hits.values
-    return np.where(np.isfinite(hits.visible.shifts), hits.visible.shifts, hits.values)
-
-
 def pole_quads(mesh: Mesh, faces: np.ndarray) -> np.ndarray:
     """(Q,) bool: which quads ``faces`` (Q,) int64 have exactly one collapsed edge (one repeated corner).
 
