@@ -75,20 +75,10 @@ def read_fbx(path: str, uv_name: str | None = None) -> tuple[Mesh, dict[str, byt
     ``uv_name`` picks the uv set by its FBX name (None: each mesh's first). Raises MeshError for a file
     ufbx cannot read or a mesh whose arrays disagree.
     """
-    import ufbx
-
-    try:
-        scene = ufbx.load_file(path, retain_dom=True, ignore_animation=True, skip_mesh_parts=True,
-                               file_format=ufbx.FileFormat.FBX, load_external_files=False)
-    except ufbx.UfbxError as error:
-        raise MeshError(path, 0, f"cannot read the FBX file: {_reason(error)}") from None
-    kept: list = []
     collecting = gc.isenabled()
-    gc.disable()  # the binding's wrappers crash the cycle collector that walks them
+    gc.disable()  # the binding's wrappers crash the cycle collector that walks them, even after the scene is freed
     try:
-        with scene:
-            read = _read_scene(_Kept(scene, kept), path, uv_name)
-            kept.clear()
+        read = _scene_contents(path, uv_name)
     finally:
         if collecting:
             gc.enable()
@@ -103,6 +93,23 @@ def read_fbx(path: str, uv_name: str | None = None) -> tuple[Mesh, dict[str, byt
     mesh.up_axis, mesh.meters_per_unit = read["up_axis"], read["meters_per_unit"]
     mesh.notes = notes
     return mesh, read["embedded"]
+
+
+def _scene_contents(path: str, uv_name: str | None) -> dict:
+    """:func:`_read_scene` of the file at ``path``, the scene opened and freed here, so that no wrapper of
+    the binding outlives this call."""
+    import ufbx
+
+    try:
+        scene = ufbx.load_file(path, retain_dom=True, ignore_animation=True, skip_mesh_parts=True,
+                               file_format=ufbx.FileFormat.FBX, load_external_files=False)
+    except ufbx.UfbxError as error:
+        raise MeshError(path, 0, f"not a readable FBX file ({type(error).__name__}: {_reason(error)})") from None
+    kept: list = []
+    with scene:
+        read = _read_scene(_Kept(scene, kept), path, uv_name)
+        kept.clear()
+    return read
 
 
 def _read_scene(scene, path: str, uv_name: str | None) -> dict:
@@ -121,6 +128,9 @@ def _read_scene(scene, path: str, uv_name: str | None) -> dict:
         raise MeshError(path, 0, "every mesh node of the FBX file is hidden")
     notes = [f"{hidden} hidden mesh node{'s' * (hidden != 1)} skipped"] if hidden else []
     paths = node_paths(scene.root_node)
+    # A mesh's place in the scene's list names its geometry (the binding's ids and names are not safe to
+    # format twice); wrappers are one per native object, so identity finds it.
+    geometry_of = {id(mesh.native): number for number, mesh in enumerate(scene.meshes)}
     parts, names, sources, materials, maps, embedded = [], [], [], [], {}, {}
     for node in nodes:
         node_path = paths.get(node.typed_id, f"/{node.name}")
@@ -139,7 +149,7 @@ def _read_scene(scene, path: str, uv_name: str | None) -> dict:
                                                     face_material, -1)]
         parts.append(part)
         names.append(node_path)
-        sources.append((path, f"Geometry::{node.mesh.name} {node.mesh.element_id}"))
+        sources.append((path, f"geometry {geometry_of.get(id(node.mesh.native), -1 - len(sources))}"))
     read = {"parts": parts, "names": names, "sources": sources, "materials": materials, "maps": maps,
             "embedded": embedded, "notes": notes, "up_axis": _AXIS.get(scene.settings.axes.up.name),
             "meters_per_unit": float(scene.settings.unit_meters)}

@@ -15,6 +15,7 @@ Where there is no ``os.fork`` (Windows) the reader runs in this process.
 
 from __future__ import annotations
 
+import gc
 import os
 import pickle
 import signal
@@ -68,6 +69,7 @@ def _child(send: int, size: int, read: Callable, args) -> None:
     """Run ``read`` within the limits and write its answer to ``send``; exit without Python's clean-up."""
     code = 0
     try:
+        gc.disable()  # the child lives for one read: nothing to collect, and native readers' wrappers may not bear it
         signal.signal(signal.SIGINT, signal.SIG_DFL)
         _limit(size)
         try:
