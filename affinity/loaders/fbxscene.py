@@ -8,10 +8,13 @@ ends each polygon), ``Vertices``, and each ``LayerElementUV``/``Normal``/``Color
 with its mapping (``ByPolygonVertex``, ``ByVertice``, ``ByPolygon``, ``AllSame``)
 and reference (``Direct``, ``IndexToDirect``). Those are USD's interpolations under
 other names, so :func:`affinity.loaders.usd.corner_index` turns them into corner
-indices and checks them. Node transforms, materials and the scene's axes and
-units come from ufbx's scene. The binding (0.0.5) crashes on a wrapper handed out
-again after it was freed and in the cycle collector: every object it gives is
-kept (:class:`_Kept`) until the scene is read, with the collector off.
+indices and checks them. An index outside its values stops ufbx (``ABORT_LOADING``:
+by default it would clamp it, silently) and the file is unreadable. Node
+transforms, materials and the scene's axes and units come from ufbx's scene.
+
+The binding (0.0.5) crashes on a wrapper it hands out again after Python freed it,
+and in the cycle collector: every object it gives is kept (:class:`_Kept`) until
+the scene is read, with the collector off.
 """
 
 from __future__ import annotations
@@ -22,7 +25,7 @@ import numpy as np
 
 from ..errors import MeshError
 from ..mesh import Mesh
-from .usd import _concatenate, _Primvar, _BadPrim, _transformed, colors_per_vertex, corner_index, world_normals
+from .usd import _BadPrim, _concatenate, _Primvar, _transformed, colors_per_vertex, corner_index, world_normals
 
 #: FBX layer mapping -> the USD interpolation that means the same.
 INTERPOLATION = {"ByPolygonVertex": "faceVarying", "ByVertice": "vertex", "ByVertex": "vertex",
@@ -40,7 +43,7 @@ class _Kept:
     its scene is open. Plain values (numbers, strings, named tuples) come back as they are.
     """
 
-    __slots__ = ("native", "kept")
+    __slots__ = ("kept", "native")
 
     def __init__(self, native, kept: list):
         self.native, self.kept = native, kept
@@ -102,7 +105,8 @@ def _scene_contents(path: str, uv_name: str | None) -> dict:
 
     try:
         scene = ufbx.load_file(path, retain_dom=True, ignore_animation=True, skip_mesh_parts=True,
-                               file_format=ufbx.FileFormat.FBX, load_external_files=False)
+                               file_format=ufbx.FileFormat.FBX, load_external_files=False,
+                               index_error_handling=ufbx.IndexErrorHandling.ABORT_LOADING)
     except ufbx.UfbxError as error:
         raise MeshError(path, 0, f"not a readable FBX file ({type(error).__name__}: {_reason(error)})") from None
     kept: list = []

@@ -91,7 +91,7 @@ def _child(send: int, size: int, read: Callable, args) -> None:
             pipe.write(payload)
             for view in views:
                 pipe.write(view)
-    except BaseException:  # noqa: BLE001 - the parent reports the missing answer
+    except BaseException:  # e.g. an answer that does not pickle: the parent reports the missing answer
         code = 1
     finally:
         os._exit(code)

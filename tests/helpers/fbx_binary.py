@@ -140,7 +140,7 @@ def scene_bytes(meshes: list[MeshNode], parents: list[int | None] | None = None,
     ``up_axis`` 0, 1 or 2 (x, y, z) and ``unit_cm`` centimetres a unit (FBX ``UnitScaleFactor``)."""
     parents = parents or [None] * len(meshes)
     objects, connections, materials = [], [], {}
-    model_id = lambda i: 2000 + i  # noqa: E731 - the ids are a numbering, kept in one place
+    model_id = lambda i: 2000 + i
     for i, mesh in enumerate(meshes):
         if mesh.geometry is None:
             objects.append(_geometry(mesh, 1000 + i))

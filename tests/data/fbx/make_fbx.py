@@ -15,7 +15,7 @@ exported twice: ``spot_textured_external.fbx`` with its image copied beside it
 Two scenes are built on Spot: ``spot_instanced.fbx``, the Spot mesh under an empty ``Root`` twice, as
 ``Root/Body`` and a linked duplicate ``Root/Copy`` (one geometry, two nodes; the copy moved, turned and
 scaled uniformly), and ``spot_two_uv_sets.fbx``, Spot with a second uv set ``Planar`` after its own
-``UVMap``: the positions' x and y, an affine image of them.
+``UVMap``: the mesh's own x and y (Blender's importer turns the object, not its vertices).
 """
 
 from __future__ import annotations
@@ -59,7 +59,7 @@ def instanced(bpy, obj_path: str, fbx_path: str) -> None:
 
 
 def two_uv_sets(bpy, obj_path: str, fbx_path: str) -> None:
-    """Spot with a second uv set ``Planar``: each corner's position x, y."""
+    """Spot with a second uv set ``Planar``: each corner's vertex x, y in the mesh's own coordinates."""
     bpy.ops.wm.read_factory_settings(use_empty=True)
     bpy.ops.wm.obj_import(filepath=obj_path)
     mesh = bpy.context.selected_objects[0].data
