@@ -296,3 +296,9 @@ def test_fix_leaves_an_fbx_file_untouched_and_names_the_way_out(tmp_path):
 def test_the_format_table_names_fbx_and_its_extra():
     assert LOADERS[".fbx"].extra == "fbx" and LOADERS[".fbx"].scene
     assert described().endswith("and FBX (.fbx, with the fbx extra)")
+
+
+def test_a_scene_without_a_mesh_is_skipped_as_a_usd_look_layer_is(tmp_path):
+    path = write(tmp_path, [], name="rig.fbx")  # an animation or a camera rig: nothing to check
+    result = run("check", "--isolated", "--no-cache", str(path))
+    assert result.returncode == 0 and result.stderr.splitlines() == [f"{path}: skipped (no-mesh)"]

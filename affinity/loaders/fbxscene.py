@@ -23,7 +23,7 @@ import gc
 
 import numpy as np
 
-from ..errors import MeshError
+from ..errors import MeshError, SkippedFile
 from ..mesh import Mesh
 from .usd import _BadPrim, _concatenate, _Primvar, _transformed, colors_per_vertex, corner_index, world_normals
 
@@ -124,12 +124,10 @@ def _read_scene(scene, path: str, uv_name: str | None) -> dict:
     from .fbxmaterials import material_maps
 
     nodes = [node for node in scene.nodes if node.mesh is not None]
-    if not nodes:
-        raise MeshError(path, 0, "the FBX file has no mesh")
     hidden = sum(not node.visible for node in nodes)
     nodes = [node for node in nodes if node.visible]
-    if not nodes:
-        raise MeshError(path, 0, "every mesh node of the FBX file is hidden")
+    if not nodes:  # an animation, a camera rig, or only hidden meshes: nothing to check, as a USD look layer
+        raise SkippedFile(path, "no-mesh")
     notes = [f"{hidden} hidden mesh node{'s' * (hidden != 1)} skipped"] if hidden else []
     paths = node_paths(scene.root_node)
     # A mesh's place in the scene's list names its geometry (the binding's ids and names are not safe to

@@ -3,8 +3,8 @@
 Written from the format as the Blender exporter's ``encode_bin.py`` and ufbx read it: a 27-byte header
 (``Kaydara FBX Binary  \\0\\x1a\\0`` and the version), then node records, each ``end offset (u32),
 property count (u32), property bytes (u32), name length (u8), name, properties, children``, a list of
-children closed by a 13-byte null record; array properties are ``count (u32), encoding 0 (u32),
-bytes (u32), data``. Enough for ufbx to read meshes with uv sets, normals, colours and materials'
+children closed by a 13-byte null record; array properties are ``count (u32), encoding (u32: 0 raw,
+1 zlib), bytes (u32), data``. Enough for ufbx to read meshes with uv sets, normals, colours and materials'
 face slots, so the loader's tests can write what Blender cannot (a hostile index, a mapping Blender never
 writes) and the benchmark can write a million quads in a second. Not product code: the product reads FBX
 only.
@@ -13,6 +13,7 @@ only.
 from __future__ import annotations
 
 import struct
+import zlib
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -32,10 +33,11 @@ class Node:
     children: list[Node] = field(default_factory=list)
 
 
-def _property(value) -> bytes:
+def _property(value, compress: bool = False) -> bytes:
     if isinstance(value, np.ndarray):
         data = np.ascontiguousarray(value.ravel())
-        return _ARRAY_CODES[data.dtype] + struct.pack("<III", len(data), 0, data.nbytes) + data.tobytes()
+        raw = zlib.compress(data.tobytes(), 1) if compress else data.tobytes()
+        return _ARRAY_CODES[data.dtype] + struct.pack("<III", len(data), int(compress), len(raw)) + raw
     if isinstance(value, bool):
         return b"C" + struct.pack("<?", value)
     if isinstance(value, int):
@@ -46,14 +48,14 @@ def _property(value) -> bytes:
     return (b"S" if isinstance(value, str) else b"R") + struct.pack("<I", len(raw)) + raw
 
 
-def _record(node: Node, offset: int) -> bytes:
-    """The bytes of ``node`` written at file offset ``offset``."""
-    properties = b"".join(_property(p) for p in node.properties)
+def _record(node: Node, offset: int, compress: bool) -> bytes:
+    """The bytes of ``node`` written at file offset ``offset``, arrays zlib-compressed with ``compress``."""
+    properties = b"".join(_property(p, compress) for p in node.properties)
     name = node.name.encode()
     head_size = 13 + len(name) + len(properties)
     children = b""
     for child in node.children:
-        children += _record(child, offset + head_size + len(children))
+        children += _record(child, offset + head_size + len(children), compress)
     if node.children or not node.properties:
         children += _NULL_RECORD
     end = offset + head_size + len(children)
@@ -61,11 +63,12 @@ def _record(node: Node, offset: int) -> bytes:
         children
 
 
-def document(nodes: list[Node]) -> bytes:
-    """A whole binary FBX file of the top-level ``nodes``."""
+def document(nodes: list[Node], compress: bool = False) -> bytes:
+    """A whole binary FBX file of the top-level ``nodes``; ``compress``: arrays zlib-compressed, as DCC tools
+    write them."""
     body = b""
     for node in nodes:
-        body += _record(node, len(HEADER) + len(body))
+        body += _record(node, len(HEADER) + len(body), compress)
     return HEADER + body + _NULL_RECORD + b"\x00" * 16
 
 
@@ -135,9 +138,10 @@ def _geometry(mesh: MeshNode, object_id: int) -> Node:
 
 
 def scene_bytes(meshes: list[MeshNode], parents: list[int | None] | None = None, up_axis: int = 1,
-                unit_cm: float = 100.0) -> bytes:
+                unit_cm: float = 100.0, compress: bool = False) -> bytes:
     """A binary FBX of mesh nodes ``meshes``; ``parents[i]`` the index of node i's parent (None: the root);
-    ``up_axis`` 0, 1 or 2 (x, y, z) and ``unit_cm`` centimetres a unit (FBX ``UnitScaleFactor``)."""
+    ``up_axis`` 0, 1 or 2 (x, y, z) and ``unit_cm`` centimetres a unit (FBX ``UnitScaleFactor``);
+    ``compress``: arrays zlib-compressed."""
     parents = parents or [None] * len(meshes)
     objects, connections, materials = [], [], {}
     model_id = lambda i: 2000 + i
@@ -170,4 +174,4 @@ def scene_bytes(meshes: list[MeshNode], parents: list[int | None] | None = None,
         settings,
         Node("Objects", [], objects),
         Node("Connections", [], connections),
-    ])
+    ], compress)
