@@ -302,3 +302,23 @@ def test_a_scene_without_a_mesh_is_skipped_as_a_usd_look_layer_is(tmp_path):
     path = write(tmp_path, [], name="rig.fbx")  # an animation or a camera rig: nothing to check
     result = run("check", "--isolated", "--no-cache", str(path))
     assert result.returncode == 0 and result.stderr.splitlines() == [f"{path}: skipped (no-mesh)"]
+
+
+def test_the_result_cache_sees_a_texture_the_fbx_file_names_change(tmp_path):
+    from PIL import Image
+
+    shutil.copytree(DATA / "spot_textured_external.fbm", tmp_path / "spot_textured_external.fbm")
+    path = tmp_path / "spot.fbx"
+    shutil.copy(DATA / "spot_textured_external.fbx", path)
+    env = {**os.environ, "AFFINITY_CACHE_DIR": str(tmp_path / "cache")}
+
+    def errors() -> int:
+        result = subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--isolated", "--select", "Q101",
+                                 "--format", "json", str(path)], capture_output=True, text=True, env=env, check=False)
+        return sum(f["level"] == "error" for f in json.loads(result.stdout)["findings"])
+
+    assert errors() > 0
+    texture = tmp_path / "spot_textured_external.fbm" / "spot_texture.png"
+    texture.chmod(0o644)
+    Image.new("RGB", Image.open(texture).size, (128, 128, 128)).save(texture)  # flat: no crease can show
+    assert errors() == 0

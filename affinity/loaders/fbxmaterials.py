@@ -13,6 +13,8 @@ in memory under :func:`embedded_name` and read from there
 from __future__ import annotations
 
 import os
+import re
+import struct
 
 from .texturemaps import TextureMap
 
@@ -25,6 +27,25 @@ ROLE_OF_PROPERTY = {
     "3dsMax|Parameters|norm_map": "normal", "normal_map": "normal",
     "Bump": "height", "Maya|TEX_bump_map": "height", "3dsMax|Parameters|bump_map": "height",
 }
+
+
+#: A texture's or video's file name as a binary FBX node spells it (name length, name, ``S``, u32 length)
+#: and as an ASCII one does.
+_BINARY_FILE_NAME = re.compile(rb"(?:\x10RelativeFilename|\x08FileName)S(.{4})", re.S)
+_ASCII_FILE_NAME = re.compile(rb'(?:RelativeFilename|FileName):\s*"([^"\n]*)"')
+
+
+def named_texture_files(path: str, data: bytes) -> list[str]:
+    """The image files the FBX file ``path`` with bytes ``data`` names (its textures' and videos' relative
+    names resolved against its folder, and their absolute names), each once, read from the bytes without
+    ufbx: what the result cache hashes beside the file."""
+    names = []
+    for match in _BINARY_FILE_NAME.finditer(data):
+        (length,) = struct.unpack("<I", match.group(1))
+        names.append(bytes(data[match.end():match.end() + length]))
+    names += [match.group(1) for match in _ASCII_FILE_NAME.finditer(data)]
+    folder = os.path.dirname(os.path.abspath(path))
+    return list(dict.fromkeys(os.path.normpath(os.path.join(folder, os.fsdecode(name))) for name in names if name))
 
 
 def embedded_name(fbx_path: str, name: str) -> str:

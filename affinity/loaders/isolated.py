@@ -3,12 +3,13 @@
 A reader in C (ufbx for FBX) that a hostile file drives into a segmentation fault
 would take the whole check down with it. :func:`read_isolated` forks, runs the
 reader in the child under ``RLIMIT_AS`` (memory) and ``RLIMIT_CPU`` (time), and
-hands its result back through a pipe: a pickle whose NumPy arrays travel out of
-band (protocol 5), each read straight into the buffer the parent's array then
-uses, so a million-quad mesh costs one copy. A child that dies (a signal, the
-limits) or says nothing is a :class:`~affinity.errors.MeshError` for that file
-only. Forking copies nothing up front (copy-on-write); a measured million-quad
-FBX pays about 0.1 s for the fork and the transfer (benchmarks/bench_fbx.py).
+hands its result back through a file in memory (``memfd``): a pickle whose NumPy
+arrays travel out of band (protocol 5), each written once by the child and mapped
+by the parent (copy-on-write), where its array then lives: no copy, and no pipe
+whose every 64 kB waits for the other process to be scheduled (on a busy machine,
+seconds for a million quads). A child that dies (a signal, the limits) or does not
+finish its answer is a :class:`~affinity.errors.MeshError` for that file only.
+Forking copies nothing up front (copy-on-write).
 
 Where there is no ``os.fork`` (Windows) the reader runs in this process.
 """
@@ -16,10 +17,12 @@ Where there is no ``os.fork`` (Windows) the reader runs in this process.
 from __future__ import annotations
 
 import gc
+import mmap
 import os
 import pickle
 import signal
 import struct
+import tempfile
 from collections.abc import Callable
 
 from ..errors import MeshError, SkippedFile
@@ -32,7 +35,7 @@ SECONDS_BASE = 30
 BYTES_PER_SECOND = 1 << 20
 
 _HEADER = struct.Struct("<QQ")  # pickle length, number of out-of-band buffers
-_LENGTH = struct.Struct("<Q")
+_PLACE = struct.Struct("<QQ")  # an out-of-band buffer's offset in the answer and its length
 
 
 def read_isolated(path: str, read: Callable, *args):
@@ -44,17 +47,12 @@ def read_isolated(path: str, read: Callable, *args):
     if not hasattr(os, "fork"):
         return read(*args)
     size = _file_size(path)
-    receive, send = os.pipe()
-    pid = os.fork()
-    if pid == 0:  # the child: never returns
-        os.close(receive)
-        _child(send, size, read, args)
-    os.close(send)
-    try:
-        with open(receive, "rb", buffering=0) as pipe:
-            answer = _received(pipe)
-    finally:
+    with _answer_file() as answer_file:
+        pid = os.fork()
+        if pid == 0:  # the child: never returns
+            _child(answer_file.fileno(), size, read, args)
         _, status = os.waitpid(pid, 0)
+        answer = _received(answer_file.fileno()) if os.WIFEXITED(status) and os.WEXITSTATUS(status) == 0 else None
     if answer is None:
         raise MeshError(path, 0, f"the reader stopped without an answer ({_how_it_ended(status)})")
     kind, *rest = answer
@@ -65,36 +63,55 @@ def read_isolated(path: str, read: Callable, *args):
     raise MeshError(path, *rest)
 
 
-def _child(send: int, size: int, read: Callable, args) -> None:
-    """Run ``read`` within the limits and write its answer to ``send``; exit without Python's clean-up."""
-    code = 0
+def _answer_file():
+    """A file in memory (``memfd``; elsewhere a temporary file) the child writes its answer to."""
+    if hasattr(os, "memfd_create"):
+        return open(os.memfd_create("affinity-reader-answer"), "w+b", buffering=0)
+    return tempfile.TemporaryFile()
+
+
+def _child(answer: int, size: int, read: Callable, args) -> None:
+    """Run ``read`` within the limits and write its answer to the file ``answer``; exit without Python's
+    clean-up (0 once the whole answer is written)."""
+    code = 1
     try:
         gc.disable()  # the child lives for one read: nothing to collect, and native readers' wrappers may not bear it
         signal.signal(signal.SIGINT, signal.SIG_DFL)
         _limit(size)
         try:
-            answer = ("mesh", read(*args))
+            result = ("mesh", read(*args))
         except MeshError as error:
-            answer = ("error", error.line, error.reason)
+            result = ("error", error.line, error.reason)
         except SkippedFile as skip:
-            answer = ("skipped", skip.reason)
+            result = ("skipped", skip.reason)
         except MemoryError:
-            answer = ("error", 0, "the reader ran out of memory")
+            result = ("error", 0, "the reader ran out of memory")
         except Exception as error:  # a reader's exception is about this file: one line, never a traceback
-            answer = ("error", 0, " ".join(f"cannot read: {type(error).__name__}: {error}".split())[:300])
+            result = ("error", 0, " ".join(f"cannot read: {type(error).__name__}: {error}".split())[:300])
         buffers = []
-        payload = pickle.dumps(answer, protocol=5, buffer_callback=buffers.append)
+        payload = pickle.dumps(result, protocol=5, buffer_callback=buffers.append)
         views = [buffer.raw() for buffer in buffers]
-        with open(send, "wb", buffering=0) as pipe:
-            pipe.write(_HEADER.pack(len(payload), len(views)))
-            pipe.write(b"".join(_LENGTH.pack(view.nbytes) for view in views))
-            pipe.write(payload)
-            for view in views:
-                pipe.write(view)
+        offsets, offset = [], _aligned(_HEADER.size + _PLACE.size * len(views) + len(payload))
+        for view in views:
+            offsets.append(offset)
+            offset = _aligned(offset + view.nbytes)
+        with open(answer, "wb", closefd=False) as out:
+            out.write(_HEADER.pack(len(payload), len(views)))
+            out.write(b"".join(_PLACE.pack(at, view.nbytes) for at, view in zip(offsets, views)))
+            out.write(payload)
+            for at, view in zip(offsets, views):
+                out.seek(at)
+                out.write(view)
+        code = 0
     except BaseException:  # e.g. an answer that does not pickle: the parent reports the missing answer
         code = 1
     finally:
         os._exit(code)
+
+
+def _aligned(offset: int) -> int:
+    """``offset`` rounded up to a multiple of 64 bytes, where an array's data starts."""
+    return -(-offset // 64) * 64
 
 
 def _limit(size: int) -> None:
@@ -118,35 +135,22 @@ def _address_space() -> int:
         return 0
 
 
-def _read_exactly(pipe, n: int) -> bytearray | None:
-    """``n`` bytes from ``pipe`` into a new buffer; None when it ends first."""
-    buffer = bytearray(n)
-    view, got = memoryview(buffer), 0
-    while got < n:
-        count = pipe.readinto(view[got:])
-        if not count:
-            return None
-        got += count
-    return buffer
-
-
-def _received(pipe):
-    """The child's answer from the pipe, its arrays over the buffers read for them; None when incomplete."""
-    header = _read_exactly(pipe, _HEADER.size)
-    if header is None:
+def _received(answer: int):
+    """The child's answer from the file ``answer``, its arrays over a copy-on-write mapping of it (no copy);
+    None when the file does not hold a whole answer."""
+    length = os.fstat(answer).st_size
+    if length < _HEADER.size:
         return None
-    length, count = _HEADER.unpack(header)
-    sizes = _read_exactly(pipe, _LENGTH.size * count)
-    payload = _read_exactly(pipe, length)
-    if sizes is None or payload is None:
+    mapped = mmap.mmap(answer, length, access=mmap.ACCESS_COPY)
+    data = memoryview(mapped)
+    size, count = _HEADER.unpack_from(data)
+    table = _HEADER.size + _PLACE.size * count
+    if table > length:
         return None
-    buffers = []
-    for (nbytes,) in _LENGTH.iter_unpack(sizes):
-        buffer = _read_exactly(pipe, nbytes)
-        if buffer is None:
-            return None
-        buffers.append(buffer)
-    return pickle.loads(payload, buffers=buffers)
+    places = list(_PLACE.iter_unpack(data[_HEADER.size:table]))
+    if table + size > length or any(at + n > length for at, n in places):
+        return None
+    return pickle.loads(data[table:table + size], buffers=[data[at:at + n] for at, n in places])
 
 
 def _how_it_ended(status: int) -> str:
