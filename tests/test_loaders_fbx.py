@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from helpers.cli import run
+from helpers.cli import run, run_without
 from helpers.fbx_binary import MeshNode, scene_bytes
 
 from affinity.errors import MeshError
@@ -271,10 +271,7 @@ def test_a_crash_of_the_reader_costs_its_file_only(tmp_path):
 
 def test_without_ufbx_an_fbx_file_names_the_extra():
     fbx = DATA / "spot_control_mesh.fbx"
-    script = ("import sys; sys.modules['ufbx'] = None\n"
-              "from affinity.cli import main\n"
-              f"sys.exit(main(['check', '--no-cache', {str(fbx)!r}, {str(ROOT / 'affinity' / 'data' / 'demo')!r}]))\n")
-    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=ROOT, check=False)
+    result = run_without("ufbx", "check", "--no-cache", str(fbx), str(ROOT / "affinity" / "data" / "demo"), cwd=ROOT)
     assert result.returncode == 2
     assert result.stderr.splitlines() == [
         f"{fbx}:0: Q901 unreadable: reading FBX needs ufbx: pip install 'quad-affinity[fbx]'"]

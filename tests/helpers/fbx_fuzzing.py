@@ -15,17 +15,14 @@ that mutations reach the arrays themselves. Mutations: the generic ones of :mod:
 from __future__ import annotations
 
 import random
-import signal
 import struct
-import subprocess
-import sys
 from collections import Counter
 from pathlib import Path
 
 import numpy as np
 
 from .fbx_binary import MeshNode, scene_bytes
-from .fuzzing import MUTATIONS
+from .fuzzing import MUTATIONS, Hang, check_once, mutated_files, time_limit
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "fbx"
 SEED_FILES = ("spot_control_mesh.fbx", "osd_catmark_torus.fbx", "osd_catmark_nonquads.fbx",
@@ -69,67 +66,41 @@ def seeds() -> list[bytes]:
 
 def mutated_fbx_files(folder: Path, count: int, seed: int) -> list[tuple[Path, str]]:
     """Write ``count`` mutated FBX files into ``folder``; (path, how it was made) each."""
-    rng = random.Random(seed)
-    sources = seeds()
-    made = []
-    for k in range(count):
-        data = sources[k % len(sources)]
-        steps = [FBX_MUTATIONS[k % len(FBX_MUTATIONS)]] + [rng.choice(FBX_MUTATIONS)
-                                                          for _ in range(rng.choice([0, 0, 1, 2]))]
-        for step in steps:
-            data = step(rng, data) if data else data
-        path = folder / f"fuzz_{k:05d}.fbx"
-        path.write_bytes(data)
-        made.append((path, "+".join(step.__name__ for step in steps)))
-    return made
-
-
-class Hang(Exception):
-    pass
-
-
-def _alarm(signum, frame):
-    raise Hang
+    return mutated_files(folder, count, seed, [(".fbx", data) for data in seeds()], FBX_MUTATIONS)
 
 
 def load_outcome(path: Path) -> tuple[str, str | None]:
-    """``clean``, ``findings``, ``skipped`` or ``unreadable``, and a broken promise (None when the contract holds)."""
+    """``clean``, ``findings``, ``skipped`` or ``unreadable``, and a broken promise (None when the contract
+    holds)."""
     from affinity.errors import MeshError, SkippedFile
     from affinity.lint import lint_mesh
     from affinity.loaders import load
     from affinity.settings import Settings
 
-    previous = signal.signal(signal.SIGALRM, _alarm)
-    signal.alarm(LOAD_SECONDS)
     try:
-        try:
-            mesh = load(path)
-        except SkippedFile:
-            return "skipped", None
-        except MeshError as error:
-            if "\n" in error.reason or error.path != str(path):
-                return "unreadable", f"not one line naming the file: {error}"
-            return "unreadable", None
-        mesh.validate()
-        hits = lint_mesh(mesh, Settings())
+        with time_limit(LOAD_SECONDS):
+            try:
+                mesh = load(path)
+            except SkippedFile:
+                return "skipped", None
+            except MeshError as error:
+                if "\n" in error.reason or error.path != str(path):
+                    return "unreadable", f"not one line naming the file: {error}"
+                return "unreadable", None
+            mesh.validate()
+            hits = lint_mesh(mesh, Settings())
     except Hang:
         return "hang", f"load or lint took more than {LOAD_SECONDS} s"
     except Exception as error:
         return "crash", f"{type(error).__name__}: {error}"
-    finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, previous)
     return ("findings" if any(len(h) for h in hits) else "clean"), None
 
 
 def check_batch(paths: list[Path], unreadable: set[Path]) -> list[str]:
     """Run ``affinity check`` once over ``paths``; the broken promises, one line each."""
-    try:
-        result = subprocess.run(
-            [sys.executable, "-m", "affinity.cli", "check", "--isolated", "--no-cache", "-j", "1", "--quiet",
-             *map(str, paths)], capture_output=True, text=True, timeout=600, check=False)
-    except subprocess.TimeoutExpired:
-        return [f"affinity check hung on a batch of {len(paths)} starting at {paths[0]}"]
+    result = check_once(paths, "--no-cache", "--quiet", timeout=600)
+    if isinstance(result, str):
+        return [result]
     problems = []
     if result.returncode not in (0, 1, 2) or (result.returncode == 2) != bool(unreadable):
         problems.append(f"batch starting at {paths[0]} exited {result.returncode}")
