@@ -319,3 +319,18 @@ def test_the_result_cache_sees_a_texture_the_fbx_file_names_change(tmp_path):
     texture.chmod(0o644)
     Image.new("RGB", Image.open(texture).size, (128, 128, 128)).save(texture)  # flat: no crease can show
     assert errors() == 0
+
+
+def test_an_embedded_image_is_the_mesh_s_texture_for_drawing_too(tmp_path, shared_meshes):
+    from PIL import Image
+
+    from affinity.draw.texture import load_image
+
+    shutil.copy(DATA / "spot_textured_embedded.fbx", tmp_path / "spot.fbx")
+    mesh = load(tmp_path / "spot.fbx")
+    path = mesh.texture_path()
+    assert path == f"{tmp_path / 'spot.fbx'}#spot_textured_embedded.fbm/spot_texture.png" and not os.path.exists(path)
+    drawn = load_image(path)
+    with Image.open(shared_meshes / "textured" / "spot_texture.png") as image:
+        png = np.asarray(image.convert("RGB"), dtype=np.float32) / 255
+    np.testing.assert_allclose(drawn, png, atol=1e-6)

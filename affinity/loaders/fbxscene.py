@@ -92,6 +92,8 @@ def read_fbx(path: str, uv_name: str | None = None) -> tuple[Mesh, dict[str, byt
     mesh.face_material = np.concatenate([part.face_material for part in parts])
     mesh.material_names = materials
     mesh.material_maps = {name: found for name, found in read["maps"].items() if found}
+    mesh.material_textures = {name: bases[0] for name, found in mesh.material_maps.items()
+                              if (bases := [m.path for m in found if m.role == "base colour"])}  # as map_Kd
     mesh.prim_sources = read["sources"]
     mesh.up_axis, mesh.meters_per_unit = read["up_axis"], read["meters_per_unit"]
     mesh.notes = notes
