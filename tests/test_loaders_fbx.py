@@ -334,3 +334,20 @@ def test_an_embedded_image_is_the_mesh_s_texture_for_drawing_too(tmp_path, share
     with Image.open(shared_meshes / "textured" / "spot_texture.png") as image:
         png = np.asarray(image.convert("RGB"), dtype=np.float32) / 255
     np.testing.assert_allclose(drawn, png, atol=1e-6)
+
+
+def _hang() -> None:
+    import time
+
+    time.sleep(60)  # neither works nor ends, as a child deadlocked on a lock would
+
+
+def test_a_reader_that_neither_works_nor_ends_is_stopped(tmp_path, monkeypatch):
+    import affinity.loaders.isolated as isolated
+
+    path = tmp_path / "x.fbx"
+    path.write_bytes(b"x")
+    monkeypatch.setattr(isolated, "WALL_FACTOR", 0.05)  # 1.5 s for a file of one byte
+    with pytest.raises(MeshError) as caught:
+        read_isolated(str(path), _hang)
+    assert caught.value.reason == "the reader stopped without an answer (killed by SIGKILL)"

@@ -16,6 +16,7 @@ Where there is no ``os.fork`` (Windows) the reader runs in this process.
 
 from __future__ import annotations
 
+import faulthandler
 import gc
 import mmap
 import os
@@ -23,6 +24,7 @@ import pickle
 import signal
 import struct
 import tempfile
+import time
 from collections.abc import Callable
 
 from ..errors import MeshError, SkippedFile
@@ -33,6 +35,9 @@ MEMORY_PER_BYTE = 64
 #: CPU seconds the child may use, plus one per this many bytes of the file.
 SECONDS_BASE = 30
 BYTES_PER_SECOND = 1 << 20
+#: Wall-clock seconds the parent waits, in CPU seconds the child may use: a child that neither works nor
+#: ends (a lock some other thread of the parent held when it forked) is killed.
+WALL_FACTOR = 10
 
 _HEADER = struct.Struct("<QQ")  # pickle length, number of out-of-band buffers
 _PLACE = struct.Struct("<QQ")  # an out-of-band buffer's offset in the answer and its length
@@ -51,7 +56,7 @@ def read_isolated(path: str, read: Callable, *args):
         pid = os.fork()
         if pid == 0:  # the child: never returns
             _child(answer_file.fileno(), size, read, args)
-        _, status = os.waitpid(pid, 0)
+        status = _waited(pid, WALL_FACTOR * _cpu_seconds(size))
         answer = _received(answer_file.fileno()) if os.WIFEXITED(status) and os.WEXITSTATUS(status) == 0 else None
     if answer is None:
         raise MeshError(path, 0, f"the reader stopped without an answer ({_how_it_ended(status)})")
@@ -77,6 +82,7 @@ def _child(answer: int, size: int, read: Callable, args) -> None:
     try:
         gc.disable()  # the child lives for one read: nothing to collect, and native readers' wrappers may not bear it
         signal.signal(signal.SIGINT, signal.SIG_DFL)
+        faulthandler.disable()  # a crash here is the parent's one line, not a dump on the shared stderr
         _limit(size)
         try:
             result = ("mesh", read(*args))
@@ -118,12 +124,30 @@ def _limit(size: int) -> None:
     """The child's limits: address space and CPU seconds growing with the file (see the constants)."""
     import resource
 
-    in_use = _address_space()
-    memory = in_use + MEMORY_BASE + MEMORY_PER_BYTE * size
-    seconds = SECONDS_BASE + size // BYTES_PER_SECOND
+    memory = _address_space() + MEMORY_BASE + MEMORY_PER_BYTE * size
+    seconds = _cpu_seconds(size)
     for which, limit in ((resource.RLIMIT_AS, memory), (resource.RLIMIT_CPU, seconds)):
         _, hard = resource.getrlimit(which)
         resource.setrlimit(which, (limit if hard == resource.RLIM_INFINITY else min(limit, hard), hard))
+
+
+def _cpu_seconds(size: int) -> int:
+    """CPU seconds the child may use for a file of ``size`` bytes."""
+    return SECONDS_BASE + size // BYTES_PER_SECOND
+
+
+def _waited(pid: int, seconds: float) -> int:
+    """The wait status of child ``pid`` once it ends, killed (SIGKILL) after ``seconds`` of wall-clock time."""
+    deadline, pause = time.monotonic() + seconds, 0.0005
+    while True:
+        done, status = os.waitpid(pid, os.WNOHANG)
+        if done:
+            return status
+        if time.monotonic() > deadline:
+            os.kill(pid, signal.SIGKILL)
+            return os.waitpid(pid, 0)[1]
+        time.sleep(pause)
+        pause = min(2 * pause, 0.02)
 
 
 def _address_space() -> int:
