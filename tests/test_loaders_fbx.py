@@ -351,3 +351,24 @@ def test_a_reader_that_neither_works_nor_ends_is_stopped(tmp_path, monkeypatch):
     with pytest.raises(MeshError) as caught:
         read_isolated(str(path), _hang)
     assert caught.value.reason == "the reader stopped without an answer (killed by SIGKILL)"
+
+
+def test_a_texture_is_found_as_fbx_stores_it_relative_then_absolute_then_embedded(tmp_path):
+    from types import SimpleNamespace
+
+    from affinity.loaders.fbxmaterials import texture_file
+
+    fbx = tmp_path / "scene" / "model.fbx"
+    (tmp_path / "scene" / "maps").mkdir(parents=True)
+    beside, elsewhere = tmp_path / "scene" / "maps" / "wood.png", tmp_path / "wood_absolute.png"
+    beside.write_bytes(b"png")
+    elsewhere.write_bytes(b"png")
+    texture = lambda relative, absolute, content=b"": SimpleNamespace(
+        relative_filename=relative, absolute_filename=absolute, content=content, name="Wood")
+    assert texture_file(texture("maps/wood.png", str(elsewhere)), str(fbx)) == (str(beside), "maps/wood.png", None)
+    assert texture_file(texture("gone/wood.png", str(elsewhere)), str(fbx)) == \
+        (str(elsewhere), "gone/wood.png", None)
+    assert texture_file(texture("gone/wood.png", "/nowhere/wood.png", b"\x89PNG"), str(fbx)) == \
+        (f"{fbx}#gone/wood.png", "gone/wood.png", b"\x89PNG")
+    assert texture_file(texture("gone/wood.png", "/nowhere/wood.png"), str(fbx)) == \
+        (str(tmp_path / "scene" / "gone" / "wood.png"), "gone/wood.png", None)  # missing: the reading says so
