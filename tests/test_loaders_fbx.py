@@ -372,3 +372,26 @@ def test_a_texture_is_found_as_fbx_stores_it_relative_then_absolute_then_embedde
         (f"{fbx}#gone/wood.png", "gone/wood.png", b"\x89PNG")
     assert texture_file(texture("gone/wood.png", "/nowhere/wood.png"), str(fbx)) == \
         (str(tmp_path / "scene" / "gone" / "wood.png"), "gone/wood.png", None)  # missing: the reading says so
+
+
+def test_material_properties_bind_their_textures_by_role(tmp_path):
+    from types import SimpleNamespace
+
+    from affinity.loaders.fbxmaterials import material_maps
+
+    fbx = tmp_path / "model.fbx"
+    for name in ("base.png", "normal.png", "bump.png", "rough.png", "other_uv.png"):
+        (tmp_path / name).write_bytes(b"png")
+
+    def bound(prop: str, file: str, uv_set: str = "") -> SimpleNamespace:
+        texture = SimpleNamespace(relative_filename=file, absolute_filename="", content=b"", name=file,
+                                  uv_set=uv_set, file_textures=[], has_uv_transform=False)
+        return SimpleNamespace(material_prop=prop, texture=texture)
+
+    material = SimpleNamespace(name="M", textures=[
+        bound("DiffuseColor", "base.png"), bound("NormalMap", "normal.png"), bound("Bump", "bump.png"),
+        bound("Maya|specularRoughness", "rough.png"), bound("DiffuseColor", "other_uv.png", uv_set="Lightmap")])
+    maps, embedded = material_maps(material, str(fbx), "UVMap")
+    assert [(m.role, os.path.basename(m.path)) for m in maps] == [
+        ("base colour", "base.png"), ("normal", "normal.png"), ("height", "bump.png"), ("scalar", "rough.png")]
+    assert embedded == {} and maps[0].source == "FBX M.DiffuseColor"
