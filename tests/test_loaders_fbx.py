@@ -395,3 +395,16 @@ def test_material_properties_bind_their_textures_by_role(tmp_path):
     assert [(m.role, os.path.basename(m.path)) for m in maps] == [
         ("base colour", "base.png"), ("normal", "normal.png"), ("height", "bump.png"), ("scalar", "rough.png")]
     assert embedded == {} and maps[0].source == "FBX M.DiffuseColor"
+
+
+@pytest.mark.parametrize("values, reason", [
+    (5, "not a readable FBX file (BadIndexError: Bad index: 5 (max 4))"),  # ufbx stops it first
+    (8, "/A: LayerElementUV UV (ByPolygonVertex) has 8 values; faceVarying interpolation needs 7 here"),
+])
+def test_a_direct_layer_with_the_wrong_number_of_values_is_one_clear_reason(values, reason, tmp_path):
+    points, face_start, corners = SQUARE_AND_TRIANGLE
+    uv = np.arange(2 * values, dtype=float).reshape(values, 2)
+    mesh = MeshNode("A", points, face_start, corners, uv=[("UVMap", "ByPolygonVertex", "Direct", uv, None)])
+    with pytest.raises(MeshError) as caught:
+        load(write(tmp_path, [mesh]))
+    assert caught.value.reason == reason

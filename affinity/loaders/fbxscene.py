@@ -292,8 +292,8 @@ def _layer_values(ufbx, element, kind: str, values: str, indices: str, width: in
     index = None
     if reference in ("IndexToDirect", "Index") and _find(element, indices) is not None:
         index = _array(ufbx, element, indices, np.int64)
-    return _Primvar(f"{kind} {values}", _finite(f"{kind} {values}", data.reshape(-1, width)),
-                    INTERPOLATION[mapping], index)
+    name = f"{kind} {values} ({mapping})"  # corner_index's messages speak USD: the FBX mapping beside it
+    return _Primvar(name, _finite(name, data.reshape(-1, width)), INTERPOLATION[mapping], index)
 
 
 def _layer(ufbx, geometry, kind: str, values: str, indices: str, width: int) -> _Primvar | None:
