@@ -408,3 +408,12 @@ def test_a_direct_layer_with_the_wrong_number_of_values_is_one_clear_reason(valu
     with pytest.raises(MeshError) as caught:
         load(write(tmp_path, [mesh]))
     assert caught.value.reason == reason
+
+
+def test_float32_vertices_and_int64_indices_read_as_the_values_written(tmp_path):
+    points, face_start, corners = SQUARE_AND_TRIANGLE
+    points = points + 0.1  # not exact in float32
+    mesh = MeshNode("A", points, face_start, corners, vertex_dtype=np.float32, index_dtype=np.int64)
+    read = load(write(tmp_path, [mesh]))
+    np.testing.assert_array_equal(read.positions[read.corner_vertex], points.astype(np.float32)[corners])
+    np.testing.assert_array_equal(read.face_start, face_start)

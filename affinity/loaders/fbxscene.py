@@ -2,8 +2,8 @@
 
 Runs where a crash costs one file (:mod:`affinity.loaders.isolated`). Topology and
 per-corner values come from the file's own arrays (ufbx keeps the parsed
-document, ``retain_dom``), handed to NumPy without a copy where ufbx exposes a
-buffer: the ``PolygonVertexIndex`` as written (a negative index, bit-inverted,
+document, ``retain_dom``), copied out in one go where ufbx exposes a buffer
+(elsewhere element by element): the ``PolygonVertexIndex`` as written (a negative index, bit-inverted,
 ends each polygon), ``Vertices``, and each ``LayerElementUV``/``Normal``/``Color``
 with its mapping (``ByPolygonVertex``, ``ByVertice``, ``ByPolygon``, ``AllSame``)
 and reference (``Direct``, ``IndexToDirect``). Those are USD's interpolations under
@@ -179,18 +179,16 @@ def _reason(error) -> str:
 def _read_node(node, uv_name: str | None) -> tuple[Mesh, np.ndarray]:
     """One mesh node in world space (``geometry_to_world``), and the material slot of each face
     (F,) int32, -1 where none."""
-    import ufbx
-
     geometry = node.mesh.dom_node
     if geometry is None:
         raise _BadPrim("its geometry has no arrays")
-    points = _finite("Vertices", _array(ufbx, geometry, "Vertices", np.float64).reshape(-1, 3))
-    written = _array(ufbx, geometry, "PolygonVertexIndex", np.int64)
+    points = _finite("Vertices", _array(geometry, "Vertices", np.float64).reshape(-1, 3))
+    written = _array(geometry, "PolygonVertexIndex", np.int64)
     sizes, corner_vertex = _polygons(written, len(points))
     topology = (len(points), sizes, corner_vertex)
-    uv = _uv_layer(ufbx, geometry, uv_name)
-    normals = _layer(ufbx, geometry, "LayerElementNormal", "Normals", "NormalsIndex", 3)
-    color = _layer(ufbx, geometry, "LayerElementColor", "Colors", "ColorIndex", 4)
+    uv = _uv_layer(geometry, uv_name)
+    normals = _layer(geometry, "LayerElementNormal", "Normals", "NormalsIndex", 3)
+    color = _layer(geometry, "LayerElementColor", "Colors", "ColorIndex", 4)
     matrix = np.array(node.geometry_to_world, dtype=np.float64)  # (4, 3): columns of the 3x4 matrix
     linear, offset = matrix[:3], matrix[3]  # rows: p' = p linear + offset (row vectors)
     positions = _transformed(points, linear) + offset
@@ -209,7 +207,7 @@ def _read_node(node, uv_name: str | None) -> tuple[Mesh, np.ndarray]:
         corner_normal=None if normals is None else corner_index(normals, *topology),
         colors=colors,
     )
-    return part, _face_materials(ufbx, geometry, sizes)
+    return part, _face_materials(geometry, sizes)
 
 
 def _polygons(written: np.ndarray, n_points: int) -> tuple[np.ndarray, np.ndarray]:
@@ -245,32 +243,28 @@ def _dom_list(node: _Kept, function: str) -> _Kept:
     return node._wrapped(getattr(ufbx, function)(node.native))
 
 
-def _text(ufbx, node, name: str) -> str:
+def _text(node, name: str) -> str:
+    """The string value of the DOM child ``name`` of ``node``; "" when it has none."""
     found = _find(node, name)
-    if found is None or not found.values or found.values[0].type != ufbx.DomValueType.STRING:
+    if found is None or not found.values or found.values[0].type.name != "STRING":
         return ""
     return found.values[0].value_str
 
 
-def _array(ufbx, node, name: str, dtype) -> np.ndarray:
+def _array(node, name: str, dtype) -> np.ndarray:
     """The array child ``name`` of DOM ``node`` as (n,) ``dtype``, copied out of the scene."""
     found = _find(node, name)
     if found is None or not found.values:
         raise _BadPrim(f"it has no {name}")
-    kind = found.values[0].type
-    if kind == ufbx.DomValueType.ARRAY_F64:
-        raw = memoryview(_dom_list(found, 'dom_as_real_list').native)
-    elif kind == ufbx.DomValueType.ARRAY_I32:
-        raw = memoryview(_dom_list(found, 'dom_as_int32_list').native)
-    elif kind == ufbx.DomValueType.ARRAY_F32:  # no buffer from the binding: element by element
-        items = _dom_list(found, 'dom_as_float_list').native
-        return np.fromiter(items, dtype=np.float64, count=len(items)).astype(dtype)
-    elif kind == ufbx.DomValueType.ARRAY_I64:
-        items = _dom_list(found, 'dom_as_int64_list').native
-        return np.fromiter(items, dtype=np.int64, count=len(items)).astype(dtype)
-    else:
-        raise _BadPrim(f"{name} is not an array of numbers")
-    return np.array(raw, dtype=dtype).reshape(-1)
+    kind = found.values[0].type.name
+    if kind in ("ARRAY_F64", "ARRAY_I32"):  # a buffer: one copy out of the scene
+        items = _dom_list(found, "dom_as_real_list" if kind == "ARRAY_F64" else "dom_as_int32_list").native
+        return np.array(memoryview(items), dtype=dtype).reshape(-1)
+    if kind in ("ARRAY_F32", "ARRAY_I64"):  # no buffer from the binding: element by element
+        items = _dom_list(found, "dom_as_float_list" if kind == "ARRAY_F32" else "dom_as_int64_list").native
+        return np.fromiter(items, dtype=np.float64 if kind == "ARRAY_F32" else np.int64,
+                           count=len(items)).astype(dtype)
+    raise _BadPrim(f"{name} is not an array of numbers")
 
 
 def _finite(name: str, values: np.ndarray) -> np.ndarray:
@@ -279,44 +273,44 @@ def _finite(name: str, values: np.ndarray) -> np.ndarray:
     return values
 
 
-def _layer_values(ufbx, element, kind: str, values: str, indices: str, width: int) -> _Primvar | None:
+def _layer_values(element, kind: str, values: str, indices: str, width: int) -> _Primvar | None:
     """One layer element as a :class:`~affinity.loaders.usd._Primvar`; None for a mapping not kept
     (``ByEdge``)."""
-    mapping = _text(ufbx, element, "MappingInformationType")
+    mapping = _text(element, "MappingInformationType")
     if mapping not in INTERPOLATION:
         return None
-    data = _array(ufbx, element, values, np.float64)
+    data = _array(element, values, np.float64)
     if len(data) % width:
         raise _BadPrim(f"{kind} {values} has {len(data)} numbers, not a multiple of {width}")
-    reference = _text(ufbx, element, "ReferenceInformationType")
+    reference = _text(element, "ReferenceInformationType")
     index = None
     if reference in ("IndexToDirect", "Index") and _find(element, indices) is not None:
-        index = _array(ufbx, element, indices, np.int64)
+        index = _array(element, indices, np.int64)
     name = f"{kind} {values} ({mapping})"  # corner_index's messages speak USD: the FBX mapping beside it
     return _Primvar(name, _finite(name, data.reshape(-1, width)), INTERPOLATION[mapping], index)
 
 
-def _layer(ufbx, geometry, kind: str, values: str, indices: str, width: int) -> _Primvar | None:
+def _layer(geometry, kind: str, values: str, indices: str, width: int) -> _Primvar | None:
     """The first ``kind`` layer element of a geometry, or None."""
     elements = _children(geometry, kind)
-    return _layer_values(ufbx, elements[0], kind, values, indices, width) if elements else None
+    return _layer_values(elements[0], kind, values, indices, width) if elements else None
 
 
-def _uv_layer(ufbx, geometry, name: str | None) -> _Primvar | None:
+def _uv_layer(geometry, name: str | None) -> _Primvar | None:
     """The uv set named ``name`` (its ``Name``), else the first one; None when there is none."""
     elements = _children(geometry, "LayerElementUV")
     if name is not None:
-        elements = [element for element in elements if _text(ufbx, element, "Name") == name]
-    return _layer_values(ufbx, elements[0], "LayerElementUV", "UV", "UVIndex", 2) if elements else None
+        elements = [element for element in elements if _text(element, "Name") == name]
+    return _layer_values(elements[0], "LayerElementUV", "UV", "UVIndex", 2) if elements else None
 
 
-def _face_materials(ufbx, geometry, sizes: np.ndarray) -> np.ndarray:
+def _face_materials(geometry, sizes: np.ndarray) -> np.ndarray:
     """(F,) int32 material slot of each face from ``LayerElementMaterial`` (``AllSame`` or ``ByPolygon``);
     0 for every face without one (the node's first material), -1 past the slots the layer names."""
     elements = _children(geometry, "LayerElementMaterial")
     if not elements or _find(elements[0], "Materials") is None:
         return np.zeros(len(sizes), dtype=np.int32)
-    slots = _array(ufbx, elements[0], "Materials", np.int64)
-    if _text(ufbx, elements[0], "MappingInformationType") == "ByPolygon" and len(slots) == len(sizes):
+    slots = _array(elements[0], "Materials", np.int64)
+    if _text(elements[0], "MappingInformationType") == "ByPolygon" and len(slots) == len(sizes):
         return slots.astype(np.int32)
     return np.full(len(sizes), slots[0] if len(slots) else 0, dtype=np.int32)

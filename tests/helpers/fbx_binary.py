@@ -78,7 +78,9 @@ class MeshNode:
     layers as ``(name, mapping, reference, values (n, k), indices or None)``; ``materials`` the names of the
     node's material slots and ``face_slots`` (F,) int32 the slot of each face (or None); ``parent`` the index
     of the mesh node above it (None: the scene's root) and ``translation`` its local translation;
-    ``geometry`` the index of the mesh whose geometry it uses (None: its own)."""
+    ``geometry`` the index of the mesh whose geometry it uses (None: its own); ``vertex_dtype`` and
+    ``index_dtype`` the array types of ``Vertices`` and ``PolygonVertexIndex`` (float32 and int64 are legal
+    too)."""
 
     name: str
     positions: np.ndarray
@@ -91,6 +93,8 @@ class MeshNode:
     face_slots: np.ndarray | None = None
     translation: tuple = (0.0, 0.0, 0.0)
     geometry: int | None = None
+    vertex_dtype: type = np.float64
+    index_dtype: type = np.int32
 
 
 def _layer(kind: str, values_name: str, index_name: str, layer: tuple, number: int) -> Node:
@@ -113,8 +117,9 @@ def polygon_vertex_index(face_start: np.ndarray, corner_vertex: np.ndarray) -> n
 
 def _geometry(mesh: MeshNode, object_id: int) -> Node:
     children = [Node("GeometryVersion", [124]),
-                Node("Vertices", [np.asarray(mesh.positions, dtype=np.float64)]),
-                Node("PolygonVertexIndex", [polygon_vertex_index(mesh.face_start, mesh.corner_vertex)])]
+                Node("Vertices", [np.asarray(mesh.positions, dtype=mesh.vertex_dtype)]),
+                Node("PolygonVertexIndex", [polygon_vertex_index(mesh.face_start, mesh.corner_vertex)
+                                            .astype(mesh.index_dtype)])]
     elements = []
     if mesh.normals is not None:
         children.append(_layer("LayerElementNormal", "Normals", "NormalsIndex", mesh.normals, 0))
