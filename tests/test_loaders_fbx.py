@@ -417,3 +417,61 @@ def test_float32_vertices_and_int64_indices_read_as_the_values_written(tmp_path)
     read = load(write(tmp_path, [mesh]))
     np.testing.assert_array_equal(read.positions[read.corner_vertex], points.astype(np.float32)[corners])
     np.testing.assert_array_equal(read.face_start, face_start)
+
+
+ASCII_QUAD_AND_TRIANGLE = """\
+; FBX 7.4.0 project file
+FBXHeaderExtension:  {
+    FBXHeaderVersion: 1003
+    FBXVersion: 7400
+}
+GlobalSettings:  {
+    Version: 1000
+    Properties70:  {
+        P: "UpAxis", "int", "Integer", "",2
+        P: "UnitScaleFactor", "double", "Number", "",1
+    }
+}
+Objects:  {
+    Geometry: 1000, "Geometry::quad", "Mesh" {
+        Vertices: *15 {
+            a: 0,0,0,1,0,0,1,1,0,0,1,0,2,0,0.5
+        }
+        PolygonVertexIndex: *7 {
+            a: 0,1,2,-4,1,4,-3
+        }
+        LayerElementUV: 0 {
+            Version: 101
+            Name: "UVMap"
+            MappingInformationType: "ByPolygonVertex"
+            ReferenceInformationType: "IndexToDirect"
+            UV: *10 {
+                a: 0,0,1,0,1,1,0,1,2,0
+            }
+            UVIndex: *7 {
+                a: 0,1,2,3,1,4,2
+            }
+        }
+    }
+    Model: 2000, "Model::quad", "Mesh" {
+        Version: 232
+    }
+}
+Connections:  {
+    C: "OO",1000,2000
+    C: "OO",2000,0
+}
+"""
+
+
+def test_an_ascii_fbx_reads_as_the_binary_one(tmp_path):
+    path = tmp_path / "ascii.fbx"
+    path.write_text(ASCII_QUAD_AND_TRIANGLE)
+    points, face_start, corners = SQUARE_AND_TRIANGLE
+    uv = ("UVMap", "ByPolygonVertex", "IndexToDirect", points[:, :2], corners)
+    binary = load(write(tmp_path, [MeshNode("quad", points, face_start, corners, uv=[uv])], up_axis=2, unit_cm=1.0))
+    read = load(path)
+    assert (read.group_names, read.up_axis, read.meters_per_unit) == (["/quad"], "Z", 0.01)
+    for name in ("positions", "texcoords"):
+        np.testing.assert_array_equal(corner_values(read, name), corner_values(binary, name))
+    np.testing.assert_array_equal(read.face_start, binary.face_start)
