@@ -58,16 +58,17 @@ class Mesh:
         The files the mesh file references (material libraries, texture maps by
         role, USD layers), in file order, as its loader read them.
     prim_face_start : (P + 1,) int64 or None
-        USD only: the faces of mesh prim ``p`` (group ``p``) are
+        USD and FBX only: the faces of mesh prim (FBX: mesh node) ``p`` (group ``p``) are
         ``prim_face_start[p]:prim_face_start[p + 1]``. None for other formats.
     prim_sources : list of (str, str) or None, one per prim
         USD only: the layer and the prim path in it where each mesh prim's points and
         topology are authored (None for a prim whose three come from different places):
-        prims that reference one geometry layer share a source.
+        prims that reference one geometry layer share a source. FBX: the file and the geometry each node
+        instances, so nodes sharing one geometry share a source.
     up_axis : str or None
-        USD only: the stage's ``upAxis`` (``"Y"`` or ``"Z"``).
+        USD and FBX only: the stage's ``upAxis`` (``"Y"`` or ``"Z"``), the FBX scene's up axis.
     meters_per_unit : float or None
-        USD only: the stage's ``metersPerUnit``.
+        USD and FBX only: the stage's ``metersPerUnit``, the FBX scene's unit.
     notes : list of str
         What the loader read but did not represent, for the user (e.g. USD
         PointInstancer copies that were not expanded).

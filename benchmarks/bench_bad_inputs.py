@@ -6,7 +6,13 @@ claiming 4e9 vertices), a truncated binary PLY, a junk ``.usda``, an OBJ with
 one Q101 finding and a clean OBJ. Goal: under 300 MB, every broken file one
 Q901 line, exit 2. Not a test: run it and read it.
 
-    python benchmarks/bench_bad_inputs.py [--runs 3]
+    python benchmarks/bench_bad_inputs.py [--runs 3] [--fbx 2000]
+
+``--fbx N`` (issue 59, with the fbx extra) also writes N mutated FBX files (the
+harness of tests/helpers/fbx_fuzzing.py: Blender exports and uncompressed files,
+byte flips, cuts, tokens and hostile 32-bit words), loads each in this process
+and checks them all with ``affinity check``: no traceback, no hang, every
+unreadable file one Q901 line. It prints the outcomes and the time.
 
 The peak is the largest resident set of the ``affinity check`` child process
 (``getrusage(RUSAGE_CHILDREN).ru_maxrss``), each run in a fresh interpreter.
@@ -68,10 +74,27 @@ def one_run(folder: Path, broken: list[str]) -> tuple[float, float, int]:
     return peak_mb, seconds, result.returncode
 
 
+def fuzz_fbx(count: int) -> None:
+    """``count`` mutated FBX files through the fuzz harness; exits 1 on a broken promise."""
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+    from helpers.fbx_fuzzing import run_fbx_fuzz
+
+    started = time.perf_counter()
+    with tempfile.TemporaryDirectory() as scratch:
+        counts, problems = run_fbx_fuzz(Path(scratch), count, seed=2026)
+    print(f"{count} mutated FBX files in {time.perf_counter() - started:.0f} s: {dict(counts)}; "
+          f"{len(problems)} problems")
+    if problems:
+        sys.exit("\n".join(problems[:40]))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], allow_abbrev=False)
     parser.add_argument("--runs", type=int, default=3)
+    parser.add_argument("--fbx", type=int, default=0, metavar="N", help="also fuzz N mutated FBX files")
     args = parser.parse_args()
+    if args.fbx:
+        fuzz_fbx(args.fbx)
     with tempfile.TemporaryDirectory() as scratch:
         folder = Path(scratch)
         broken = write_folder(folder)

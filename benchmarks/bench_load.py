@@ -32,22 +32,29 @@ READERS = {
 CHILD = "import sys, time\n{setup}\nt = time.perf_counter(); call(sys.argv[1]); print(time.perf_counter() - t)\n"
 
 
-def write_grid_obj(path: str, quads: int) -> None:
-    """Write an OBJ with ``quads`` quads on an n x m grid, one vt and one vn per vertex."""
+def grid(quads: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``quads`` quads on an n x m wavy grid: positions (V, 3), uv (V, 2) and normals (V, 3) float64 per
+    vertex, and faces (quads, 4) int64, 0-based."""
     n = int(np.ceil(np.sqrt(quads)))
     m = -(-quads // n)
     i, j = np.meshgrid(np.arange(n + 1), np.arange(m + 1))
     u, v = (i / n).ravel(), (j / m).ravel()
     positions = np.stack([10 * u - 5, 10 * v - 5, 0.3 * np.sin(7 * u) * np.cos(5 * v)], axis=1)
     normals = np.stack([np.zeros_like(u), np.sin(v), np.cos(v)], axis=1)
-    corner = (j[:-1, :-1] * (n + 1) + i[:-1, :-1]).ravel()[:quads] + 1
+    corner = (j[:-1, :-1] * (n + 1) + i[:-1, :-1]).ravel()[:quads]
     faces = np.stack([corner, corner + 1, corner + n + 2, corner + n + 1], axis=1)
+    return positions, np.stack([u, v], axis=1), normals, faces
+
+
+def write_grid_obj(path: str, quads: int) -> None:
+    """Write an OBJ with ``quads`` quads on an n x m grid (:func:`grid`), one vt and one vn per vertex."""
+    positions, uv, normals, faces = grid(quads)
     with open(path, "w") as fh:
-        fh.write(f"# {quads} quads on a {n} x {m} grid, written by benchmarks/bench_load.py\n")
+        fh.write(f"# {quads} quads, written by benchmarks/bench_load.py\n")
         np.savetxt(fh, positions, fmt="v %.6f %.6f %.6f")
-        np.savetxt(fh, np.stack([u, v], axis=1), fmt="vt %.6f %.6f")
+        np.savetxt(fh, uv, fmt="vt %.6f %.6f")
         np.savetxt(fh, normals, fmt="vn %.6f %.6f %.6f")
-        np.savetxt(fh, np.repeat(faces, 3, axis=1), fmt="f" + " %d/%d/%d" * 4)
+        np.savetxt(fh, np.repeat(faces + 1, 3, axis=1), fmt="f" + " %d/%d/%d" * 4)
 
 
 def generated_input(path: str, quads: int, write) -> str:

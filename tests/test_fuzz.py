@@ -25,14 +25,12 @@ from __future__ import annotations
 import json
 import os
 import random
-import signal
-import subprocess
 import sys
 from collections import Counter
 from pathlib import Path
 
 import numpy as np
-from helpers.fuzzing import MUTATIONS, mutated_files, seed_files
+from helpers.fuzzing import MUTATIONS, Hang, check_once, mutated_files, seed_files, time_limit
 from helpers.generated_obj import FIELDS
 
 from affinity.errors import MeshError, SkippedFile
@@ -51,37 +49,25 @@ SMALL_CHUNK = 4096
 LOAD_SECONDS = 20
 
 
-class Hang(Exception):
-    pass
-
-
-def _alarm(signum, frame):
-    raise Hang
-
-
 def load_outcome(path: Path) -> tuple[str, str | None]:
     """``clean``, ``findings``, ``skipped`` or ``unreadable``, and a problem (None when the contract holds)."""
-    previous = signal.signal(signal.SIGALRM, _alarm)
-    signal.alarm(LOAD_SECONDS)
     try:
-        try:
-            mesh = load(path)
-        except MeshError as error:
-            return "unreadable", (f"error names {error.path}" if error.path != str(path) else
-                                  None if path.suffix != ".obj" else chunked_difference(path, None))
-        mesh.validate()
-        hits = lint_mesh(mesh, Settings())
-        if path.suffix == ".obj" and (difference := chunked_difference(path, mesh)):
-            return "crash", difference
+        with time_limit(LOAD_SECONDS):
+            try:
+                mesh = load(path)
+            except MeshError as error:
+                return "unreadable", (f"error names {error.path}" if error.path != str(path) else
+                                      None if path.suffix != ".obj" else chunked_difference(path, None))
+            mesh.validate()
+            hits = lint_mesh(mesh, Settings())
+            if path.suffix == ".obj" and (difference := chunked_difference(path, mesh)):
+                return "crash", difference
     except SkippedFile:
         return "skipped", None
     except Hang:
         return "hang", f"load or lint took more than {LOAD_SECONDS} s"
     except Exception as error:
         return "crash", f"{type(error).__name__}: {error}"
-    finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, previous)
     return ("findings" if any(len(h) for h in hits) else "clean"), None
 
 
@@ -106,12 +92,9 @@ def chunked_difference(path: Path, whole) -> str | None:
 
 def check_batch(paths: list[Path], expected: str) -> list[str]:
     """Run ``affinity check`` once over ``paths``; the broken promises, one line each."""
-    try:
-        result = subprocess.run(
-            [sys.executable, "-m", "affinity.cli", "check", "--isolated", "--format", "json", "-j", "1",
-             *map(str, paths)], capture_output=True, text=True, timeout=300, check=False)
-    except subprocess.TimeoutExpired:
-        return [f"affinity check hung on a batch of {len(paths)} starting at {paths[0]}"]
+    result = check_once(paths, "--format", "json")
+    if isinstance(result, str):
+        return [result]
     problems = []
     if result.returncode not in (0, 1, 2):
         problems.append(f"exit {result.returncode}")

@@ -15,13 +15,11 @@ import doctest
 import importlib.util
 import json
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
-from helpers.cli import run
+from helpers.cli import run, run_without
 from helpers.sarif import assert_valid
 
 import affinity.loaders.usd
@@ -300,10 +298,7 @@ def test_parse_error_points_at_its_line(tmp_path):
 
 
 def test_without_usd_core_a_usd_file_names_the_install_command():
-    script = ("import sys; sys.modules['pxr'] = None\n"
-              "from affinity.cli import main\n"
-              f"sys.exit(main(['check', {str(SCENE)!r}, {str(ROOT / 'affinity' / 'data' / 'demo')!r}]))\n")
-    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=ROOT, check=False)
+    result = run_without("pxr", "check", str(SCENE), str(ROOT / "affinity" / "data" / "demo"), cwd=ROOT)
     assert result.returncode == 2
     assert result.stderr.splitlines() == [
         f"{SCENE}:0: Q901 unreadable: reading USD needs usd-core: pip install 'quad-affinity[usd]'"]

@@ -137,7 +137,8 @@ def add_parser(sub) -> None:
     usd.add_argument("--time", type=_time, metavar="T",
                      help="read the stage at time code T (default: the earliest time sample)")
     usd.add_argument("--uv-primvar", metavar="NAME",
-                     help="texture coordinates from primvar NAME (default: st, else the first texCoord2f primvar)")
+                     help="texture coordinates from primvar NAME (default: st, else the first texCoord2f primvar); "
+                          "in an FBX file, the uv set NAME (default: the first)")
     config = p.add_argument_group("configuration")
     config.add_argument("--config", metavar="FILE",
                         help="use this affinity.toml/pyproject.toml for every file instead of searching")

@@ -152,6 +152,11 @@ def _fix_one(path: str, resolver, args) -> dict:
     from ..fix.plan import profile_subdivides
     from ..loaders import load
 
+    if _format(path) == "fbx":
+        from ..loaders.fbx import NO_FIX
+
+        sys.stderr.write(f"{path}: {NO_FIX}\n")
+        return {"path": path, "error": NO_FIX}
     try:
         settings = resolver.resolve(path).settings.for_file(path)
         mesh = load(path)

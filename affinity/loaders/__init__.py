@@ -3,7 +3,8 @@
 Supported (the format table, :data:`.formats.LOADERS`): Wavefront OBJ (``.obj``),
 PLY (``.ply``; ASCII and binary) and OFF (``.off``; with the C/N/ST prefixes), and
 USD stages (``.usd``, ``.usda``, ``.usdc``, ``.usdz``) when usd-core is installed
-(see :mod:`affinity.loaders.usd`). Every problem with the input is a
+(see :mod:`affinity.loaders.usd`), and FBX (``.fbx``) when ufbx is installed
+(:mod:`affinity.loaders.fbx`). Every problem with the input is a
 :class:`~affinity.mesh.MeshError` naming the file and line; a Git LFS pointer
 is a :class:`~affinity.mesh.SkippedFile`. A reader is imported when a file of its
 format is read (NumPy; ``pxr`` for USD).
@@ -52,7 +53,7 @@ def reads_whole(path) -> bool:
 def load(path, usd: UsdOptions | None = None, source: bytes | None = None) -> Mesh:
     """Read the mesh at ``path``, choosing the reader by its extension (case-insensitive).
 
-    ``usd`` says how to read a USD stage (time, uv primvar); other formats ignore it.
+    ``usd`` says how to read a USD stage (time, uv primvar) or an FBX scene (uv set); other formats ignore it.
     ``source`` is the file's bytes (:func:`read_source`) when the caller has them: an
     OBJ file is then not opened again; other formats open the file themselves.
 
@@ -81,7 +82,7 @@ def load(path, usd: UsdOptions | None = None, source: bytes | None = None) -> Me
         raise SkippedFile(path, "lfs-pointer")
     try:
         read = mesh_format.load_function()
-        if mesh_format.key == "usd":
+        if mesh_format.scene:
             return read(path, usd)
         if mesh_format.whole_source:
             return read(path, source=source)

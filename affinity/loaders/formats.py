@@ -30,6 +30,8 @@ class MeshFormat:
     whole_source : the reader parses the file's bytes as a caller read them
         (``source=``), so a check reads such a file once
     extra : the pip extra its reader needs (``"usd"``: usd-core), or None
+    scene : the reader takes the scene options (:class:`~affinity.loaders.usd.UsdOptions`: time, uv set)
+        after the path, and locates faces by node or prim path (``path:/A/B:face N``)
     """
 
     key: str
@@ -38,6 +40,7 @@ class MeshFormat:
     loader: str
     whole_source: bool = False
     extra: str | None = None
+    scene: bool = False
 
     def load_function(self) -> Callable:
         """The reader function, imported now."""
@@ -51,7 +54,8 @@ FORMATS: tuple[MeshFormat, ...] = (
     MeshFormat(key="ply", title="PLY", suffixes=(".ply",), loader=".ply:load_ply"),
     MeshFormat(key="off", title="OFF", suffixes=(".off",), loader=".off:load_off"),
     MeshFormat(key="usd", title="USD", suffixes=(".usd", ".usda", ".usdc", ".usdz"), loader=".usd:load_usd",
-               extra="usd"),
+               extra="usd", scene=True),
+    MeshFormat(key="fbx", title="FBX", suffixes=(".fbx",), loader=".fbx:load_fbx", extra="fbx", scene=True),
 )
 
 #: File suffix -> its format: the one format table.
@@ -70,7 +74,7 @@ def described() -> str:
     """The formats for a help text, each extra named.
 
     >>> described()
-    '.obj/.ply/.off and USD (.usd/.usda/.usdc/.usdz, with the usd extra)'
+    '.obj/.ply/.off and USD (.usd/.usda/.usdc/.usdz, with the usd extra) and FBX (.fbx, with the fbx extra)'
     """
     text = "/".join(suffix for f in FORMATS if f.extra is None for suffix in f.suffixes)
     for f in FORMATS:

@@ -9,8 +9,10 @@ and BigTIFF too), OpenEXR and DDS. Every texture file is opened by
 
 from __future__ import annotations
 
+import io
 import os
 import struct
+from collections import OrderedDict
 from dataclasses import dataclass
 
 from .regular import RefusedFile, open_regular
@@ -54,11 +56,36 @@ class ImageHeader:
         return self.width * self.height
 
 
+#: Images a mesh file holds inside it (FBX embedded media), by the path its texture maps name them with
+#: (:func:`embed`); read from memory. At most :data:`EMBEDDED_BYTES` of them are kept, the oldest dropped first.
+EMBEDDED: OrderedDict[str, bytes] = OrderedDict()
+EMBEDDED_BYTES = 1 << 29
+
+
+def embed(path: str, content: bytes) -> None:
+    """Keep the image ``content`` that a mesh file embeds under the (not existing) file name ``path``."""
+    EMBEDDED.pop(path, None)
+    EMBEDDED[path] = content
+    while sum(map(len, EMBEDDED.values())) > EMBEDDED_BYTES and len(EMBEDDED) > 1:
+        EMBEDDED.popitem(last=False)
+
+
 def open_image_file(path: str | os.PathLike):
     """Open a texture file for reading bytes: the one place texture files are opened (header
     reading and decoding alike), so a policy on what may be opened (regular files only, a size
-    budget) applies to both. Raises OSError."""
-    return open_regular(path)
+    budget) applies to both; an embedded image (:func:`embed`) opens from memory. Raises OSError."""
+    content = EMBEDDED.get(os.fspath(path))
+    return io.BytesIO(content) if content is not None else open_regular(path)
+
+
+def image_identity(path: str | os.PathLike) -> tuple:
+    """What tells one version of the image ``path`` from another, for caches: the real path, size and
+    modification time of a file; the name and content of an embedded image. Raises OSError."""
+    content = EMBEDDED.get(os.fspath(path))
+    if content is not None:
+        return os.fspath(path), len(content), hash(content)
+    stat = os.stat(path)
+    return os.path.realpath(path), stat.st_size, stat.st_mtime_ns
 
 
 def read_header(path: str | os.PathLike) -> ImageHeader:

@@ -43,8 +43,8 @@ def named_files(path: str, data=None) -> list[str]:
     an OBJ's material libraries (from its bytes ``data``; read when None), an MTL file's
     texture maps of every role named in MTL files, a USD layer's sublayers, references and
     payloads and the files of its asset-valued attributes (textures; none without ``pxr``), a
-    MaterialX document's image files. A UDIM texture names its tiles on disk. Other files name
-    none. Paths are normalised, not made absolute."""
+    MaterialX document's image files, an FBX file's texture files. A UDIM texture names its tiles on
+    disk. Other files name none. Paths are normalised, not made absolute."""
     suffix = os.path.splitext(path)[1].lower()
     if suffix == ".obj":
         if data is None:
@@ -56,6 +56,11 @@ def named_files(path: str, data=None) -> list[str]:
                                   for _, name in mtllib_statements(data)))
     if suffix == ".mtl":
         return tile_files(texture for *_, texture in material_maps(path))
+    if suffix in format_named("fbx").suffixes:
+        from .fbxmaterials import named_texture_files
+        from .regular import read_regular
+
+        return named_texture_files(path, read_regular(path) if data is None else data)
     if suffix == ".mtlx":
         from .usdmaterials import mtlx_document_maps
 

@@ -320,6 +320,8 @@ class ResultCache:
         usd_key = None
         if os.path.splitext(path)[1].lower() in format_named("usd").suffixes:
             usd_key = [_usd_reader(), None if usd is None else dataclasses.asdict(usd)]
+        elif os.path.splitext(path)[1].lower() in format_named("fbx").suffixes:  # the uv set is a scene option
+            usd_key = [_reader_version("ufbx", "ufbx"), None if usd is None else dataclasses.asdict(usd)]
         if id(settings) not in self._settings:  # files share a few Settings objects: describe each once
             self._settings[id(settings)] = (settings, dataclasses.asdict(settings))
         payload = _json([SCHEMA, self.tool, path, tree, self._settings[id(settings)][1], usd_key])
@@ -557,14 +559,20 @@ def _content_digest(path: str) -> str:
 
 def _usd_reader() -> str | None:
     """The usd-core version that would read a stage, None without one (found, not imported: that is slow)."""
+    return _reader_version("pxr", "usd-core")
+
+
+def _reader_version(module: str, distribution: str) -> str | None:
+    """The version of ``distribution`` whose ``module`` would read a file, None without the module (found, not
+    imported: that may be slow); the module's name when it comes from elsewhere (pxr from a USD build)."""
     from importlib.metadata import PackageNotFoundError, version
     from importlib.util import find_spec
 
-    if "pxr" in sys.modules and sys.modules["pxr"] is None:  # blocked, as a test does
+    if module in sys.modules and sys.modules[module] is None:  # blocked, as a test does
         return None
-    if find_spec("pxr") is None:
+    if find_spec(module) is None:
         return None
     try:
-        return version("usd-core")
-    except PackageNotFoundError:  # pxr from a USD build rather than the wheel
-        return "pxr"
+        return version(distribution)
+    except PackageNotFoundError:
+        return module

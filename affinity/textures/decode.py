@@ -12,7 +12,6 @@ pyramids (2/3 of it at most, built only over the rows the lint's queries reach).
 
 from __future__ import annotations
 
-import os
 import threading
 from collections import OrderedDict
 from dataclasses import dataclass
@@ -20,7 +19,7 @@ from functools import cached_property, partial
 
 import numpy as np
 
-from ..loaders.imagesize import ImageHeader, ImageUnreadable, open_image_file, read_header
+from ..loaders.imagesize import ImageHeader, ImageUnreadable, image_identity, open_image_file, read_header
 from .held import held_texture
 
 #: Pixels (width x height) a texture may have to be decoded: 8192 x 8192.
@@ -172,10 +171,9 @@ def decode(path: str, budget: int = DECODE_BUDGET) -> DecodedTexture:
     if refused is not None:
         raise TextureUnusable(refused + (", not decoded" if header is not None else ""), header)
     try:
-        stat = os.stat(path)
+        key = image_identity(path)
     except OSError as err:
         raise TextureUnusable(f"not readable ({err.__class__.__name__})", header) from None
-    key = (os.path.realpath(path), stat.st_size, stat.st_mtime_ns)
     with _cache_lock:
         if key in _cache:
             _cache.move_to_end(key)

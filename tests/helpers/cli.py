@@ -19,6 +19,14 @@ def run(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
     )
 
 
+def run_without(module: str, *args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
+    """``affinity ARGS`` in a process where ``module`` cannot be imported (an extra not installed)."""
+    script = (f"import sys; sys.modules[{module!r}] = None\n"
+              "from affinity.cli import main\n"
+              f"sys.exit(main({list(args)!r}))\n")
+    return subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=cwd, check=False)
+
+
 def write(tmp_path: Path, name: str, text: str | bytes) -> Path:
     path = tmp_path / name
     if isinstance(text, bytes):

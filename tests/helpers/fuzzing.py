@@ -3,7 +3,11 @@
 from __future__ import annotations
 
 import random
+import signal
 import struct
+import subprocess
+import sys
+from contextlib import contextmanager
 from pathlib import Path
 
 from helpers.corpus import shared_mesh_paths
@@ -131,18 +135,49 @@ def lie_about_counts(rng: random.Random, data: bytes) -> bytes:
 MUTATIONS = (flip_bytes, truncate, insert_token, lie_about_counts)
 
 
-def mutated_files(folder: Path, count: int, seed: int) -> list[tuple[Path, str]]:
-    """Write ``count`` mutated files into ``folder``; return (path, how it was made)."""
+def mutated_files(folder: Path, count: int, seed: int, seeds: list[tuple[str, bytes]] | None = None,
+                  mutations: tuple = MUTATIONS) -> list[tuple[Path, str]]:
+    """Write ``count`` mutated files into ``folder``; return (path, how it was made). ``seeds``: (suffix,
+    content) pairs (default :func:`seed_files`), each mutated by one to three of ``mutations``."""
     rng = random.Random(seed)
-    seeds = seed_files(rng)
+    seeds = seed_files(rng) if seeds is None else seeds
     made = []
     for k in range(count):
         suffix, data = seeds[k % len(seeds)]
-        first = MUTATIONS[k % len(MUTATIONS)]  # every class for every format, in turn
-        steps = [first] + [rng.choice(MUTATIONS) for _ in range(rng.choice([0, 0, 0, 1, 2]))]
+        first = mutations[k % len(mutations)]  # every class for every format, in turn
+        steps = [first] + [rng.choice(mutations) for _ in range(rng.choice([0, 0, 0, 1, 2]))]
         for step in steps:
             data = step(rng, data) if data else data
         path = folder / f"fuzz_{k:05d}{suffix}"
         path.write_bytes(data)
         made.append((path, "+".join(step.__name__ for step in steps)))
     return made
+
+
+class Hang(Exception):
+    """A load or lint that took longer than its :func:`time_limit`."""
+
+
+@contextmanager
+def time_limit(seconds: int):
+    """Raise :class:`Hang` in the block once ``seconds`` have passed (SIGALRM)."""
+
+    def alarm(signum, frame):
+        raise Hang
+
+    previous = signal.signal(signal.SIGALRM, alarm)
+    signal.alarm(seconds)
+    try:
+        yield
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, previous)
+
+
+def check_once(paths: list[Path], *options: str, timeout: int = 300) -> subprocess.CompletedProcess | str:
+    """``affinity check --isolated -j 1 OPTIONS PATHS`` in one process; its result, or the line saying it hung."""
+    try:
+        return subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--isolated", "-j", "1", *options,
+                               *map(str, paths)], capture_output=True, text=True, timeout=timeout, check=False)
+    except subprocess.TimeoutExpired:
+        return f"affinity check hung on a batch of {len(paths)} starting at {paths[0]}"
