@@ -32,7 +32,7 @@ from bpy.props import (
 from ..rules import RULES, number_text, with_unit
 from ..settings import DIAGONALS, MEASURES, Settings
 from . import compat
-from .check import check_object, face_error, finding_units, severity
+from .check import check_object, face_error, severity
 from .convert import ERROR_ATTRIBUTE, ERROR_COLOR, base_color_texture, polygon_corners
 from .fix import fix_object
 
@@ -242,7 +242,7 @@ class AFFINITY_OT_check(bpy.types.Operator):
                 row = props.results.add()
                 row.object_name, row.code, row.rule_name = obj.name, hits.code, RULES[hits.code].name
                 row.count, row.worst = len(hits), float(hits.values[order[0]])
-                row.unit = finding_units(hits)[order[0]]
+                row.unit = hits.units()[order[0]]
                 row.selectable = bool(mapping is not None and hits.faces[0] >= 0)
                 if row.selectable:
                     faces = mapping[hits.faces[order]]

@@ -96,22 +96,6 @@ def _finding_dicts(mesh, hits, settings, original_face) -> list[dict]:
     return rows
 
 
-def finding_units(hits) -> np.ndarray:
-    """(n,) str: the unit of each value of settled ``hits`` (:func:`affinity.findings.settle`), as
-    ``affinity check --format json`` gives it: the texture's (``1/255``, ``degrees``) where Q101's visible
-    reading read C, else the rule's unit under the reading (``texels``, ``barycentric score``).
-
-    Parameters
-    ----------
-    hits : RuleHits with ``unit`` set and ``visible`` None or VisibleColumns of (n,) ``picks`` and ``shifts``
-    """
-    units = np.full(len(hits), hits.unit, dtype=object)
-    if hits.visible is not None:
-        read = (hits.visible.picks >= 0) & np.isfinite(hits.visible.shifts)
-        units[read] = np.asarray(hits.visible.units, dtype=object)[hits.visible.picks[read]]
-    return units
-
-
 def severity(hits) -> np.ndarray:
     """(n,) float64: how many times over (or under) its limit each finding of one rule is.
 
@@ -121,15 +105,17 @@ def severity(hits) -> np.ndarray:
     to know which is which. Findings without a threshold, or with a value that
     is not positive, read 1.0. The worst finding of a rule is the most severe.
 
+    Each value is read against its own threshold (:meth:`~affinity.findings.RuleHits.thresholds`: C against
+    visible-warning where Q101 read it through a texture, the shift against the texel threshold elsewhere).
+
     Parameters
     ----------
-    hits : RuleHits with ``values`` (n,) float64 and ``threshold``
+    hits : settled RuleHits with ``values`` (n,) float64
     """
-    v = hits.values
+    v, t = hits.values, hits.thresholds()
     ratio = np.ones(len(v))
-    if hits.threshold > 0:
-        positive = v > 0
-        ratio[positive] = np.maximum(v[positive] / hits.threshold, hits.threshold / v[positive])
+    positive = (v > 0) & (t > 0)
+    ratio[positive] = np.maximum(v[positive] / t[positive], t[positive] / v[positive])
     return ratio
 
 

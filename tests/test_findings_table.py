@@ -1,0 +1,114 @@
+"""One column, one unit (design.md, Clarifications "One findings table"; issue 51).
+
+A Q101 finding read through a texture has ``value`` = C (1/255 steps) and the split's shift (texels) in its own
+column; every consumer that needs the shift or a rank reads the right column. The scene is the issue's: a 6 x 6
+grid whose uv is sheared by a bilinear term, under a 256 px checker. The shift there has a closed form: uv =
+(x / 6 + k x y / 36, y / 6) on unit quads adds k / 36 s t to u in each quad's own (s, t), and the split of s t
+along either diagonal misses it by at most 1/4 (at the centre), so every quad shifts by 256 k / 144 texels.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+SIDE, TEXTURE = 6, 256
+#: The shear: 1.0667 texels per quad, above the 0.5 texel threshold and above visible-min-shift (1.0).
+SHEAR = 0.6
+SHIFT = TEXTURE * SHEAR / 144
+
+
+def grid_obj(folder, material: str | None = "checker", split_materials: bool = False):
+    """The sheared grid as an OBJ in ``folder``: with ``material`` a 256 px 8 x 8 checker bound by an MTL
+    (none: no MTL); with ``split_materials`` the left half of the quads in a second material without a map."""
+    from PIL import Image
+
+    checks = (np.indices((TEXTURE, TEXTURE)) // (TEXTURE // 8)).sum(axis=0) % 2
+    Image.fromarray((checks * 255).astype(np.uint8)).convert("RGB").save(folder / "checker.png")
+    (folder / "grid.mtl").write_text("newmtl checker\nmap_Kd checker.png\nnewmtl plain\nKd 1 1 1\n")
+    lines = ["mtllib grid.mtl"] if material else []
+    for y in range(SIDE + 1):
+        for x in range(SIDE + 1):
+            lines.append(f"v {x} {y} 0")
+            lines.append(f"vt {x / SIDE + SHEAR * x * y / SIDE ** 2:.17g} {y / SIDE:.17g}")
+    current = None
+    for y in range(SIDE):
+        for x in range(SIDE):
+            wanted = "plain" if split_materials and x < SIDE // 2 else material
+            if wanted and wanted != current:
+                lines.append(f"usemtl {wanted}")
+                current = wanted
+            corners = [y * (SIDE + 1) + x + 1, y * (SIDE + 1) + x + 2, (y + 1) * (SIDE + 1) + x + 2,
+                       (y + 1) * (SIDE + 1) + x + 1]
+            lines.append("f " + " ".join(f"{c}/{c}" for c in corners))
+    path = folder / "grid.obj"
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def checked(path, **settings):
+    from affinity.pipeline.check import load_and_check
+    from affinity.settings import Settings
+
+    report, mesh = load_and_check(str(path), Settings(texture_size=TEXTURE, **settings))
+    assert report.error is None, report.error
+    return report
+
+
+def q101(report):
+    return next(h for h in report.hits if h.code == "Q101")
+
+
+def test_the_shift_column_is_the_closed_form_shift_in_texels_where_value_is_c(tmp_path):
+    hits = q101(checked(grid_obj(tmp_path)))
+    assert len(hits) == SIDE * SIDE
+    assert hits.visible is not None and hits.visible.read().all()
+    np.testing.assert_allclose(hits.shifts, SHIFT, rtol=1e-9)
+    assert set(hits.units()) == {"1/255"}
+    # C is read through the checker: up to a whole step of it, far from the shift's number of texels
+    assert (hits.values > 0).all() and (hits.values <= 255).all() and hits.values.max() > 100
+    np.testing.assert_array_equal(hits.thresholds(), 2.0)  # visible-warning, C's own threshold
+
+
+def test_the_shift_column_does_not_depend_on_the_texture_being_read(tmp_path):
+    """Without a texture the value is the shift itself; with one, the shift column keeps it."""
+    plain, textured = tmp_path / "plain", tmp_path / "textured"
+    plain.mkdir(), textured.mkdir()
+    without = q101(checked(grid_obj(plain, material=None)))
+    with_texture = q101(checked(grid_obj(textured)))
+    assert without.visible is None and set(without.units()) == {"texels"}
+    np.testing.assert_array_equal(without.shifts, without.values)
+    np.testing.assert_allclose(without.values, SHIFT, rtol=1e-9)
+    np.testing.assert_array_equal(with_texture.faces, without.faces)
+    np.testing.assert_allclose(with_texture.shifts, without.shifts, rtol=1e-12)
+
+
+def test_json_value_is_c_and_shift_is_texels_per_row(tmp_path):
+    from affinity.output import select
+
+    report = checked(grid_obj(tmp_path))
+    rows = [f for f in select(report).findings() if f.code == "Q101"]
+    assert {f.unit for f in rows} == {"1/255"} and {f.threshold for f in rows} == {2.0}
+    np.testing.assert_allclose([f.shift for f in rows], SHIFT, rtol=1e-9)
+    assert all(f.value != pytest.approx(f.shift) for f in rows)
+
+
+def test_findings_in_two_units_rank_by_their_own_thresholds(tmp_path):
+    """Half the quads bind the checker (C in 1/255), half a material without a map (the shift in texels): at one
+    level, each ranks by how far it is beyond its own threshold, never by comparing C with texels."""
+    from affinity.output import badness, worst_first
+
+    hits = q101(checked(grid_obj(tmp_path, split_materials=True)))
+    read = hits.visible.read()
+    assert read.any() and (~read).any()
+    np.testing.assert_array_equal(hits.units()[read], "1/255")
+    np.testing.assert_array_equal(hits.units()[~read], "texels")
+    np.testing.assert_allclose(hits.shifts, SHIFT, rtol=1e-9)  # every row, read or not
+    ratios = np.where(read, hits.values / 2.0, SHIFT / 0.5)  # C / visible-warning, shift / Q101's threshold
+    np.testing.assert_allclose(badness(hits), -ratios, rtol=1e-12)
+    order = worst_first(hits)
+    ranks = hits.level_ranks()[order]
+    assert (np.diff(ranks) >= 0).all()
+    for rank in np.unique(ranks):
+        within = ratios[order[ranks == rank]]
+        assert (np.diff(within) <= 1e-12).all(), "within a level, the larger ratio first"
