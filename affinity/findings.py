@@ -301,15 +301,13 @@ def share_authored_geometry(hits: list[RuleHits], mesh) -> tuple[list[RuleHits],
     Mesh prims whose points and topology come from one layer (the same
     ``mesh.prim_sources`` entry, the same number of faces) are one mesh: their
     findings move to the first of them (faces renumbered into its faces), each
-    (rule, face) keeping its worst value over the prims (:attr:`Rule.worst`).
+    (rule, face) keeping its worst value over the prims (:meth:`RuleHits.worst_key`: each against its own threshold).
     Returns the hits and the :attr:`FileReport.shared` entries; a mesh of other
     formats, or a stage without shared geometry, comes back as it was.
 
     Vectorized per rule: ``owner`` (P,) maps each prim to the first prim of its
     source, ``shift`` (P,) moves its faces onto that prim's.
     """
-    from .rules import RULES
-
     sources = mesh.prim_sources
     if not sources or len(sources) < 2:
         return hits, []

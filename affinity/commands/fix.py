@@ -28,12 +28,13 @@ def _level(text: str) -> int:
 
 def add_parser(sub) -> None:
     from ..loaders.formats import described
+    from ..rules.wording import fix_left_code, scored, scored_span
     from ..settings import DIAGONALS, MEASURES
     from .check import _codes, _measure, _selection, _threshold
 
     p = sub.add_parser(
         "fix", help="refine the quads the affinity rules flag, crack-free, touching nothing else",
-        description=f"Refine the quads of {described()} files that Q101-Q103 flag until the crease is gone: "
+        description=f"Refine the quads of {described()} files that {scored_span()} flag until the crease is gone: "
                     "each becomes n x n quads on its own bilinear surface, and the faces beside it are re-cut "
                     "to meet the new edge points (no T-junction). Writes NAME.fixed.EXT beside each input.",
     )
@@ -46,14 +47,16 @@ def add_parser(sub) -> None:
                    help="write nothing; list the faces that would be refined (with n), left (with why) and added")
     p.add_argument("--format", choices=("text", "json"), default="text", help="output of --dry-run and the summary")
     p.add_argument("--fix-level", choices=("info", "warning", "error"), default="warning",
-                   help="the lowest level of a Q101-Q103 finding that is fixed (default: warning)")
+                   help=f"the lowest level of a {scored_span()} finding that is fixed (default: warning)")
     p.add_argument("--max-refine", type=_level, default=8, metavar="N",
                    help="refine a quad into at most N x N quads (default 8); one that needs more is left "
                         "and reported as needing a re-UV")
     p.add_argument("--refine-nonplanar", action="store_true",
-                   help="refine the quads Q202 flags too: their pieces follow the quad's bilinear surface, "
+                   help=f"refine the quads {fix_left_code('nonplanar')} flags too: their pieces follow the quad's "
+                        "bilinear surface, "
                         "not the folded split the input draws (default: left)")
-    p.add_argument("--select", type=_selection, help="rule codes or prefixes whose findings are fixed, e.g. Q101")
+    p.add_argument("--select", type=_selection,
+                   help=f"rule codes or prefixes whose findings are fixed, e.g. {scored()[0]}")
     p.add_argument("--ignore", type=_codes, help="rule codes or prefixes not fixed")
     p.add_argument("--threshold", type=_threshold, action="append", default=[], metavar="[CODE=]VALUE",
                    help="as in check: the value each refined quad's pieces must get under")
@@ -128,6 +131,8 @@ def _fix_one(path: str, resolver, args) -> dict:
     from ..errors import MeshError, SkippedFile
     from ..fix import FixSettings, plan_fix
     from ..loaders import load
+    from ..output.names import printable
+    from ..rules.wording import unreadable_line
 
     try:
         settings = resolver.resolve(path).settings.for_file(path)
@@ -137,7 +142,7 @@ def _fix_one(path: str, resolver, args) -> dict:
         sys.stderr.write(f"{path}: skipped ({skip.reason})\n")
         return {"path": path, "skipped": skip.reason}
     except MeshError as err:
-        sys.stderr.write(f"{path}:{err.line}: Q901 unreadable: {err.reason}\n")
+        sys.stderr.write(unreadable_line(printable(path), err.reason, err.line) + "\n")
         return {"path": path, "error": err.reason, "line": err.line}
     try:
         plan = plan_fix(mesh, FixSettings(lint=settings, level=args.fix_level, max_refine=args.max_refine,

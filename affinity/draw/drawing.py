@@ -153,9 +153,10 @@ def uv_routing_inputs(mesh: Mesh, faces: np.ndarray, uv: np.ndarray, settings: S
     the split's texture displacement of every render quad, and the lint's uv error
     (along 0-2, uv units) per render quad when some uv quad is degenerate (Q301 at
     the threshold of ``settings``), else None."""
+    from ..rules.texture import UV_DEGENERATE
     from .routing import uv_displacement
 
-    moves = uv_displacement(uv, settings.threshold("Q301"))
+    moves = uv_displacement(uv, settings.threshold(UV_DEGENERATE))
     uv_error = None
     if moves.degenerate.any():
         from ..lint import quad_uv_error

@@ -23,11 +23,16 @@ from . import grid
 from .layout import MAX_LEVEL, Layout, edge_parameters, face_patterns, layout
 from .tessellate import face_polygons
 
-#: The scored rules a refinement removes.
-SCORED = ("Q101", "Q102", "Q103")
-#: Why a candidate is left, by the rule that says so, checked in this order.
-LEFT_BY_RULE = {"Q201": "degenerate", "Q204": "bowtie", "Q202": "nonplanar", "Q301": "uv-degenerate"}
-REASONS = ("over-cap", *LEFT_BY_RULE.values())
+
+def left_by_rule() -> dict[str, str]:
+    """Why a candidate is left, by the rule that says so (:attr:`affinity.rules.Rule.fix_leaves`), checked in
+    this order."""
+    from ..rules import fix_left_rules
+
+    return {rule.code: rule.fix_leaves for rule in fix_left_rules()}
+
+
+REASONS = ("over-cap", *left_by_rule().values())
 LEVEL_ORDER = ("info", "warning", "error")
 #: Quads refined together when their pieces are measured: (n + 1)^2 points each.
 SCORE_BATCH = 8192
@@ -106,16 +111,17 @@ def flagged_quads(mesh: Mesh, fix: FixSettings) -> tuple[dict, dict]:
     leaving : code -> faces (n,) int64 of Q201, Q202, Q204, Q301 findings
     """
     from ..findings import settle
-    from ..lint import lint_mesh
+    from ..lint import lint_mesh, scored_codes
     from ..rules import resolve_codes
 
-    enabled = [code for code in resolve_codes(fix.lint.select, fix.lint.ignore) if code in SCORED]
-    settings = replace(fix.lint, select=[*enabled, *LEFT_BY_RULE], ignore=[])
+    removed = scored_codes()  # the scored rules a refinement removes
+    enabled = [code for code in resolve_codes(fix.lint.select, fix.lint.ignore) if code in removed]
+    settings = replace(fix.lint, select=[*enabled, *left_by_rule()], ignore=[])
     hits = settle(lint_mesh(mesh, settings), settings, list(mesh.group_names), fix.inline)
     lowest = LEVEL_ORDER.index(fix.level)
     scored, leaving = {}, {}
     for h in hits:
-        if h.code in SCORED:
+        if h.code in removed:
             at_level = np.isin(h.levels(), LEVEL_ORDER[lowest:])
             scored[h.code] = h.faces[at_level], h.values[at_level]
         else:
@@ -202,7 +208,7 @@ def plan_fix(mesh: Mesh, fix: FixSettings | None = None) -> FixPlan:
     if fix.faces is not None:
         candidates = np.intersect1d(candidates, np.asarray(fix.faces, dtype=np.int64))
     reasons = np.full(len(candidates), "", dtype=object)
-    for code, reason in reversed(LEFT_BY_RULE.items()):  # the first rule in the table wins
+    for code, reason in reversed(left_by_rule().items()):  # the first rule in the table wins
         if not (reason == "nonplanar" and fix.refine_nonplanar):
             reasons[np.isin(candidates, leaving.get(code, []))] = reason
     reasons[(reasons == "degenerate") & pole_quads(mesh, candidates)] = ""

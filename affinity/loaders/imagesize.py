@@ -13,7 +13,8 @@ import os
 import struct
 from dataclasses import dataclass
 
-from .regular import RefusedFile, open_regular
+from .regular import RefusedFile
+from .sidefiles import open_side_file
 
 _PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 # JPEG start-of-frame markers: C0-CF except DHT (C4), JPG (C8) and DAC (CC).
@@ -57,8 +58,9 @@ class ImageHeader:
 def open_image_file(path: str | os.PathLike):
     """Open a texture file for reading bytes: the one place texture files are opened (header
     reading and decoding alike), so a policy on what may be opened (regular files only, a size
-    budget) applies to both. Raises OSError."""
-    return open_regular(path)
+    budget) applies to both, and a file is opened once for every header read and its decode
+    (:mod:`.sidefiles`). Raises OSError."""
+    return open_side_file(path)
 
 
 def read_header(path: str | os.PathLike) -> ImageHeader:

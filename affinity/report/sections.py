@@ -16,7 +16,7 @@ import numpy as np
 
 from ..attributes import ATTRIBUTE_NAMES, ATTRIBUTES
 from ..findings import FileReport
-from ..rules import LEVELS, RULES, number_text, resolve_codes, with_unit
+from ..rules import LEVELS, RULES, UNREADABLE, number_text, resolve_codes, with_unit
 from ..study.run import PACKAGE_TABLE
 from .build import MeshResult, ReportRun
 from .images import data_uri, heat_bar, heatmap_uri, image_uri, png_bytes
@@ -100,7 +100,7 @@ def file_row(result: MeshResult, fail_on: str) -> dict:
     file = result.file
     judged = verdict([file], fail_on)
     if file.error is not None:
-        status, message = "unreadable", f"Q901 unreadable: line {file.error_line}: {file.error}"
+        status, message = "unreadable", f"{UNREADABLE.code} {UNREADABLE.name}: line {file.error_line}: {file.error}"
     elif file.skipped is not None:
         status, message = "skipped", f"skipped ({file.skipped})"
     else:

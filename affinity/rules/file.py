@@ -6,6 +6,7 @@ import os
 
 import numpy as np
 
+from .families import QUAD_SHAPE
 from .registry import RULES, Measured, Rule, page_fields, rule
 
 FORMATS = (
@@ -14,7 +15,7 @@ FORMATS = (
 )
 
 
-@rule(code="Q205", name="no-faces", unit="vertices", scope="mesh", references=FORMATS)
+@rule(code="Q205", name="no-faces", unit="vertices", scope="mesh", family=QUAD_SHAPE, references=FORMATS)
 def no_faces(context) -> Measured:
     """The mesh has vertices but no faces.
 
@@ -58,10 +59,11 @@ def unusable_resource(path: str, image: bool) -> str | None:
     regular file: not read"``, over the side-file budget: an image is read in part, others whole), or None."""
     from ..loaders import LFS_POINTER
     from ..loaders.imagesize import image_size
-    from ..loaders.regular import SIDE_FILE_BUDGET, RefusedFile, open_regular
+    from ..loaders.regular import SIDE_FILE_BUDGET, RefusedFile
+    from ..loaders.sidefiles import open_side_file
 
     try:
-        with open_regular(path, None if image else SIDE_FILE_BUDGET) as fh:
+        with open_side_file(path, None if image else SIDE_FILE_BUDGET) as fh:
             head = fh.read(len(LFS_POINTER))
     except FileNotFoundError:
         return "not found"
@@ -76,7 +78,7 @@ def unusable_resource(path: str, image: bool) -> str | None:
     return None
 
 
-@rule(code="Q902", name="missing-resource", level="info", scope="mesh",
+@rule(code="Q902", name="missing-resource", level="info", scope="mesh", family=QUAD_SHAPE,
       references="Wavefront OBJ and MTL (Advanced Visualizer manual, Appendix B1 and B2: mtllib, map_Kd).")
 def missing_resources(context) -> Measured:
     """An mtllib or map_Kd named by the file cannot be found or read.
@@ -122,8 +124,8 @@ def missing_resources(context) -> Measured:
     # changes reach the cache, but a missing one is not a finding (Q902 is about OBJ and MTL). A finding sits on the line that pulls the file in
     # (face -1); its detail names the resource and, where the texel unit would have come
     # from that texture, the texture-size used instead.
+    from ..loaders.names import printable  # names come from the file: never send its control characters
     from ..loaders.resources import ROLES
-    from ..output.names import printable  # names come from the file: never send its control characters
 
     mesh, settings = context.mesh, context.settings
     folder = os.path.dirname(mesh.path)
@@ -186,5 +188,5 @@ How to fix:
 """
 
 #: Q901 is not a lint rule (design.md): documented like one, never registered.
-UNREADABLE = Rule(code="Q901", name="unreadable", level="error", scope="mesh", references=FORMATS,
+UNREADABLE = Rule(code="Q901", name="unreadable", level="error", scope="mesh", family=QUAD_SHAPE, references=FORMATS,
                   **page_fields(UNREADABLE_PAGE))
