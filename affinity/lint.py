@@ -214,16 +214,6 @@ class WholeMesh:
         return np.array([-1])
 
 
-def texture_grid(mesh: Mesh, settings: Settings) -> tuple[tuple[int, int], bool]:
-    """The (w, h) texel grid of the mesh's ``map_Kd`` image when its header reads, else the
-    ``texture-size`` setting; and whether it was assumed (no readable texture). Q101 counts each quad
-    in its own material's texture (:func:`quad_texel_grid`)."""
-    from .loaders.imagesize import image_size
-
-    size = image_size(mesh.texture_path())
-    return (size, False) if size is not None else ((settings.texture_size,) * 2, True)
-
-
 def quad_texel_grid(mesh: Mesh, settings: Settings, faces: np.ndarray | None = None):
     """Each quad's texel grid (:func:`affinity.textures.binding.texel_grid`): the size of the texture its
     material binds, from the header, else the ``texture-size`` setting."""

@@ -81,56 +81,25 @@ def new_rules():
 
     register_family("Synthetic", "rules registered by a test.")
 
-    @rule(code="Q998", name="triple-shift", unit="texels", default_threshold=1.0, attribute="texcoords", scored=True,
-          family="Synthetic")
-    def triple_shift(quads) -> Measured:
-        """Three times the split's shift.
+    page = {"why": "A test.", "example": "v 0 0 0\nf 1 1 1\n", "fix": "Unregister it."}  # each rule's page
 
-        What it does:
-            Q101's measure, tripled.
-        Why it matters:
-            A test.
-        Example:
-            v 0 0 0
-            f 1 1 1
-        How to fix:
-            Refine the quad.
-        """
+    @rule(code="Q998", name="triple-shift", unit="texels", default_threshold=1.0, attribute="texcoords", scored=True,
+          family="Synthetic", what="Q101's measure, tripled.", **page)
+    def triple_shift(quads) -> Measured:
+        """Three times the split's shift."""
         measured = uv_disaffinity(quads)
         return Measured(measured.rows, 3 * measured.values)
 
     @rule(code="Q997", name="marked-quad", unit="marks", default_threshold=0.5, family="Synthetic",
-          masks=("texcoords",), unmeasurable=marked, cause="it is marked")
+          masks=("texcoords",), unmeasurable=marked, cause="it is marked", what="Flags the first column.", **page)
     def marked_quad(quads) -> Measured:
-        """The quad is marked.
-
-        What it does:
-            Flags the grid's first column.
-        Why it matters:
-            A test.
-        Example:
-            v 0 0 0
-            f 1 1 1
-        How to fix:
-            Unmark it.
-        """
+        """The quad is marked."""
         return Measured(slice(None), marked(quads).astype(np.float64))
 
     @rule(code="Q996", name="held-quad", unit="holds", default_threshold=0.5, family="Synthetic", fix_leaves="held",
-          fix_precedence=9)
+          fix_precedence=9, what="Flags the second column.", **page)
     def held_quad(quads) -> Measured:
-        """The quad is held.
-
-        What it does:
-            Flags the grid's second column.
-        Why it matters:
-            A test.
-        Example:
-            v 0 0 0
-            f 1 1 1
-        How to fix:
-            Let it go.
-        """
+        """The quad is held."""
         return Measured(slice(None), (column(quads) == 1).astype(np.float64))
 
     try:

@@ -29,7 +29,7 @@ from bpy.props import (
     StringProperty,
 )
 
-from ..rules import RULES, number_text, with_unit
+from ..rules import LEVELS, RULES, number_text, with_unit
 from ..settings import DIAGONALS, MEASURES, Settings
 from . import compat
 from .check import check_object, face_error, severity
@@ -77,7 +77,7 @@ def _settings_annotations() -> dict:
         "fix_level": EnumProperty(
             name="Fix level", default="warning",
             items=[(level, level.capitalize(), f"Fix {', '.join(SCORED)} findings at {level} and above")
-                   for level in ("info", "warning", "error")],
+                   for level in reversed(LEVELS)],
         ),
         "max_refine": IntProperty(
             name="Max refine", default=8, min=2, soft_max=32,

@@ -55,8 +55,7 @@ def check_object(obj, **options) -> ObjectCheck:
     size of the active material's Base Color image (packed or generated), the
     default of :class:`~affinity.settings.Settings`.
     """
-    from ..findings import settle
-    from ..lint import lint_mesh
+    from ..lint import mesh_report
     from ..rules import RULES, resolve_codes
     from ..settings import Settings
 
@@ -68,22 +67,20 @@ def check_object(obj, **options) -> ObjectCheck:
         notes.extend(f"{code} skipped: the mesh has no UV map"
                      for code in resolve_codes(options.get("select"), options.get("ignore"))
                      if RULES[code].scored and RULES[code].attribute == "texcoords")
-    if mesh.texture_path() is None and texture is not None and "texture_size" not in options:
+    if not mesh.material_textures and texture is not None and "texture_size" not in options:
         options["texture_size"] = max(texture.size)
         if texture.size[0] != texture.size[1]:
             notes.append(f"texture {texture.image} is not square and not a file: "
                          f"texels counted at {max(texture.size)} px both ways")
     settings = Settings(**options)
-    hits = settle(lint_mesh(mesh, settings), settings, list(mesh.group_names))  # levels and units, as check does
-    rows = _finding_dicts(mesh, hits, settings, conversion.original_face if convert.get("evaluated") else None)
-    return ObjectCheck(conversion, settings, hits, rows, notes)
+    report = mesh_report(mesh.path, mesh, settings)  # check's own path from a mesh to its findings
+    rows = _finding_dicts(report, settings, conversion.original_face if convert.get("evaluated") else None)
+    return ObjectCheck(conversion, settings, report.hits, rows, notes)
 
 
-def _finding_dicts(mesh, hits, settings, original_face) -> list[dict]:
-    from ..findings import FileReport
+def _finding_dicts(report, settings, original_face) -> list[dict]:
     from ..output import file_findings, finding_dict
 
-    report = FileReport(path=mesh.path, counts=mesh.counts(), hits=hits, group_names=mesh.group_names)
     rows = []
     for finding in file_findings(report)[0]:
         row = finding_dict(finding)

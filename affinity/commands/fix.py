@@ -28,6 +28,7 @@ def _level(text: str) -> int:
 
 def add_parser(sub) -> None:
     from ..loaders.formats import described
+    from ..rules import LEVELS
     from ..rules.wording import fix_left_code, scored, scored_span
     from ..settings import DIAGONALS, MEASURES
     from .check import _codes, _measure, _selection, _threshold
@@ -46,7 +47,7 @@ def add_parser(sub) -> None:
     p.add_argument("--dry-run", action="store_true",
                    help="write nothing; list the faces that would be refined (with n), left (with why) and added")
     p.add_argument("--format", choices=("text", "json"), default="text", help="output of --dry-run and the summary")
-    p.add_argument("--fix-level", choices=("info", "warning", "error"), default="warning",
+    p.add_argument("--fix-level", choices=tuple(reversed(LEVELS)), default="warning",
                    help=f"the lowest level of a {scored_span()} finding that is fixed (default: warning)")
     p.add_argument("--max-refine", type=_level, default=8, metavar="N",
                    help="refine a quad into at most N x N quads (default 8); one that needs more is left "

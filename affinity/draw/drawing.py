@@ -199,13 +199,13 @@ def choose_methods(mesh: Mesh, faces: np.ndarray, uv: np.ndarray | None, clip: n
 def resolve_texture(mesh: Mesh, options: RenderOptions, warn: Callable[[str], None]) -> np.ndarray:
     """The explicit texture (an image, or a path whose errors are fatal), else map_Kd (a missing
     one warns), else the checker."""
-    from .texture import TextureError, checker, load_image
+    from .texture import TextureError, checker, load_image, painted_texture
 
     if isinstance(options.texture, np.ndarray):
         return options.texture
     if options.texture:
         return load_image(options.texture)
-    path = mesh.texture_path()
+    path = painted_texture(mesh)
     if path:
         try:
             return load_image(path)

@@ -18,6 +18,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..mesh import Mesh, mesh_from_polygons
+from ..rules import LEVELS
 from ..settings import Settings
 from . import grid
 from .layout import MAX_LEVEL, Layout, edge_parameters, face_patterns, layout
@@ -33,7 +34,7 @@ def left_by_rule() -> dict[str, str]:
 
 
 REASONS = ("over-cap", *left_by_rule().values())
-LEVEL_ORDER = ("info", "warning", "error")
+LEVEL_ORDER = tuple(reversed(LEVELS))  # the mildest first
 #: Quads refined together when their pieces are measured: (n + 1)^2 points each.
 SCORE_BATCH = 8192
 

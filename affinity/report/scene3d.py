@@ -98,7 +98,9 @@ def _texture(result: MeshResult) -> dict | None:
 
     Decoded by the core (:func:`affinity.textures.decode.decode`: regular files only, never over the pixel
     budget, once per run); a texture it refuses leaves the view to the uv line pattern."""
-    path = result.options.texture or result.mesh.texture_path()
+    from ..draw import painted_texture
+
+    path = result.options.texture or painted_texture(result.mesh)
     if not path or result.mesh.texcoords is None:
         return None
     from PIL import Image

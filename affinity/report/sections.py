@@ -292,17 +292,18 @@ def _errors_against_exact(result: MeshResult) -> dict | None:
     if result.shown is None:
         return None
     from ..attributes import pixel_error
-    from ..loaders.imagesize import image_size
+    from ..lint import quad_texel_grid
 
     exact = result.renders["exact"].frame
-    texture_size = image_size(result.mesh.texture_path()) or (result.settings.texture_size,) * 2
+    grid = quad_texel_grid(result.mesh, result.settings)  # each face in its own texture's texels, as the lint
     errors = {}
     for method in ("split", "hybrid", "mvc", "exact"):
-        frame = result.renders[method].frame
+        render = result.renders[method]
+        frame = render.frame
         covered = (frame.face >= 0) & (frame.face == exact.face)
         error = np.zeros(covered.shape)
         error[covered] = pixel_error(frame.attrs[covered], exact.attrs[covered], RULES[result.shown].attribute,
-                                      texture_size)
+                                      grid.of(render.faces[frame.face[covered]]))
         errors[method] = error, covered
     return errors
 

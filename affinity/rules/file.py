@@ -130,7 +130,6 @@ def missing_resources(context) -> Measured:
     mesh, settings = context.mesh, context.settings
     folder = os.path.dirname(mesh.path)
     texels = mesh.texcoords is not None and "Q101" in RULES
-    used = mesh.texture_path()
     fallback = f"; texels use texture-size {settings.texture_size}"
     lines, details, seen = [], [], set()
     for resource in mesh.resources:
@@ -143,13 +142,13 @@ def missing_resources(context) -> Measured:
             continue
         lines.append(resource.line)
         if resource.library is None:
-            texture_unit_lost = texels and used is None and role.name == "mtllib"
+            texture_unit_lost = texels and not mesh.material_textures and role.name == "mtllib"
             details.append(f"{role.statement} {printable(resource.name)} {problem}"
                            + (fallback if texture_unit_lost else ""))
         else:
             shown = os.path.relpath(resource.path, folder) if folder else resource.path
             details.append(f"{role.statement} {printable(shown)} (in {printable(resource.library)}) {problem}"
-                           + (fallback if texels and resource.path == used else ""))
+                           + (fallback if texels and role.texture == "base colour" else ""))
     n = len(lines)
     return Measured(np.zeros(n, dtype=np.int64), np.zeros(n), lines=np.array(lines, dtype=np.int64), details=details)
 
