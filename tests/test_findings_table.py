@@ -79,3 +79,22 @@ def test_findings_in_two_units_rank_by_their_own_thresholds(tmp_path):
     for rank in np.unique(ranks):
         within = ratios[order[ranks == rank]]
         assert (np.diff(within) <= 1e-12).all(), "within a level, the larger ratio first"
+
+
+def test_the_worst_finding_and_place_are_the_furthest_beyond_their_own_threshold(tmp_path):
+    """A faint checker (grey levels 0 and 4): C is at most 4/255, 2x visible-warning at most, while the plain half's
+    shift is 2.13x Q101's threshold. Both are warnings; the worst is a plain quad, though its value (1.07 texels)
+    is the smaller number."""
+    from affinity.loaders import load
+    from affinity.output import worst_first
+    from affinity.report.places import places_of
+
+    path = grid_obj(tmp_path, split_materials=True, contrast=4)
+    hits = q101(checked(path))
+    read = hits.visible.read()
+    assert read.any() and (hits.values[read] <= 4.0 + 1e-9).all() and (hits.values[read] > SHIFT).any()
+    assert set(hits.levels()[(hits.values >= 2.0) | ~read]) == {"warning"}
+    worst = worst_first(hits)[0]
+    assert not read[worst]
+    [place] = places_of(load(str(path)), hits, limit=SIDE * SIDE)  # one group: the grid is connected
+    assert place.worst in hits.faces[~read] and place.beyond == pytest.approx(SHIFT / 0.5)

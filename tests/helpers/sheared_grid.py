@@ -14,13 +14,14 @@ SHEAR = 0.6
 SHIFT = TEXTURE * SHEAR / 144
 
 
-def grid_obj(folder, material: str | None = "checker", split_materials: bool = False):
-    """The sheared grid as an OBJ in ``folder``: with ``material`` a 256 px 8 x 8 checker bound by an MTL
-    (none: no MTL); with ``split_materials`` the left half of the quads in a second material without a map."""
+def grid_obj(folder, material: str | None = "checker", split_materials: bool = False, contrast: int = 255):
+    """The sheared grid as an OBJ in ``folder``: with ``material`` a 256 px 8 x 8 checker of grey levels 0 and
+    ``contrast`` bound by an MTL (none: no MTL); with ``split_materials`` the left half of the quads in a second
+    material without a map."""
     from PIL import Image
 
     checks = (np.indices((TEXTURE, TEXTURE)) // (TEXTURE // 8)).sum(axis=0) % 2
-    Image.fromarray((checks * 255).astype(np.uint8)).convert("RGB").save(folder / "checker.png")
+    Image.fromarray((checks * contrast).astype(np.uint8)).convert("RGB").save(folder / "checker.png")
     (folder / "grid.mtl").write_text("newmtl checker\nmap_Kd checker.png\nnewmtl plain\nKd 1 1 1\n")
     lines = ["mtllib grid.mtl"] if material else []
     for y in range(SIDE + 1):
