@@ -129,7 +129,7 @@ def run(args) -> int:
 
 def _fix_one(path: str, resolver, args) -> dict:
     """Fix (or, with --dry-run, plan) one file; its entry of the JSON document. Never raises for bad input."""
-    from ..errors import MeshError, SkippedFile
+    from ..errors import MeshError, SkippedFile, internal_error
     from ..fix import FixSettings, plan_fix
     from ..loaders import load
     from ..output.names import printable
@@ -140,7 +140,7 @@ def _fix_one(path: str, resolver, args) -> dict:
         mesh = load(path)
         inline = _inline_ignores(path, mesh)
     except SkippedFile as skip:
-        sys.stderr.write(f"{path}: skipped ({skip.reason})\n")
+        sys.stderr.write(f"{printable(path)}: skipped ({skip.reason})\n")
         return {"path": path, "skipped": skip.reason}
     except MeshError as err:
         sys.stderr.write(unreadable_line(printable(path), err.reason, err.line) + "\n")
@@ -157,11 +157,11 @@ def _fix_one(path: str, resolver, args) -> dict:
             entry["output"] = out
     except OSError as err:
         reason = f"cannot write {_output_path(path, args)}: {err.strerror or err}"
-        sys.stderr.write(f"{path}: {reason}\n")
+        sys.stderr.write(f"{printable(path)}: {reason}\n")
         return {"path": path, "error": reason}
     except Exception as err:  # one file's failure never stops the others, nor shows a traceback
-        reason = " ".join(f"internal error: {type(err).__name__}: {err}".split())[:300]
-        sys.stderr.write(f"{path}: {reason}\n")
+        reason = internal_error(err)
+        sys.stderr.write(f"{printable(path)}: {reason}\n")
         return {"path": path, "error": reason}
     if args.format == "text":
         write_text(entry, args.dry_run, sys.stdout, args.quiet)

@@ -13,7 +13,7 @@ from collections.abc import Callable, Iterable, Iterator
 from contextlib import AbstractContextManager, nullcontext
 from functools import partial
 
-from ..errors import MeshError, SkippedFile
+from ..errors import MeshError, SkippedFile, internal_error
 from ..findings import FileReport
 from ..mesh import Mesh
 from ..settings import Settings
@@ -50,8 +50,7 @@ def load_and_check(path: str, settings: Settings, usd=None, source: bytes | None
     except MeshError as err:
         return FileReport(path, error=err.reason, error_line=err.line), None
     except Exception as err:
-        reason = " ".join(f"internal error: {type(err).__name__}: {err}".split())
-        return FileReport(path, error=reason[:300], error_line=0, transient=True), None
+        return FileReport(path, error=internal_error(err), error_line=0, transient=True), None
     return report, mesh
 
 
