@@ -6,7 +6,8 @@ reads through :func:`read_side_file` or :func:`open_side_file`, which open a fil
 unchanged (its path, size, modification time and inode, from ``stat``, which opens nothing) and hand every
 caller the same bytes, so they agree on what the file says. A file that cannot be kept (missing, not a
 regular file, over the caller's budget or over :data:`KEPT_FILE`) is opened as before, each time, and says
-why in the same words (:mod:`.regular`).
+why in the same words (:mod:`.regular`). The bytes are kept for one file's check: :func:`forget` drops them
+when it ends (:func:`affinity.pipeline.check.load_and_check`), so a run over many files holds one file's.
 """
 
 from __future__ import annotations
@@ -20,9 +21,9 @@ from collections import OrderedDict
 from .regular import open_regular, read_regular
 
 #: A file of more bytes is never kept (a texture too big to decode: its header is read in part, each time).
-KEPT_FILE = 64 << 20
+KEPT_FILE = 32 << 20
 #: Bytes kept over all files; the least recently read go first.
-KEPT_BYTES = 256 << 20
+KEPT_BYTES = 64 << 20
 
 _kept: OrderedDict[tuple, bytes] = OrderedDict()
 _lock = threading.Lock()  # one reader at a time: two threads asking for one file open it once
@@ -64,3 +65,9 @@ def open_side_file(path, budget: int | None = None):
     object either way."""
     data = kept_bytes(path, budget)
     return open_regular(path, budget) if data is None else io.BytesIO(data)
+
+
+def forget() -> None:
+    """Drop every kept file's bytes (the end of one file's check)."""
+    with _lock:
+        _kept.clear()

@@ -35,6 +35,7 @@ def load_and_check(path: str, settings: Settings, usd=None, source: bytes | None
     the report holds every quad's scores from the same lint (:attr:`FileReport.scores`)."""
     from ..lint import mesh_report
     from ..loaders import load, reads_whole
+    from ..loaders.sidefiles import forget
 
     try:
         if reads_whole(path):
@@ -51,6 +52,8 @@ def load_and_check(path: str, settings: Settings, usd=None, source: bytes | None
         return FileReport(path, error=err.reason, error_line=err.line), None
     except Exception as err:
         return FileReport(path, error=internal_error(err), error_line=0, transient=True), None
+    finally:
+        forget()  # the side files' bytes served this file's readers; the next file reads its own
     return report, mesh
 
 
