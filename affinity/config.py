@@ -46,6 +46,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .errors import UsageError
+from .rules import RULES
 from .settings import (
     DIAGONALS,
     MEASURES,
@@ -113,7 +114,7 @@ def find_config(folder: Path) -> Path | None:
 
 def _codes(value, where: str) -> list[str]:
     if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
-        raise ConfigError(f"{where}: expected a list of rule codes, e.g. [\"Q101\"]")
+        raise ConfigError(f"{where}: expected a list of rule codes, e.g. [\"{next(iter(RULES))}\"]")
     codes = [v.strip().upper() for v in value]
     unknown = unknown_codes(codes)
     if unknown:
@@ -265,9 +266,11 @@ def read_config(path: Path) -> dict:
     for key in _RUN_KEYS.keys() & table.keys():
         _RUN_KEYS[key](table[key], prefix + key)
     if "threshold" in table:
-        if "Q101" in options.get("thresholds", {}):
-            raise ConfigError(f"{prefix}threshold and thresholds.Q101 both set the Q101 threshold")
-        options.setdefault("thresholds", {})["Q101"] = _number(table["threshold"], prefix + "threshold")
+        from .rules.affinity import UV_DISAFFINE
+
+        if UV_DISAFFINE in options.get("thresholds", {}):
+            raise ConfigError(f"{prefix}threshold and thresholds.{UV_DISAFFINE} both set the {UV_DISAFFINE} threshold")
+        options.setdefault("thresholds", {})[UV_DISAFFINE] = _number(table["threshold"], prefix + "threshold")
     return options
 
 

@@ -33,3 +33,9 @@ class SkippedFile(Exception):
         super().__init__(f"{path}: skipped ({reason})")
         self.path = str(path)
         self.reason = reason
+
+
+def internal_error(err: BaseException) -> str:
+    """An unexpected exception while checking or fixing one file, as the one line said for that file (at most
+    300 characters): ``internal error: ValueError: ...``."""
+    return " ".join(f"internal error: {type(err).__name__}: {err}".split())[:300]

@@ -42,6 +42,10 @@ class VisibleColumns:
         return VisibleColumns(*(getattr(self, name)[rows] for name in self.ARRAYS), self.textures, self.roles,
                               self.units, self.limits, self.fixed)
 
+    def read(self) -> np.ndarray:
+        """(n,) bool: the findings whose value is C, read through a texture (its shift known, a texture picked)."""
+        return (self.picks >= 0) & np.isfinite(self.shifts)
+
     def levels(self) -> np.ndarray:
         """(n,) str: the visible reading's level where C was read, "" elsewhere."""
         from .textures.visible import VisibleLimits
@@ -121,6 +125,67 @@ class RuleHits:
             for index, level in enumerate(LEVELS):
                 rank[visible == level] = index
         return rank
+
+    @property
+    def shifts(self) -> np.ndarray:
+        """(n,) float64: what the rule measured against ``threshold``, in ``unit`` (Q101: the split's shift in
+        texels): ``values`` where no texture was read, the visible reading's shift where ``values`` hold C.
+        Consumers that need the shift (fix, the texel unit) read this column, never ``values``."""
+        if self.visible is None:
+            return self.values
+        return np.where(self.visible.read(), self.visible.shifts, self.values)
+
+    def units(self) -> np.ndarray:
+        """(n,) str (object): the unit of each of ``values``: the texture's (``1/255``, ``degrees``) where C was
+        read, else ``unit`` (the rule's under the file's reading; set by :func:`settle`)."""
+        from .rules import RULES
+
+        units = np.full(len(self), self.unit or RULES[self.code].unit, dtype=object)
+        if self.visible is not None:
+            read = self.visible.read()
+            units[read] = np.asarray(self.visible.units, dtype=object)[self.visible.picks[read]]
+        return units
+
+    def thresholds(self) -> np.ndarray:
+        """(n,) float64: the threshold each of ``values`` is read against, in its own unit: ``threshold``, or
+        visible-warning where C was read (as every format writes the finding's ``threshold``)."""
+        thresholds = np.full(len(self), float(self.threshold))
+        if self.visible is not None:
+            thresholds[self.visible.read()] = self.visible.limits[1]
+        return thresholds
+
+    def ratios(self) -> np.ndarray:
+        """(n,) float64: how far each value is beyond its own threshold (:meth:`thresholds`), as a ratio, worse
+        the larger: value / threshold for a rule that flags above, threshold / value for one that flags at or
+        below (inf at 0); NaN for a rule without a threshold. One unit for every row, so findings read in
+        texels and in 1/255 steps rank together (output order, report places, Blender's worst)."""
+        from .rules import RULES
+
+        rule = RULES[self.code]
+        if not rule.has_threshold:
+            return np.full(len(self), np.nan)
+        thresholds = self.thresholds()
+        with np.errstate(divide="ignore", invalid="ignore"):
+            if rule.flags == "above":
+                return np.where(thresholds > 0, self.values / thresholds, np.inf * np.sign(self.values))
+            return np.where(self.values > 0, thresholds / self.values, np.inf)
+
+    @property
+    def ranked_by_ratio(self) -> bool:
+        """Whether the findings rank by :meth:`ratios`: the rule flags values above a positive threshold."""
+        from .rules import RULES
+
+        rule = RULES[self.code]
+        return rule.flags == "above" and rule.has_threshold and self.threshold > 0
+
+    def worst_key(self) -> np.ndarray:
+        """(n,) float64, lowest the worst: minus :meth:`ratios` where the findings rank by them, else the values
+        from the rule's ``worst`` end (a rule without a threshold, or one that flags at or below it)."""
+        from .rules import RULES
+
+        if self.ranked_by_ratio:
+            return -self.ratios()
+        return self.values if RULES[self.code].worst == "lowest" else -self.values
 
     def at_or_above(self, level: str) -> RuleHits:
         """The findings at ``level`` or worse (``error`` > ``warning`` > ``info``)."""
@@ -236,15 +301,13 @@ def share_authored_geometry(hits: list[RuleHits], mesh) -> tuple[list[RuleHits],
     Mesh prims whose points and topology come from one layer (the same
     ``mesh.prim_sources`` entry, the same number of faces) are one mesh: their
     findings move to the first of them (faces renumbered into its faces), each
-    (rule, face) keeping its worst value over the prims (:attr:`Rule.worst`).
+    (rule, face) keeping its worst value over the prims (:meth:`RuleHits.worst_key`: each against its own threshold).
     Returns the hits and the :attr:`FileReport.shared` entries; a mesh of other
     formats, or a stage without shared geometry, comes back as it was.
 
     Vectorized per rule: ``owner`` (P,) maps each prim to the first prim of its
     source, ``shift`` (P,) moves its faces onto that prim's.
     """
-    from .rules import RULES
-
     sources = mesh.prim_sources
     if not sources or len(sources) < 2:
         return hits, []
@@ -268,8 +331,7 @@ def share_authored_geometry(hits: list[RuleHits], mesh) -> tuple[list[RuleHits],
         prim = h.groups.astype(np.int64)
         faces = np.where(on_face, h.faces + shift[prim], h.faces)
         groups = np.where(on_face, owner[prim], prim).astype(h.groups.dtype)
-        worst = -h.values if RULES[h.code].worst == "highest" else h.values
-        order = np.lexsort((worst, faces, ~on_face))
+        order = np.lexsort((h.worst_key(), faces, ~on_face))
         keep = order[np.concatenate(([True], (faces[order][1:] != faces[order][:-1]) | ~on_face[order][1:]))]
         keep.sort()
         out = h.subset(keep)

@@ -24,7 +24,7 @@ from .findings import FileReport, RuleHits, settle, share_authored_geometry
 from .geometry import PlanarQuads, planar_quads_by_component, squared_lengths
 from .measures import split_error_by_component, split_scale
 from .mesh import Mesh
-from .rules import RULES, resolve_codes
+from .rules import RULES, masking_rules, resolve_codes
 from .settings import Settings
 
 #: Quads measured together. Whole-mesh temporaries of a million quads spill out
@@ -214,16 +214,6 @@ class WholeMesh:
         return np.array([-1])
 
 
-def texture_grid(mesh: Mesh, settings: Settings) -> tuple[tuple[int, int], bool]:
-    """The (w, h) texel grid of the mesh's ``map_Kd`` image when its header reads, else the
-    ``texture-size`` setting; and whether it was assumed (no readable texture). Q101 counts each quad
-    in its own material's texture (:func:`quad_texel_grid`)."""
-    from .loaders.imagesize import image_size
-
-    size = image_size(mesh.texture_path())
-    return (size, False) if size is not None else ((settings.texture_size,) * 2, True)
-
-
 def quad_texel_grid(mesh: Mesh, settings: Settings, faces: np.ndarray | None = None):
     """Each quad's texel grid (:func:`affinity.textures.binding.texel_grid`): the size of the texture its
     material binds, from the header, else the ``texture-size`` setting."""
@@ -289,7 +279,8 @@ def lint_pass(mesh: Mesh, settings: Settings, visible: bool = True, scores: bool
     file order within each; ``scores``, rule code -> QuadScores (empty without ``scores``).
     """
     enabled = [RULES[code] for code in resolve_codes(settings.select, settings.ignore)]
-    reads_textures = (visible and RULES["Q101"] in enabled and RULES["Q101"].unit_for(settings.measure) == "texels"
+    reads_textures = (visible and any(rule.visible_reading and rule.unit_for(settings.measure) == "texels"
+                                      for rule in enabled)
                       and mesh.texcoords is not None and (mesh.material_maps or mesh.material_textures))
     preparing = _prepare_textures(mesh) if reads_textures else None
     hits = []
@@ -336,12 +327,12 @@ def lint_pass(mesh: Mesh, settings: Settings, visible: bool = True, scores: bool
             values = np.concatenate([found[rule.code][1] for found in batches])
             threshold = thresholds[rule.code]
             breaks = np.concatenate([found[rule.code][2] for found in batches])
-            taken = [r.code for r in maskable if r.attribute in CAUSE_MASKS.get(rule.code, ())]
+            taken = [r.code for r in maskable if r.attribute in rule.masks]
             found = RuleHits(rule.code, faces, mesh.face_line[faces], values,
                              0.0 if threshold is None else float(threshold), mesh.face_group[faces],
                              details=_texel_details(settings, rule, faces, values, grid)
-                             or _cause_details(rule.code, breaks, taken))
-            if reads_textures and rule.code == "Q101":
+                             or _cause_details(rule, breaks, taken))
+            if reads_textures and rule.visible_reading and rule.unit_for(settings.measure) == "texels":
                 if preparing is not None:
                     preparing.join()
                 found = _read_visible(mesh, settings, found)
@@ -381,72 +372,47 @@ def mesh_report(path: str, mesh, settings, inline=(), scores: bool = False) -> F
                       meters_per_unit=mesh.meters_per_unit, notes=list(mesh.notes), scores=linted.scores)
 
 
-#: Cause rule -> the attributes whose scored rules (Q101-Q103) it takes over (:class:`Unmeasurable`).
-CAUSE_MASKS = {"Q201": ("texcoords", "colors", "normals"), "Q204": ("texcoords", "colors", "normals"),
-               "Q301": ("texcoords",)}
-
-
 class Unmeasurable:
     """The quads of a batch the scored rules (Q101-Q103) do not measure: one finding per defect (design.md).
 
-    A quad whose uv collapses to a line or a point (Q301's test, at Q301's threshold) gets no Q101: its
-    value would be computed from collapsed values. A quad without area (its whole area at or below
-    Q201's threshold; one repeated corner, a pole quad, is a triangle with area and keeps its findings)
-    or a bow-tie (Q204's test) gets no Q101-Q103. The tests run whatever rules are selected, so the
-    suppression does not depend on the cause being reported.
-
-    Attributes
-    ----------
-    collapsed_uv, no_area, bowtie : (Q,) bool
+    Each rule with :attr:`~affinity.rules.Rule.masks` says where its defect takes the scored rules of those
+    attributes over (:attr:`~affinity.rules.Rule.unmeasurable`): a quad whose uv collapses to a line or a point
+    (Q301) gets no Q101, its value would be computed from collapsed values; a quad without area (Q201 by
+    area; one repeated corner, a pole quad, is a triangle with area and keeps its findings) or a bow-tie (Q204)
+    gets no Q101-Q103. The tests run whatever rules are selected, so the suppression does not depend on the
+    cause being reported; each runs once per batch.
     """
 
     def __init__(self, batch: QuadBatch):
         self.batch = batch
+        self._where: dict[str, np.ndarray] = {}
 
-    @cached_property
-    def no_area(self) -> np.ndarray:
-        from .geometry import zero_area
-
-        return zero_area(self.batch.planar, self.batch.settings.threshold("Q201"))
-
-    @cached_property
-    def bowtie(self) -> np.ndarray:
-        from .geometry import is_bowtie
-
-        return is_bowtie(self.batch.planar)
-
-    @cached_property
-    def collapsed_uv(self) -> np.ndarray:
-        from .rules.texture import uv_degenerate
-
-        collapsed = np.zeros(len(self.batch), dtype=bool)
-        if self.batch.tables.tables.get("texcoords") is not None:
-            area = uv_degenerate(self.batch)
-            collapsed[area.rows] = RULES["Q301"].flagged(area.values, self.batch.settings.threshold("Q301"))
-        return collapsed
+    def where(self, cause) -> np.ndarray:
+        """(Q,) bool: the quads where rule ``cause``'s defect takes its masked scores over."""
+        if cause.code not in self._where:
+            self._where[cause.code] = np.asarray(cause.unmeasurable(self.batch), dtype=bool)
+        return self._where[cause.code]
 
     def masked(self, rule) -> np.ndarray:
         """(Q,) bool: the quads the scored ``rule`` leaves alone."""
-        masked = self.no_area | self.bowtie
-        return masked | self.collapsed_uv if rule.attribute in CAUSE_MASKS["Q301"] else masked
+        masked = np.zeros(len(self.batch), dtype=bool)
+        for cause in masking_rules(rule.attribute):
+            masked |= self.where(cause)
+        return masked
 
     def breaks(self, code: str) -> np.ndarray:
         """(Q,) bool: the quads where a finding of rule ``code`` takes the scored rules' place."""
-        cause = {"Q201": "no_area", "Q204": "bowtie", "Q301": "collapsed_uv"}.get(code)
-        return np.zeros(len(self.batch), dtype=bool) if cause is None else getattr(self, cause)
+        cause = RULES[code]
+        return self.where(cause) if cause.masks else np.zeros(len(self.batch), dtype=bool)
 
 
-#: What a cause's finding says where it takes the scored rules' place (:class:`Unmeasurable`).
-CAUSES = {"Q201": "it has no area", "Q204": "it has no consistent orientation", "Q301": "the texture smears over it"}
-
-
-def _cause_details(code: str, breaks: np.ndarray, taken: list[str]) -> list | None:
-    """One detail per finding of rule ``code``: where ``breaks`` (n,) bool, the cause and the scored
-    rules ``taken`` over (those selected whose attribute the mesh has, that the cause masks), else None;
-    None altogether where nothing was taken over."""
-    if code not in CAUSES or not taken or not breaks.any():
+def _cause_details(cause, breaks: np.ndarray, taken: list[str]) -> list | None:
+    """One detail per finding of rule ``cause``: where ``breaks`` (n,) bool, what it says as a cause
+    (:attr:`~affinity.rules.Rule.cause`) and the scored rules ``taken`` over (those selected whose attribute
+    the mesh has, that it masks), else None; None altogether where nothing was taken over."""
+    if not cause.cause or not taken or not breaks.any():
         return None
-    detail = f"{CAUSES[code]}, so {', '.join(taken)} {'is' if len(taken) == 1 else 'are'} not measured on it"
+    detail = f"{cause.cause}, so {', '.join(taken)} {'is' if len(taken) == 1 else 'are'} not measured on it"
     return np.where(breaks, detail, None).tolist()
 
 

@@ -162,13 +162,6 @@ class Mesh:
         out[picked < 0] = np.nan
         return out
 
-    def texture_path(self) -> str | None:
-        """The ``map_Kd`` path of the first material that has one, or None."""
-        for name in self.material_names:
-            if name in self.material_textures:
-                return self.material_textures[name]
-        return next(iter(self.material_textures.values()), None)
-
     def validate(self) -> None:
         """Raise ValueError naming every invariant of the model this mesh breaks.
 

@@ -50,7 +50,8 @@ def main(argv=None) -> None:
         whole = time.perf_counter() - start
         covered = drawn.frame.face >= 0
         direction = np.subtract(drawn.camera.eye, drawn.camera.target)
-        colour = texture.checker() if not drawn.mesh.texture_path() else texture.load_image(drawn.mesh.texture_path())
+        painted = texture.painted_texture(drawn.mesh)
+        colour = texture.checker() if not painted else texture.load_image(painted)
         times = {"mip": [], "base": []}
         for _ in range(rounds):
             for kind in ("mip", "base"):

@@ -36,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
-from affinity.lint import quad_scores, texture_grid
+from affinity.lint import quad_scores, quad_texel_grid
 from affinity.loaders import load
 from affinity.rules import RULES
 from affinity.settings import Settings
@@ -109,7 +109,10 @@ def measure(path: Path) -> dict:
     if mesh.texcoords is not None:
         values = quad_scores(mesh, settings, "Q101").values
         largest = float(values.max()) if len(values) else None
-    (width, height), assumed = texture_grid(mesh, settings)
+    quads = np.flatnonzero(mesh.face_sizes == 4)
+    grid = quad_texel_grid(mesh, settings)  # each quad's texture, as the lint binds it; one here
+    width, height = (int(side) for side in np.asarray(grid.of(quads), dtype=float).reshape(-1, 2)[0])
+    assumed = bool(grid.assumed[quads].all())
     result = subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--isolated", "--no-cache",
                              "--format", "json", str(path)], capture_output=True, text=True, check=False)
     doc = json.loads(result.stdout)

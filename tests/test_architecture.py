@@ -95,7 +95,9 @@ def project_modules() -> list[Path]:
 def module_graph(paths: list[Path], root: Path = ROOT) -> dict[str, set[str]]:
     """Module -> the modules among ``paths`` (files under ``root``) it imports. ``from package
     import name`` points at the module ``package.name`` where there is one (a submodule), else at
-    ``package`` (its ``__init__``, which defines or imports the name)."""
+    ``package`` (its ``__init__``, which defines or imports the name). Importing a module runs the
+    ``__init__`` of every package above it first: a module also points at those packages (all but
+    the ones it sits in, whose ``__init__`` has run before it)."""
     names = {module_name(path, root): path for path in paths}
     graph = {}
     for name, path in names.items():
@@ -112,8 +114,16 @@ def module_graph(paths: list[Path], root: Path = ROOT) -> dict[str, set[str]]:
                     targets |= submodules
                 else:
                     targets.add(target)
+        targets |= {package for target in targets for package in enclosing_packages(target)
+                    if not (name == package or name.startswith(package + "."))}
         graph[name] = {target for target in targets if target in names and target != name}
     return graph
+
+
+def enclosing_packages(module: str) -> list[str]:
+    """The packages ``module`` sits in, outermost first: ``a.b.c`` -> ``a``, ``a.b``."""
+    parts = module.split(".")
+    return [".".join(parts[:k]) for k in range(1, len(parts))]
 
 
 def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
@@ -205,6 +215,29 @@ def test_the_cycle_check_sees_lazy_and_relative_imports(tmp_path):
     graph = module_graph(sorted(package.glob("*.py")), tmp_path)
     assert cycles(graph) == []
     assert cycles({"a": {"a"}}) == [["a"]]
+
+
+def test_the_cycle_check_follows_package_inits(tmp_path):
+    """Importing ``pkg.output.names`` runs ``pkg/output/__init__.py``: issue 51's ``rules.file -> output.names
+    -> output/__init__ -> rules`` is a cycle, though no module imports ``rules.file``'s importer by name."""
+    files = {
+        "pkg/__init__.py": "",
+        "pkg/rules/__init__.py": "from . import file\n",
+        "pkg/rules/file.py": "def f():\n    from ..output.names import printable\n",
+        "pkg/output/__init__.py": "from ..rules import f\nfrom .names import printable\n",
+        "pkg/output/names.py": "def printable(name):\n    return name\n",
+    }
+    for name, text in files.items():
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / name).write_text(text)
+    paths = sorted(tmp_path.rglob("*.py"))
+    graph = module_graph(paths, tmp_path)
+    assert graph["pkg.rules.file"] == {"pkg.output", "pkg.output.names"}
+    assert graph["pkg.output.names"] == set()  # inside pkg.output: its __init__ ran first
+    assert cycles(graph) == [["pkg.output", "pkg.rules", "pkg.rules.file"]]
+    (tmp_path / "pkg/rules/file.py").write_text("def f():\n    from ..names import printable\n")
+    (tmp_path / "pkg/names.py").write_text("def printable(name):\n    return name\n")
+    assert cycles(module_graph(sorted(tmp_path.rglob("*.py")), tmp_path)) == []
 
 
 def test_render_knows_nothing_of_affinity():

@@ -15,7 +15,7 @@ import pytest
 
 from affinity import RenderOptions, render_mesh
 from affinity.fix import FixSettings, plan_fix, refine_mesh
-from affinity.lint import texture_grid
+from affinity.lint import quad_texel_grid
 from affinity.loaders import load
 from affinity.scenes import trapezoid
 from affinity.settings import Settings
@@ -45,7 +45,7 @@ def uv_difference_at_worst_fixed_face(mesh, max_refine: int) -> tuple[np.ndarray
     source_fixed = np.where(fixed.frame.face >= 0, refined.source[fixed.faces[fixed.frame.face]], -1)
     source_exact = np.where(exact.frame.face >= 0, exact.faces[exact.frame.face], -1)
     compared = (source_exact >= 0) & (source_fixed == source_exact) & ~np.isin(source_exact, plan.left_faces)
-    texels = np.array(texture_grid(mesh, Settings())[0], dtype=float)
+    texels = quad_texel_grid(mesh, Settings()).of(np.maximum(source_exact, 0))  # each face's own texels
     distance = np.linalg.norm((fixed.frame.attrs[..., :2] - exact.frame.attrs[..., :2]) * texels, axis=-1)
     return distance[compared], int(np.count_nonzero(compared & (source_exact == worst)))
 

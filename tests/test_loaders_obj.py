@@ -172,7 +172,6 @@ def test_groups_objects_materials_and_textures():
     assert mesh.material_names == ["wood", "stone"]
     assert mesh.face_material.tolist() == [0, 1]
     assert mesh.material_textures == {"wood": str(DATA / "textures" / "wood.png")}
-    assert mesh.texture_path() == str(DATA / "textures" / "wood.png")
     assert mesh.face_line.tolist() == [19, 22]
     assert mesh.corner_texcoord.tolist() == [0, 1, 2, 3, 0, 1, 4, 3]
 

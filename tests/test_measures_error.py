@@ -104,23 +104,24 @@ def test_never_above_the_corner_extent_on_random_convex_and_folded_quads():
 def test_never_above_the_corner_extent_on_the_shared_meshes(shared_meshes):
     """Every Q101-Q103 value of every quad (linted at threshold -inf) against the largest
     distance between two of its corner values, in the rule's unit."""
-    from affinity.lint import lint_mesh
+    from affinity.lint import lint_mesh, quad_texel_grid
     from affinity.loaders import load
-    from affinity.loaders.imagesize import image_size
     from affinity.settings import Settings
 
     checked = 0
     for path in sorted(shared_meshes.glob("*.obj")):
         mesh = load(str(path))
         faces, corners = mesh.faces_of_size(4)
-        size = image_size(mesh.texture_path()) or (1024, 1024)
-        units = {"Q101": ("texcoords", np.asarray(size, float)), "Q102": ("colors", 255.0), "Q103": ("normals", None)}
+        grid = quad_texel_grid(mesh, Settings())  # each quad in its own texture's texels, as the lint counts them
+        units = {"Q101": ("texcoords", None), "Q102": ("colors", 255.0), "Q103": ("normals", None)}
         for diagonal in ("both", "shortest"):
             settings = Settings(diagonal=diagonal, thresholds={code: -np.inf for code in units})
             for hits in lint_mesh(mesh, settings):
                 if hits.code not in units:
                     continue
                 name, scale = units[hits.code]
+                if hits.code == "Q101":
+                    scale = np.broadcast_to(grid.of(hits.faces), (len(hits.faces), 2))[:, None, :]
                 values = mesh.corner_attribute(name, corners[np.searchsorted(faces, hits.faces)])
                 if hits.code == "Q103":  # degrees: the extent of unit normals turns the mean normal
                     unit = values / np.linalg.norm(values, axis=2, keepdims=True)

@@ -172,7 +172,7 @@ def q104():
     register_role(NORMAL_MAP)
 
     @rule(code="Q104", name="normal-map-disaffine", unit="texels", default_threshold=0.5, attribute="texcoords",
-          scored=True)
+          scored=True, family="UvAffinity")
     def normal_map_disaffine(quads):
         """Texture coordinates misplace the normal map.
 

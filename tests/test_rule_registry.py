@@ -50,7 +50,7 @@ def count_corners(quads) -> Measured:
 def synthetic_rule():
     rule = register(Rule(
         code="Q999", name="synthetic-rule", summary="a rule registered by a test", unit="corners",
-        default_threshold=3.0, check=count_corners,
+        default_threshold=3.0, check=count_corners, family="QuadShape",
         what="Counts corners.", why="To show that the registry is the only place a rule lives.",
         example="v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n", fix="Unregister it.",
     ))

@@ -97,11 +97,12 @@ def validated(errors: list[dict]) -> list[tuple]:
 def test_affinity_usd_plugin_prints_the_folder_of_the_plugins_plug_info():
     folder = Path(run("usd-plugin").stdout.strip())
     [plugin] = json.loads((folder / "plugInfo.json").read_text())["Plugins"]
-    from affinity.usd.families import FAMILIES
+    from affinity.usd.families import families
 
     assert (plugin["Type"], plugin["Name"]) == ("python", "affinity.usd.validators")
     validators = plugin["Info"]["Validators"]
-    assert list(validators) == [family.name for family in FAMILIES]
+    assert list(validators) == [family.name for family in families()]
+    assert [v["doc"] for v in validators.values()] == [family.doc for family in families()]
     assert all(v["keywords"] == ["quad-affinity"] and v["schemaTypes"] == ["UsdGeomMesh"] for v in validators.values())
 
 

@@ -29,10 +29,10 @@ from bpy.props import (
     StringProperty,
 )
 
-from ..rules import RULES, number_text, with_unit
+from ..rules import LEVELS, RULES, number_text, with_unit
 from ..settings import DIAGONALS, MEASURES, Settings
 from . import compat
-from .check import check_object, face_error, finding_units, severity
+from .check import check_object, face_error, severity
 from .convert import ERROR_ATTRIBUTE, ERROR_COLOR, polygon_corners
 from .fix import fix_object
 from .materials import material_images
@@ -78,7 +78,7 @@ def _settings_annotations() -> dict:
         "fix_level": EnumProperty(
             name="Fix level", default="warning",
             items=[(level, level.capitalize(), f"Fix {', '.join(SCORED)} findings at {level} and above")
-                   for level in ("info", "warning", "error")],
+                   for level in reversed(LEVELS)],
         ),
         "max_refine": IntProperty(
             name="Max refine", default=8, min=2, soft_max=32,
@@ -243,7 +243,7 @@ class AFFINITY_OT_check(bpy.types.Operator):
                 row = props.results.add()
                 row.object_name, row.code, row.rule_name = obj.name, hits.code, RULES[hits.code].name
                 row.count, row.worst = len(hits), float(hits.values[order[0]])
-                row.unit = finding_units(hits)[order[0]]
+                row.unit = hits.units()[order[0]]
                 row.selectable = bool(mapping is not None and hits.faces[0] >= 0)
                 if row.selectable:
                     faces = mapping[hits.faces[order]]

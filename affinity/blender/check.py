@@ -57,8 +57,7 @@ def check_object(obj, **options) -> ObjectCheck:
     while the lint runs: each quad's texel unit is its material's image size (a UDIM tile's own), as
     ``affinity check`` reads a file's header, else ``texture_size``; Q101 is read through them (C).
     """
-    from ..findings import settle
-    from ..lint import lint_mesh
+    from ..lint import mesh_report
     from ..rules import RULES, resolve_codes
     from ..settings import Settings
     from ..textures.held import holding
@@ -73,19 +72,17 @@ def check_object(obj, **options) -> ObjectCheck:
                      if RULES[code].scored and RULES[code].attribute == "texcoords")
     settings = Settings(**options)
     with holding(conversion.textures.held):
-        hits = settle(lint_mesh(mesh, settings), settings, list(mesh.group_names))  # levels and units, as check does
-    rows = _finding_dicts(mesh, hits, settings, conversion.original_face if convert.get("evaluated") else None)
+        report = mesh_report(mesh.path, mesh, settings)  # check's own path from a mesh to its findings
+    rows = _finding_dicts(report, settings, conversion.original_face if convert.get("evaluated") else None)
     subdivision = subdivision_modifier(obj)
     if subdivision is not None:
         notes.append(subdivision.note(bool(convert.get("evaluated"))))
-    return ObjectCheck(conversion, settings, hits, rows, notes, subdivision)
+    return ObjectCheck(conversion, settings, report.hits, rows, notes, subdivision)
 
 
-def _finding_dicts(mesh, hits, settings, original_face) -> list[dict]:
-    from ..findings import FileReport
+def _finding_dicts(report, settings, original_face) -> list[dict]:
     from ..output import file_findings, finding_dict
 
-    report = FileReport(path=mesh.path, counts=mesh.counts(), hits=hits, group_names=mesh.group_names)
     rows = []
     for finding in file_findings(report)[0]:
         row = finding_dict(finding)
@@ -96,22 +93,6 @@ def _finding_dicts(mesh, hits, settings, original_face) -> list[dict]:
             row["original_face"] = int(original_face[finding.face]) if finding.face >= 0 else -1
         rows.append(row)
     return rows
-
-
-def finding_units(hits) -> np.ndarray:
-    """(n,) str: the unit of each value of settled ``hits`` (:func:`affinity.findings.settle`), as
-    ``affinity check --format json`` gives it: the texture's (``1/255``, ``degrees``) where Q101's visible
-    reading read C, else the rule's unit under the reading (``texels``, ``barycentric score``).
-
-    Parameters
-    ----------
-    hits : RuleHits with ``unit`` set and ``visible`` None or VisibleColumns of (n,) ``picks`` and ``shifts``
-    """
-    units = np.full(len(hits), hits.unit, dtype=object)
-    if hits.visible is not None:
-        read = (hits.visible.picks >= 0) & np.isfinite(hits.visible.shifts)
-        units[read] = np.asarray(hits.visible.units, dtype=object)[hits.visible.picks[read]]
-    return units
 
 
 def severity(hits) -> np.ndarray:
@@ -126,18 +107,20 @@ def severity(hits) -> np.ndarray:
     a quad the shift flags but whose crease shows nothing (C = 0) reads 0. The worst
     finding of a rule is the most severe.
 
+    Each value is read against its own threshold (:meth:`~affinity.findings.RuleHits.thresholds`: C against
+    visible-warning where Q101 read it through a texture, the shift against the texel threshold elsewhere).
+
     Parameters
     ----------
-    hits : RuleHits with ``values`` (n,) float64, ``threshold`` and ``visible`` None or VisibleColumns
+    hits : settled RuleHits with ``values`` (n,) float64 and ``visible`` None or VisibleColumns
     """
-    v = hits.values
+    v, t = hits.values, hits.thresholds()
     ratio = np.ones(len(v))
-    if hits.threshold > 0:
-        positive = v > 0
-        ratio[positive] = np.maximum(v[positive] / hits.threshold, hits.threshold / v[positive])
+    positive = (v > 0) & (t > 0)
+    ratio[positive] = np.maximum(v[positive] / t[positive], t[positive] / v[positive])
     if hits.visible is not None:
         read = (hits.visible.picks >= 0) & np.isfinite(hits.visible.shifts)
-        ratio[read] = v[read] / hits.visible.limits[1]
+        ratio[read] = v[read] / t[read]
     return ratio
 
 

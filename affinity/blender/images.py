@@ -128,5 +128,5 @@ def held_textures(images) -> tuple[dict[str, DecodedTexture], list[str]]:
             else:
                 textures[image_key(image)] = decoded_image(image, image_key(image))
         except ValueError as err:
-            notes.append(f"{err}: Q101 stays in texels there")
+            notes.append(f"{err}: its findings stay in texels")
     return textures, notes

@@ -42,6 +42,9 @@ def _selection(text: str) -> list[str]:
 
 def _threshold(text: str) -> tuple[str, float]:
     """``0.8`` (the uv rule Q101) or ``CODE=VALUE``; VALUE a finite number."""
+    from ..rules.affinity import UV_DISAFFINE
+    from ..rules.wording import threshold_example
+
     code, _, value = text.rpartition("=")
     try:
         number = float(value)
@@ -49,8 +52,8 @@ def _threshold(text: str) -> tuple[str, float]:
         number = math.nan
     if not math.isfinite(number):
         raise argparse.ArgumentTypeError(f"not a finite threshold: {text!r} "
-                                         "(use 0.8 or Q102=3; --ignore switches a rule off)")
-    return (code.strip().upper() or "Q101"), number
+                                         f"(use {threshold_example()}; --ignore switches a rule off)")
+    return (code.strip().upper() or UV_DISAFFINE), number
 
 
 def _count(text: str) -> int:
@@ -107,6 +110,7 @@ def add_parser(sub) -> None:
     from ..loaders.formats import described
     from ..output import FORMATS
     from ..pipeline.progress import MODES as PROGRESS_MODES
+    from ..rules.wording import bare_threshold_help, measure_help, select_example
     from ..settings import DIAGONALS, MEASURES
 
     p = sub.add_parser(
@@ -120,15 +124,13 @@ def add_parser(sub) -> None:
     p.add_argument("--demo", action="store_true", help="also check the bundled demo meshes")
     p.add_argument("--format", choices=FORMATS, default="text",
                    help="text (default), json, sarif (code scanning), github (workflow annotations), junit")
-    p.add_argument("--select", type=_selection, help="rule codes or prefixes to enable, e.g. Q1,Q201")
+    p.add_argument("--select", type=_selection, help=f"rule codes or prefixes to enable, e.g. {select_example()}")
     p.add_argument("--ignore", type=_codes, help="rule codes or prefixes to disable")
     p.add_argument(
         "--threshold", type=_threshold, action="append", default=[], metavar="[CODE=]VALUE",
-        help="flag above VALUE: a bare number sets Q101 (uv); repeat CODE=VALUE for other rules",
+        help=bare_threshold_help(),
     )
-    p.add_argument("--measure", type=_measure, metavar="{" + ",".join(MEASURES) + "}",
-                   help="Q101-Q103 reading: the split's largest error (default), its shift at the centre, "
-                        "or (Q101) the paper's barycentric score")
+    p.add_argument("--measure", type=_measure, metavar="{" + ",".join(MEASURES) + "}", help=measure_help())
     p.add_argument("--diagonal", choices=DIAGONALS,
                    help="which split diagonal the affinity test measures (default: both)")
     p.add_argument("--texture-size", type=int, metavar="PX",
@@ -227,11 +229,12 @@ def report_problems(reports, quiet: bool, skips_fail: bool = False) -> None:
     """Unreadable files (always), skipped files (unless quiet; always when they fail the run) and the
     loader's notes (unless quiet), one line each on stderr."""
     from ..output.names import printable
+    from ..rules.wording import unreadable_line
 
     for report in reports:
         path = printable(report.path)
         if report.error is not None:
-            sys.stderr.write(f"{path}:{report.error_line}: Q901 unreadable: {report.error}\n")
+            sys.stderr.write(unreadable_line(path, report.error, report.error_line) + "\n")
         elif report.skipped is not None and (skips_fail or not quiet):
             sys.stderr.write(f"{path}: skipped ({report.skipped})\n")
         for note in [] if quiet else report.notes:

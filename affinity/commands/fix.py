@@ -40,12 +40,14 @@ def _count(text: str) -> int:
 def add_parser(sub) -> None:
     from ..fix.plan import MAX_BYTES_ADDED, MAX_FACES_ADDED
     from ..loaders.formats import described
+    from ..rules import LEVELS
+    from ..rules.wording import fix_left_code, scored, scored_span
     from ..settings import DIAGONALS, MEASURES
     from .check import _codes, _measure, _selection, _threshold
 
     p = sub.add_parser(
         "fix", help="refine the quads the affinity rules flag, crack-free, touching nothing else",
-        description=f"Refine the quads of {described()} files that Q101-Q103 flag until the crease is gone: "
+        description=f"Refine the quads of {described()} files that {scored_span()} flag until the crease is gone: "
                     "each becomes n x n quads on its own bilinear surface (n odd), and the faces beside it are "
                     "cut into quads to meet the new edge points (no T-junction, no triangle); a face it leaves "
                     "keeps its line. The result is re-checked before it is written. Writes NAME.fixed.EXT "
@@ -59,8 +61,8 @@ def add_parser(sub) -> None:
     p.add_argument("--dry-run", action="store_true",
                    help="write nothing; list the faces that would be refined (with n), left (with why) and added")
     p.add_argument("--format", choices=("text", "json"), default="text", help="output of --dry-run and the summary")
-    p.add_argument("--fix-level", choices=("info", "warning", "error"), default="warning",
-                   help="the lowest level of a Q101-Q103 finding that is fixed (default: warning)")
+    p.add_argument("--fix-level", choices=tuple(reversed(LEVELS)), default="warning",
+                   help=f"the lowest level of a {scored_span()} finding that is fixed (default: warning)")
     p.add_argument("--max-refine", type=_level, default=9, metavar="N",
                    help="refine a quad into at most N x N quads, N rounded up to odd (default 9); one that needs "
                         "more is left and reported as needing a re-UV")
@@ -73,9 +75,11 @@ def add_parser(sub) -> None:
     p.add_argument("--allow-new-findings", action="store_true",
                    help="write a result even where it adds a finding of another rule at warning or above")
     p.add_argument("--refine-nonplanar", action="store_true",
-                   help="refine the quads Q202 flags too: their pieces follow the quad's bilinear surface, "
+                   help=f"refine the quads {fix_left_code('nonplanar')} flags too: their pieces follow the quad's "
+                        "bilinear surface, "
                         "not the folded split the input draws (default: left)")
-    p.add_argument("--select", type=_selection, help="rule codes or prefixes whose findings are fixed, e.g. Q101")
+    p.add_argument("--select", type=_selection,
+                   help=f"rule codes or prefixes whose findings are fixed, e.g. {scored()[0]}")
     p.add_argument("--ignore", type=_codes, help="rule codes or prefixes not fixed")
     p.add_argument("--threshold", type=_threshold, action="append", default=[], metavar="[CODE=]VALUE",
                    help="as in check: the value each refined quad's pieces must get under")
@@ -147,10 +151,12 @@ def run(args) -> int:
 
 def _fix_one(path: str, resolver, args) -> dict:
     """Fix (or, with --dry-run, plan) one file; its entry of the JSON document. Never raises for bad input."""
-    from ..errors import MeshError, SkippedFile
+    from ..errors import MeshError, SkippedFile, internal_error
     from ..fix import FixSettings, plan_fix
     from ..fix.plan import profile_subdivides
     from ..loaders import load
+    from ..output.names import printable
+    from ..rules.wording import unreadable_line
 
     if _format(path) == "fbx":
         from ..loaders.fbx import NO_FIX
@@ -162,10 +168,10 @@ def _fix_one(path: str, resolver, args) -> dict:
         mesh = load(path)
         inline = _inline_ignores(path, mesh)
     except SkippedFile as skip:
-        sys.stderr.write(f"{path}: skipped ({skip.reason})\n")
+        sys.stderr.write(f"{printable(path)}: skipped ({skip.reason})\n")
         return {"path": path, "skipped": skip.reason}
     except MeshError as err:
-        sys.stderr.write(f"{path}:{err.line}: Q901 unreadable: {err.reason}\n")
+        sys.stderr.write(unreadable_line(printable(path), err.reason, err.line) + "\n")
         return {"path": path, "error": err.reason, "line": err.line}
     try:
         plan = plan_fix(mesh, FixSettings(lint=settings, level=args.fix_level, max_refine=args.max_refine,
@@ -183,11 +189,11 @@ def _fix_one(path: str, resolver, args) -> dict:
             entry["output"] = out
     except OSError as err:
         reason = f"cannot write {_output_path(path, args)}: {err.strerror or err}"
-        sys.stderr.write(f"{path}: {reason}\n")
+        sys.stderr.write(f"{printable(path)}: {reason}\n")
         return {"path": path, "error": reason}
     except Exception as err:  # one file's failure never stops the others, nor shows a traceback
-        reason = " ".join(f"internal error: {type(err).__name__}: {err}".split())[:300]
-        sys.stderr.write(f"{path}: {reason}\n")
+        reason = internal_error(err)
+        sys.stderr.write(f"{printable(path)}: {reason}\n")
         return {"path": path, "error": reason}
     if args.format == "text":
         write_text(entry, args.dry_run, sys.stdout, args.quiet)

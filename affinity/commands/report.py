@@ -123,6 +123,7 @@ def run(args) -> int:
     from ..output.names import printable
     from ..report.build import ReportOptions, collect_run
     from ..report.page import render_page
+    from ..rules.wording import unreadable_line
 
     start = time.perf_counter()
     require(("PIL", "jinja2", "matplotlib", "mpmath"), "report")
@@ -155,7 +156,7 @@ def run(args) -> int:
 
     failed = [result.file for result in report.meshes if result.file.error is not None]
     for file in failed:
-        sys.stderr.write(f"{printable(file.path)}:{file.error_line}: Q901 unreadable: {file.error}\n")
+        sys.stderr.write(unreadable_line(printable(file.path), file.error, file.error_line) + "\n")
     for file in skipped:
         sys.stderr.write(f"{printable(file.path)}: skipped ({file.skipped})\n")
     if not args.quiet:

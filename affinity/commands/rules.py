@@ -13,6 +13,8 @@ from . import EXIT_CLEAN
 
 
 def add_parser(sub) -> None:
+    from ..rules import RULES
+
     listing = sub.add_parser("rules", help="list every rule", description="List every rule code, name and summary.")
     listing.add_argument("--markdown", action="store_true", help="print the README's Markdown rule table")
     listing.set_defaults(run=run_rules)
@@ -20,7 +22,8 @@ def add_parser(sub) -> None:
         "rule", help="explain one rule",
         description="Print what a rule detects, why it matters, an example and how to fix it.",
     )
-    page.add_argument("code", metavar="CODE", help="rule code or name, e.g. Q101 or uv-disaffine")
+    first = next(iter(RULES.values()))
+    page.add_argument("code", metavar="CODE", help=f"rule code or name, e.g. {first.code} or {first.name}")
     page.set_defaults(run=run_rule)
 
 

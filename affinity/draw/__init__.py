@@ -25,9 +25,9 @@ from .png import png_bytes, to_pixels
 from .quads import render_corners
 from .routing import MVC, SPLIT
 from .shading import FLAG_COLOUR, OVERLAY_TINT, flat_normals
-from .texture import TextureError, checker
+from .texture import TextureError, checker, painted_texture
 
 __all__ = ["CLOSEUP_SIZE", "FLAG_COLOUR", "MVC", "OVERLAY_TINT", "SPLIT", "UP_AXES", "Closeup", "CloseupView",
            "RenderOptions", "RenderResult", "TextureError", "checker", "closeup", "face_centroids", "face_ids",
-           "face_vertices", "flat_normals", "over_render_budget", "overview_camera", "png_bytes", "render_corners",
-           "render_mesh", "to_pixels", "up_axis_of", "used_points"]
+           "face_vertices", "flat_normals", "over_render_budget", "overview_camera", "painted_texture", "png_bytes",
+           "render_corners", "render_mesh", "to_pixels", "up_axis_of", "used_points"]

@@ -528,10 +528,10 @@ def _paint(mesh: Mesh, code: str, texture: str | None) -> _Paint:
     """How a close-up of rule ``code``'s place on ``mesh`` is painted; ``texture`` is ``--texture``, overriding
     map_Kd."""
     from ..textures.decode import why_not_decoded
-    from .texture import GLYPH_SPACING, LINE_SPACING
+    from .texture import GLYPH_SPACING, LINE_SPACING, painted_texture
 
     show = shown_for(mesh, code)
-    path = mesh.texture_path()
+    path = painted_texture(mesh)
     refused = why_not_decoded(path) if path else None
     image_file = texture or (path if path and refused is None else None)  # map_Kd when the core decodes it
     lines = show == "uv" and not image_file

@@ -153,9 +153,10 @@ def uv_routing_inputs(mesh: Mesh, faces: np.ndarray, uv: np.ndarray, settings: S
     the split's texture displacement of every render quad, and the lint's uv error
     (along 0-2, uv units) per render quad when some uv quad is degenerate (Q301 at
     the threshold of ``settings``), else None."""
+    from ..rules.texture import UV_DEGENERATE
     from .routing import uv_displacement
 
-    moves = uv_displacement(uv, settings.threshold("Q301"))
+    moves = uv_displacement(uv, settings.threshold(UV_DEGENERATE))
     uv_error = None
     if moves.degenerate.any():
         from ..lint import quad_uv_error
@@ -198,13 +199,13 @@ def choose_methods(mesh: Mesh, faces: np.ndarray, uv: np.ndarray | None, clip: n
 def resolve_texture(mesh: Mesh, options: RenderOptions, warn: Callable[[str], None]) -> np.ndarray:
     """The explicit texture (an image, or a path whose errors are fatal), else map_Kd (a missing
     one warns), else the checker."""
-    from .texture import TextureError, checker, load_image
+    from .texture import TextureError, checker, load_image, painted_texture
 
     if isinstance(options.texture, np.ndarray):
         return options.texture
     if options.texture:
         return load_image(options.texture)
-    path = mesh.texture_path()
+    path = painted_texture(mesh)
     if path:
         try:
             return load_image(path)

@@ -39,6 +39,7 @@ import numpy as np
 from ..geometry import planar_quads, relative_signed_area
 from ..measures import split_error_point
 from ..rules import RULES
+from ..rules.texture import UV_DEGENERATE
 
 SPLIT, MVC = "split", "mvc"
 
@@ -69,7 +70,7 @@ class UvDisplacement:
     degenerate: np.ndarray
 
 
-def uv_displacement(uv: np.ndarray, degenerate_at: float = RULES["Q301"].default_threshold) -> UvDisplacement:
+def uv_displacement(uv: np.ndarray, degenerate_at: float = RULES[UV_DEGENERATE].default_threshold) -> UvDisplacement:
     """Corner weights of the split's largest texture displacement along diagonal 0-2.
 
     Parameters

@@ -21,6 +21,16 @@ CHECKS = 32
 
 
 @functools.lru_cache(maxsize=4)
+def painted_texture(mesh) -> str | None:
+    """The image file a render paints the whole mesh with, the renderer taking one texture: the ``map_Kd``
+    of the first material that has one, or None. Only renders paint one image; everything that measures
+    reads each face's own maps (:mod:`affinity.textures.binding`)."""
+    for name in mesh.material_names:
+        if name in mesh.material_textures:
+            return mesh.material_textures[name]
+    return next(iter(mesh.material_textures.values()), None)
+
+
 def checker(size: int = 1024, checks: int = CHECKS) -> np.ndarray:
     """A checker with thin grid lines, so a bent diagonal stands out.
 

@@ -16,7 +16,7 @@ from ..mesh import Mesh
 from .apply import build
 from .budget import estimated_bytes, within_budget
 from .layout import MAX_LEVEL, layout
-from .plan import LEFT_BY_RULE, LEVEL_ORDER, Candidates, FixPlan, FixSettings, candidates, readings
+from .plan import LEVEL_ORDER, Candidates, FixPlan, FixSettings, candidates, left_by_rule, readings
 from .verify import flagged_by_rule, verify
 
 
@@ -50,7 +50,7 @@ def plan_fix(mesh: Mesh, fix: FixSettings | None = None) -> FixPlan:
         earlier = reasons.copy()
         refined_now = reasons == ""
         for d in new:  # a refined quad whose pieces add a finding is left for that rule's reason
-            reasons[refined_now & (found.faces == d["face"])] = LEFT_BY_RULE.get(d["code"], "still-flagged")
+            reasons[refined_now & (found.faces == d["face"])] = left_by_rule().get(d["code"], "still-flagged")
         reasons[np.isin(found.faces, flagged) & refined_now] = "still-flagged"
         cut = np.intersect1d(np.union1d(flagged, adding), plan.transition_faces)
         if (reasons == earlier).all() and np.isin(cut, quiet).all():  # nothing left to change

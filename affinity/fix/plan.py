@@ -24,17 +24,28 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..mesh import Mesh
+from ..rules import LEVELS
 from ..settings import Settings
 
-#: The scored rules a refinement removes.
-SCORED = ("Q101", "Q102", "Q103")
-#: Why a candidate is left, by the rule that says so, checked in this order.
-LEFT_BY_RULE = {"Q201": "degenerate", "Q204": "bowtie", "Q202": "nonplanar", "Q301": "uv-degenerate"}
-#: Quads beside a refinement that are never cut (a cut of their bilinear patch would fold): they stay as
-#: they are and the refined quad closes to them.
-UNCUT_BY_RULE = ("Q201", "Q203", "Q204")
-REASONS = ("over-cap", *LEFT_BY_RULE.values(), "subdivided", "still-flagged", "over-budget")
-LEVEL_ORDER = ("info", "warning", "error")
+
+def left_by_rule() -> dict[str, str]:
+    """Why a candidate is left, by the rule that says so (:attr:`affinity.rules.Rule.fix_leaves`), checked in
+    this order."""
+    from ..rules import fix_left_rules
+
+    return {rule.code: rule.fix_leaves for rule in fix_left_rules()}
+
+
+def uncut_by_rule() -> tuple[str, ...]:
+    """The rules whose quads beside a refinement are never cut (:attr:`affinity.rules.Rule.fix_uncut`): a cut of
+    their bilinear patch would fold, so they stay as they are and the refined quad closes to them."""
+    from ..rules import fix_uncut_rules
+
+    return tuple(rule.code for rule in fix_uncut_rules())
+
+
+REASONS = ("over-cap", *left_by_rule().values(), "subdivided", "still-flagged", "over-budget")
+LEVEL_ORDER = tuple(reversed(LEVELS))  # the mildest first
 #: Quads refined together when their pieces are measured: (n + 1)^2 points each.
 SCORE_BATCH = 8192
 #: The default output budget: faces added, and bytes added to the written file (an estimate).
@@ -161,19 +172,20 @@ def flagged_quads(mesh: Mesh, fix: FixSettings) -> tuple[dict, dict]:
     -------
     scored : code -> (faces (n,) int64, values (n,) float64) of Q101-Q103 findings at the level, values
         in the rule's measure (:func:`rule_values`)
-    leaving : code -> faces (n,) int64 of the findings of :data:`LEFT_BY_RULE` and :data:`UNCUT_BY_RULE`
+    leaving : code -> faces (n,) int64 of the findings of :func:`left_by_rule` and :func:`uncut_by_rule`
     """
     from ..findings import settle
-    from ..lint import lint_mesh
+    from ..lint import lint_mesh, scored_codes
     from ..rules import resolve_codes
 
-    enabled = [code for code in resolve_codes(fix.lint.select, fix.lint.ignore) if code in SCORED]
-    settings = replace(fix.lint, select=[*enabled, *LEFT_BY_RULE, *UNCUT_BY_RULE], ignore=[])
+    removed = scored_codes()  # the scored rules a refinement removes
+    enabled = [code for code in resolve_codes(fix.lint.select, fix.lint.ignore) if code in removed]
+    settings = replace(fix.lint, select=[*enabled, *left_by_rule(), *uncut_by_rule()], ignore=[])
     hits = settle(lint_mesh(mesh, settings), settings, list(mesh.group_names), fix.inline)
     lowest = LEVEL_ORDER.index(fix.level)
     scored, leaving = {}, {}
     for h in hits:
-        if h.code in SCORED:
+        if h.code in removed:
             at_level = np.isin(h.levels(), LEVEL_ORDER[lowest:])
             scored[h.code] = h.faces[at_level], rule_values(h)[at_level]
         else:
@@ -277,7 +289,7 @@ class Candidates:
     ----------
     faces : (K,) int64 ascending; reasons : (K,) object "" for a quad to refine, else why it is left
     need : (K,) int64 the level each needs; badness : (K,) float64 its worst value over its threshold
-    uncut : (u,) int64 quads not flagged that a cut would fold (:data:`UNCUT_BY_RULE`)
+    uncut : (u,) int64 quads not flagged that a cut would fold (:func:`uncut_by_rule`)
     scored : the findings (:func:`flagged_quads`)
     """
 
@@ -296,7 +308,7 @@ def candidates(mesh: Mesh, fix: FixSettings) -> Candidates:
     if fix.faces is not None:
         found = np.intersect1d(found, np.asarray(fix.faces, dtype=np.int64))
     reasons = np.full(len(found), "", dtype=object)
-    for code, reason in reversed(LEFT_BY_RULE.items()):  # the first rule in the table wins
+    for code, reason in reversed(left_by_rule().items()):  # the first rule in the table wins
         if not (reason == "nonplanar" and fix.refine_nonplanar):
             reasons[np.isin(found, leaving.get(code, []))] = reason
     reasons[(reasons == "degenerate") & pole_quads(mesh, found)] = ""
@@ -320,7 +332,7 @@ def candidates(mesh: Mesh, fix: FixSettings) -> Candidates:
         keep[keep] &= reasons[rows[keep]] == ""
         need[rows[keep]] = np.maximum(need[rows[keep]], needed_levels(mesh, faces[keep], values[keep], code, fix))
     reasons[(reasons == "") & (need > fix.cap)] = "over-cap"
-    uncut = np.unique(np.concatenate([leaving.get(code, np.zeros(0, np.int64)) for code in UNCUT_BY_RULE]))
+    uncut = np.unique(np.concatenate([leaving.get(code, np.zeros(0, np.int64)) for code in uncut_by_rule()]))
     uncut = uncut[mesh.face_sizes[uncut] == 4]
     uncut = uncut[~pole_quads(mesh, uncut)]
     return Candidates(found, reasons, need, badness, np.setdiff1d(uncut, found), scored)

@@ -40,7 +40,8 @@ def verify(mesh: Mesh, plan, fix, baseline: dict) -> tuple[np.ndarray, list[dict
     new : ``{"code": CODE, "face": F}`` per input face F whose new faces have a finding of rule CODE (at
         warning or above) that F had not
     """
-    from .plan import LEVEL_ORDER, SCORED
+    from ..lint import scored_codes
+    from .plan import LEVEL_ORDER
 
     refined = plan.refined
     source = refined.source
@@ -50,7 +51,7 @@ def verify(mesh: Mesh, plan, fix, baseline: dict) -> tuple[np.ndarray, list[dict
     for h in checked(refined.mesh, fix, inline):
         on_face = h.faces >= 0
         faces, levels = h.faces[on_face], h.levels()[on_face]
-        if h.code in SCORED:
+        if h.code in scored_codes():
             flagged.append(source[faces[np.isin(levels, lowest)]])
             continue
         added = faces[refined.added[faces] & np.isin(levels, ("warning", "error"))]

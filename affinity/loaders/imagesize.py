@@ -15,7 +15,8 @@ import struct
 from collections import OrderedDict
 from dataclasses import dataclass
 
-from .regular import RefusedFile, open_regular
+from .regular import RefusedFile
+from .sidefiles import open_side_file
 
 _PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 # JPEG start-of-frame markers: C0-CF except DHT (C4), JPG (C8) and DAC (CC).
@@ -73,9 +74,10 @@ def embed(path: str, content: bytes) -> None:
 def open_image_file(path: str | os.PathLike):
     """Open a texture file for reading bytes: the one place texture files are opened (header
     reading and decoding alike), so a policy on what may be opened (regular files only, a size
-    budget) applies to both; an embedded image (:func:`embed`) opens from memory. Raises OSError."""
+    budget) applies to both, and a file is opened once for every header read and its decode
+    (:mod:`.sidefiles`); an embedded image (:func:`embed`) opens from memory. Raises OSError."""
     content = EMBEDDED.get(os.fspath(path))
-    return io.BytesIO(content) if content is not None else open_regular(path)
+    return io.BytesIO(content) if content is not None else open_side_file(path)
 
 
 def image_identity(path: str | os.PathLike) -> tuple:

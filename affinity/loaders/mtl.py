@@ -8,8 +8,9 @@ from __future__ import annotations
 
 import os
 
-from .regular import SIDE_FILE_BUDGET, read_regular
+from .regular import SIDE_FILE_BUDGET
 from .resources import ROLES, roles_named_in
+from .sidefiles import read_side_file
 from .texturemaps import TextureMap
 
 #: ``map_Kd`` options with a fixed number of arguments.
@@ -39,7 +40,7 @@ def map_statements(path) -> list[tuple[str, str, TextureMap]]:
     ``-s`` scale and ``-o`` offset of u and v (w is not used by a 2-D texture). A missing or unreadable
     file gives an empty list."""
     try:
-        text = read_regular(path, SIDE_FILE_BUDGET).decode("utf-8", "replace")
+        text = read_side_file(path, SIDE_FILE_BUDGET).decode("utf-8", "replace")
     except OSError:
         return []
     statements = {role.statement: role.name for role in roles_named_in("mtl")}

@@ -86,7 +86,7 @@ def unregister_role(name: str) -> None:
 register_role(ResourceRole(name="mtllib", statement="mtllib", named_in="obj",
                            summary="a Wavefront material library"))
 register_role(ResourceRole(name="map_Kd", statement="map_Kd", named_in="mtl", image=True, texture="base colour",
-                           summary="the diffuse colour texture of a material (Q101's texel unit)"))
+                           summary="the diffuse colour texture of a material (the texel unit of the uv rule)"))
 register_role(ResourceRole(name="norm", statement="norm", named_in="mtl", image=True, texture="normal",
                            summary="a tangent-space normal map"))
 for _statement in ("bump", "map_Bump", "map_bump"):

@@ -323,9 +323,9 @@ def _visible_fields(hits: RuleHits, take: np.ndarray, path: str) -> list[dict]:
     relative = [texture.removeprefix(HELD) if texture.startswith(HELD) else  # a Blender image: its name
                 os.path.relpath(os.path.abspath(texture), folder) for texture in columns.textures]  # once each
     rows = []
-    for shift, bound, pick in zip(columns.shifts[take].tolist(), columns.bounds[take].tolist(),
-                                  columns.picks[take].tolist()):
-        if pick < 0 or shift != shift:  # no texture read (NaN shift)
+    for read, shift, bound, pick in zip(columns.read()[take].tolist(), columns.shifts[take].tolist(),
+                                        columns.bounds[take].tolist(), columns.picks[take].tolist()):
+        if not read:
             rows.append({})
             continue
         texture = relative[pick]
@@ -342,19 +342,16 @@ def visible_remark(role: str, texture: str, shift: float) -> str:
 
 
 def badness(hits: RuleHits) -> np.ndarray:
-    """(n,) float64 order within a level, lowest the worst: minus how far each value is beyond the threshold, as
-    a ratio; -inf for findings without a measured ratio (Q201, Q204, Q205, ...: first within their level)."""
-    rule = RULES[hits.code]
-    if rule.flags != "above" or rule.default_threshold is None or not hits.threshold > 0:
-        return np.full(len(hits), -np.inf)
-    return -hits.values / hits.threshold
+    """(n,) float64 order within a level, lowest the worst: minus how far each value is beyond its own threshold,
+    as a ratio (C against visible-warning where Q101 read it, the shift against the threshold elsewhere: one
+    unit); -inf for findings without a measured ratio (Q201, Q204, Q205, ...: first within their level)."""
+    return -hits.ratios() if hits.ranked_by_ratio else np.full(len(hits), -np.inf)
 
 
 def worst_first(hits: RuleHits) -> np.ndarray:
     """(n,) int64 order of ``hits`` from the worst (errors first, then the worst values: the rule's ``worst``
-    end) to the mildest, ties in file order."""
-    key = hits.values if RULES[hits.code].worst == "lowest" else -hits.values
-    return np.lexsort((hits.faces, key, hits.level_ranks()))
+    end, as ratios to their own thresholds where the rule flags above one) to the mildest, ties in file order."""
+    return np.lexsort((hits.faces, hits.worst_key(), hits.level_ranks()))
 
 
 @dataclass(eq=False)

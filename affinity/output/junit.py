@@ -26,6 +26,7 @@ import numpy as np
 
 from ..findings import FileReport
 from ..rules import LEVELS, RULES, UNREADABLE
+from ..rules.wording import unreadable_line
 from . import CheckRun, Columns, Selection, face_line_pieces, rows, statistics, text_lines
 
 # Characters XML 1.0 cannot carry at all (control characters, lone surrogates from undecodable file names).
@@ -86,7 +87,7 @@ def _suite(run: CheckRun, selection: Selection, counts: dict[str, int], out: Tex
     out.write(f"  <testsuite{_attributes(name=report.path, **counts)}>\n")
     path = xml_attribute(report.path)
     if report.error is not None:
-        text = f"{report.path}:{report.error_line}: {UNREADABLE.code} {UNREADABLE.name}: {report.error}"
+        text = unreadable_line(report.path, report.error, report.error_line)
         out.write(f'    <testcase classname="{path}" name="{UNREADABLE.code} {UNREADABLE.name}">'
                   f'<error{_attributes(type=UNREADABLE.code, message=report.error)}>{xml_text(text)}</error>'
                   "</testcase>\n")

@@ -13,7 +13,7 @@ from collections.abc import Callable, Iterable, Iterator
 from contextlib import AbstractContextManager, nullcontext
 from functools import partial
 
-from ..errors import MeshError, SkippedFile
+from ..errors import MeshError, SkippedFile, internal_error
 from ..findings import FileReport
 from ..mesh import Mesh
 from ..settings import Settings
@@ -35,6 +35,7 @@ def load_and_check(path: str, settings: Settings, usd=None, source: bytes | None
     the report holds every quad's scores from the same lint (:attr:`FileReport.scores`)."""
     from ..lint import mesh_report
     from ..loaders import load, reads_whole
+    from ..loaders.sidefiles import forget
 
     try:
         if reads_whole(path):
@@ -50,8 +51,9 @@ def load_and_check(path: str, settings: Settings, usd=None, source: bytes | None
     except MeshError as err:
         return FileReport(path, error=err.reason, error_line=err.line), None
     except Exception as err:
-        reason = " ".join(f"internal error: {type(err).__name__}: {err}".split())
-        return FileReport(path, error=reason[:300], error_line=0, transient=True), None
+        return FileReport(path, error=internal_error(err), error_line=0, transient=True), None
+    finally:
+        forget()  # the side files' bytes served this file's readers; the next file reads its own
     return report, mesh
 
 

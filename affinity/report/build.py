@@ -191,9 +191,10 @@ def _texture_label(mesh: Mesh, view: View, texture: str | None = None) -> str:
         return f"texture {os.path.basename(texture)} (--texture)"
     if view.checks:
         return f"checker texture, {view.checks} squares across"
+    from ..draw import painted_texture
     from ..textures.decode import why_not_decoded
 
-    path = mesh.texture_path()
+    path = painted_texture(mesh)
     if path is None:
         return "checker texture (the mesh names no map_Kd)"
     name, refused = os.path.basename(path), why_not_decoded(path)

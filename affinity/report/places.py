@@ -151,21 +151,22 @@ def places_of(mesh: Mesh, hits: RuleHits, limit: int = PLACE_FACES) -> list[Plac
 
     rule = RULES[hits.code]
     keep = hits.faces >= 0
-    faces, values, levels = hits.faces[keep], hits.values[keep], hits.levels()[keep]
+    # Worst by each value against its own threshold (worst_key): C and the shift are not one unit.
+    faces, values, levels, key = hits.faces[keep], hits.values[keep], hits.levels()[keep], hits.worst_key()[keep]
     order = np.argsort(faces)
-    faces, values, levels = faces[order], values[order], levels[order]
+    faces, values, levels, key = faces[order], values[order], levels[order], key[order]
     centroids = face_centroids(mesh)
     places = []
     groups = group_faces(mesh, faces)
     parts = [(number, members[part]) for number, members in enumerate(groups)  # one pass per place, not per face
-             for part in carve(values[members], centroids[faces[members]], rule.worst == "lowest", limit)]
+             for part in carve(key[members], centroids[faces[members]], True, limit)]
     for number, members in parts:
         group, vals = faces[members], values[members]
-        k = int(np.argmin(vals) if rule.worst == "lowest" else np.argmax(vals))
+        k = int(np.argmin(key[members]))
         value = float(vals[k])
         with np.errstate(divide="ignore", invalid="ignore"):
             beyond = (hits.threshold / value if value > 0 else np.inf) if rule.worst == "lowest" else (
-                value / hits.threshold if hits.threshold > 0 else np.inf)
+                -key[members][k] if hits.ranked_by_ratio else np.inf)
         places.append(Place(hits.code, group, vals, int(group[k]), value, float(beyond), str(levels[members][k]),
                             number))
     places.sort(key=lambda p: (-p.beyond, p.worst))

@@ -98,7 +98,9 @@ def _texture(result: MeshResult) -> dict | None:
 
     Decoded by the core (:func:`affinity.textures.decode.decode`: regular files only, never over the pixel
     budget, once per run); a texture it refuses leaves the view to the uv line pattern."""
-    path = result.options.texture or result.mesh.texture_path()
+    from ..draw import painted_texture
+
+    path = result.options.texture or painted_texture(result.mesh)
     if not path or result.mesh.texcoords is None:
         return None
     from PIL import Image
@@ -133,14 +135,13 @@ def _findings(result: MeshResult) -> tuple[list[dict], np.ndarray]:
         valid = hits.faces >= 0
         level_rank = np.select([levels == level for level in LEVELS], np.arange(1, len(LEVELS) + 1)).astype(np.uint8)
         np.minimum.at(rank, hits.faces[valid], level_rank[valid])
-        severity = hits.values if rule.worst == "lowest" else -hits.values
-        unit = hits.unit or rule.unit_for(result.settings.measure)
-        for i in np.argsort(severity, kind="stable")[:TABLE_ROWS_PER_RULE]:
+        units = hits.units()  # per finding: C's where Q101 read it through a texture
+        for i in np.argsort(hits.worst_key(), kind="stable")[:TABLE_ROWS_PER_RULE]:
             if hits.faces[i] < 0:
                 continue
             rows.append({"code": hits.code, "name": rule.name, "level": str(levels[i]), "face": int(hits.faces[i]),
                          "line": int(hits.lines[i]), "group": file.group_names[hits.groups[i]],
-                         "value": float(hits.values[i]), "unit": unit,
+                         "value": float(hits.values[i]), "unit": str(units[i]),
                          "attribute": ATTRIBUTE_NAMES.get(rule.attribute)})
     return rows, np.where(rank == unflagged, 0, rank).astype(np.uint8)
 

@@ -16,7 +16,7 @@ import numpy as np
 
 from ..attributes import ATTRIBUTE_NAMES, ATTRIBUTES
 from ..findings import FileReport
-from ..rules import LEVELS, RULES, number_text, resolve_codes, with_unit
+from ..rules import LEVELS, RULES, UNREADABLE, number_text, resolve_codes, with_unit
 from ..study.run import PACKAGE_TABLE
 from .build import MeshResult, ReportRun
 from .images import data_uri, heat_bar, heatmap_uri, image_uri, png_bytes
@@ -100,7 +100,7 @@ def file_row(result: MeshResult, fail_on: str) -> dict:
     file = result.file
     judged = verdict([file], fail_on)
     if file.error is not None:
-        status, message = "unreadable", f"Q901 unreadable: line {file.error_line}: {file.error}"
+        status, message = "unreadable", f"{UNREADABLE.code} {UNREADABLE.name}: line {file.error_line}: {file.error}"
     elif file.skipped is not None:
         status, message = "skipped", f"skipped ({file.skipped})"
     else:
@@ -292,17 +292,18 @@ def _errors_against_exact(result: MeshResult) -> dict | None:
     if result.shown is None:
         return None
     from ..attributes import pixel_error
-    from ..loaders.imagesize import image_size
+    from ..lint import quad_texel_grid
 
     exact = result.renders["exact"].frame
-    texture_size = image_size(result.mesh.texture_path()) or (result.settings.texture_size,) * 2
+    grid = quad_texel_grid(result.mesh, result.settings)  # each face in its own texture's texels, as the lint
     errors = {}
     for method in ("split", "hybrid", "mvc", "exact"):
-        frame = result.renders[method].frame
+        render = result.renders[method]
+        frame = render.frame
         covered = (frame.face >= 0) & (frame.face == exact.face)
         error = np.zeros(covered.shape)
         error[covered] = pixel_error(frame.attrs[covered], exact.attrs[covered], RULES[result.shown].attribute,
-                                      texture_size)
+                                      grid.of(render.faces[frame.face[covered]]))
         errors[method] = error, covered
     return errors
 

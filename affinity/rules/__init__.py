@@ -17,12 +17,19 @@ from . import affinity, file, shape, texture  # noqa: F401  each registers its r
 from .docs import SECTIONS, number_spec, number_text, rule_page, rules_table, threshold_text, with_unit
 from .file import UNREADABLE
 from .registry import (
+    FAMILIES,
     LEVELS,
     RULES,
     Measured,
     Rule,
+    family_codes,
+    family_doc,
+    fix_left_rules,
+    fix_uncut_rules,
+    masking_rules,
     page_fields,
     register,
+    register_family,
     resolve_codes,
     rule,
     unregister,
@@ -38,6 +45,7 @@ def find_rule(key: str) -> Rule | None:
     return None
 
 
-__all__ = ["LEVELS", "RULES", "SECTIONS", "UNREADABLE", "Measured", "Rule", "find_rule", "number_spec", "number_text",
-           "page_fields", "register",
+__all__ = ["FAMILIES", "LEVELS", "RULES", "SECTIONS", "UNREADABLE", "Measured", "Rule", "family_codes", "family_doc",
+           "find_rule", "fix_left_rules", "fix_uncut_rules", "masking_rules", "number_spec", "number_text", "page_fields", "register",
+           "register_family",
            "resolve_codes", "rule", "rule_page", "rules_table", "threshold_text", "unregister", "with_unit"]

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..measures import barycentric_score, color_steps, normal_degrees, texels
+from .families import COLOR_AFFINITY, NORMAL_AFFINITY, UV_AFFINITY
 from .registry import Measured, rule
 
 #: The paper's own tolerance for its dimensionless barycentric reading.
@@ -25,9 +26,12 @@ REFERENCES = (
     "Hormann & Tarini 2004, A quadrilateral rendering primitive (mean value coordinates, the fix a renderer applies)."
 )
 
+#: The uv rule: a bare ``--threshold N`` (and ``threshold = N`` in a configuration file) sets its threshold.
+UV_DISAFFINE = "Q101"
 
-@rule(code="Q101", name="uv-disaffine", unit="texels", default_threshold=0.5, visible_threshold=2.0, attribute="texcoords", scored=True,
-      readings={"barycentric": ("barycentric score", BARYCENTRIC_TOLERANCE)}, why=CREASE, references=REFERENCES)
+
+@rule(code=UV_DISAFFINE, name="uv-disaffine", unit="texels", default_threshold=0.5, visible_threshold=2.0, attribute="texcoords", scored=True,
+      visible_reading=True, family=UV_AFFINITY, readings={"barycentric": ("barycentric score", BARYCENTRIC_TOLERANCE)}, why=CREASE, references=REFERENCES)
 def uv_disaffinity(quads) -> Measured:
     """Texture coordinates are not an affine image of the positions.
 
@@ -97,7 +101,7 @@ def uv_disaffinity(quads) -> Measured:
 
 
 @rule(code="Q102", name="color-disaffine", unit="1/255", default_threshold=2.0, visible_threshold=8.0, attribute="colors", scored=True,
-      why=CREASE, references=REFERENCES)
+      family=COLOR_AFFINITY, why=CREASE, references=REFERENCES)
 def color_disaffinity(quads) -> Measured:
     """Vertex colours are not an affine image of the positions.
 
@@ -142,7 +146,7 @@ def color_disaffinity(quads) -> Measured:
 
 
 @rule(code="Q103", name="normal-disaffine", unit="degrees", default_threshold=2.0, visible_threshold=8.0, attribute="normals", scored=True,
-      why=CREASE, references=REFERENCES)
+      family=NORMAL_AFFINITY, why=CREASE, references=REFERENCES)
 def normal_disaffinity(quads) -> Measured:
     """Normals are not an affine image of the positions.
 

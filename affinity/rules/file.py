@@ -6,6 +6,7 @@ import os
 
 import numpy as np
 
+from .families import QUAD_SHAPE
 from .registry import RULES, Measured, Rule, page_fields, rule
 
 FORMATS = (
@@ -14,7 +15,7 @@ FORMATS = (
 )
 
 
-@rule(code="Q205", name="no-faces", unit="vertices", scope="mesh", references=FORMATS)
+@rule(code="Q205", name="no-faces", unit="vertices", scope="mesh", family=QUAD_SHAPE, references=FORMATS)
 def no_faces(context) -> Measured:
     """The mesh has vertices but no faces.
 
@@ -58,10 +59,11 @@ def unusable_resource(path: str, image: bool) -> str | None:
     regular file: not read"``, over the side-file budget: an image is read in part, others whole), or None."""
     from ..loaders import LFS_POINTER
     from ..loaders.imagesize import image_size
-    from ..loaders.regular import SIDE_FILE_BUDGET, RefusedFile, open_regular
+    from ..loaders.regular import SIDE_FILE_BUDGET, RefusedFile
+    from ..loaders.sidefiles import open_side_file
 
     try:
-        with open_regular(path, None if image else SIDE_FILE_BUDGET) as fh:
+        with open_side_file(path, None if image else SIDE_FILE_BUDGET) as fh:
             head = fh.read(len(LFS_POINTER))
     except FileNotFoundError:
         return "not found"
@@ -76,7 +78,7 @@ def unusable_resource(path: str, image: bool) -> str | None:
     return None
 
 
-@rule(code="Q902", name="missing-resource", level="info", scope="mesh",
+@rule(code="Q902", name="missing-resource", level="info", scope="mesh", family=QUAD_SHAPE,
       references="Wavefront OBJ and MTL (Advanced Visualizer manual, Appendix B1 and B2: mtllib, map_Kd).")
 def missing_resources(context) -> Measured:
     """An mtllib or map_Kd named by the file cannot be found or read.
@@ -122,13 +124,12 @@ def missing_resources(context) -> Measured:
     # changes reach the cache, but a missing one is not a finding (Q902 is about OBJ and MTL). A finding sits on the line that pulls the file in
     # (face -1); its detail names the resource and, where the texel unit would have come
     # from that texture, the texture-size used instead.
+    from ..loaders.names import printable  # names come from the file: never send its control characters
     from ..loaders.resources import ROLES
-    from ..output.names import printable  # names come from the file: never send its control characters
 
     mesh, settings = context.mesh, context.settings
     folder = os.path.dirname(mesh.path)
     texels = mesh.texcoords is not None and "Q101" in RULES
-    used = mesh.texture_path()
     fallback = f"; texels use texture-size {settings.texture_size}"
     lines, details, seen = [], [], set()
     for resource in mesh.resources:
@@ -141,13 +142,13 @@ def missing_resources(context) -> Measured:
             continue
         lines.append(resource.line)
         if resource.library is None:
-            texture_unit_lost = texels and used is None and role.name == "mtllib"
+            texture_unit_lost = texels and not mesh.material_textures and role.name == "mtllib"
             details.append(f"{role.statement} {printable(resource.name)} {problem}"
                            + (fallback if texture_unit_lost else ""))
         else:
             shown = os.path.relpath(resource.path, folder) if folder else resource.path
             details.append(f"{role.statement} {printable(shown)} (in {printable(resource.library)}) {problem}"
-                           + (fallback if texels and resource.path == used else ""))
+                           + (fallback if texels and role.texture == "base colour" else ""))
     n = len(lines)
     return Measured(np.zeros(n, dtype=np.int64), np.zeros(n), lines=np.array(lines, dtype=np.int64), details=details)
 
@@ -186,5 +187,5 @@ How to fix:
 """
 
 #: Q901 is not a lint rule (design.md): documented like one, never registered.
-UNREADABLE = Rule(code="Q901", name="unreadable", level="error", scope="mesh", references=FORMATS,
+UNREADABLE = Rule(code="Q901", name="unreadable", level="error", scope="mesh", family=QUAD_SHAPE, references=FORMATS,
                   **page_fields(UNREADABLE_PAGE))

@@ -20,7 +20,7 @@ rule is one decorated function (tests/test_rule_registry.py runs this one)::
     from affinity.rules import Measured, rule
 
 
-    @rule(code="Q999", name="long-edge", unit="units", default_threshold=1.0)
+    @rule(code="Q999", name="long-edge", unit="units", default_threshold=1.0, family="QuadShape")
     def long_edge(context) -> Measured:
         '''A quad has an edge longer than the threshold.
 
@@ -113,10 +113,25 @@ class Rule:
         (the report's histograms, the hybrid's ``--route lint``)
     readings : measure -> (unit, default threshold) where a ``--measure`` reading
         changes them (Q101's dimensionless barycentric score)
+    visible_reading : its findings on quads that bind a readable texture are read through it: C, with the
+        shift kept beside it (design.md, "The visible reading"; Q101)
     mirroring : a finding is a texture mirrored against the surface: its report close-up draws an
         asymmetric glyph in texture space (a symmetric pattern looks the same mirrored)
     folding : a finding is the split folding along its diagonal: its report close-up draws the shaded surface,
         lit across the fold, with the diagonal (texture lines are affine on either triangle and show no fold)
+    family : the validator family that reports the rule inside USD (:data:`FAMILIES`: one UsdValidation
+        validator and one NVIDIA rule each, :mod:`affinity.usd.families`)
+    masks : the attributes (Mesh fields) whose scored rules this rule's defect takes over: where
+        ``unmeasurable`` holds, they are not measured (design.md, "One finding per defect")
+    unmeasurable : ``unmeasurable(context) -> (Q,) bool``, with ``masks``: the quads of a batch whose
+        defect makes the masked scores meaningless; run whether or not the rule is selected
+    cause : with ``masks``: what a finding of this rule says where it took the scored rules' place
+        (``"it has no area"``, then ``", so Q101 is not measured on it"``)
+    fix_leaves : the reason ``affinity fix`` gives for a flagged quad this rule also flags and that it leaves
+        (``"degenerate"``); "": fix does not look at this rule
+    fix_precedence : where several ``fix_leaves`` rules flag one quad, the lowest precedence names the reason
+    fix_uncut : a quad this rule flags is never cut to meet a refined neighbour (a cut of its bilinear patch
+        would fold): it keeps its line and the neighbour's refinement closes to it
     scope : the faces a check's context holds: ``"quad"``, a batch of the mesh's quads
         (:class:`affinity.lint.QuadBatch`); ``"mesh"``, the file itself as face -1
         (:class:`affinity.lint.WholeMesh`: Q205, Q902)
@@ -145,9 +160,17 @@ class Rule:
     worst: str = "highest"
     attribute: str | None = None
     scored: bool = False
+    visible_reading: bool = False
     mirroring: bool = False
     folding: bool = False
     readings: Mapping[str, tuple[str, float]] = field(default_factory=dict)
+    family: str = ""
+    masks: tuple[str, ...] = ()
+    unmeasurable: Callable | None = None
+    cause: str = ""
+    fix_leaves: str = ""
+    fix_precedence: int = 0
+    fix_uncut: bool = False
     scope: str = "quad"
     check: Callable | None = None
     bound: Callable | None = None
@@ -183,6 +206,55 @@ class Rule:
 
 #: Every lint rule by code, in code order.
 RULES: dict[str, Rule] = {}
+#: The validator families by name, in the order they were registered: name -> their one-line doc (what their
+#: rules find, after the codes: :func:`family_doc`). Every rule names one (:attr:`Rule.family`).
+FAMILIES: dict[str, str] = {}
+
+
+def register_family(name: str, doc: str) -> str:
+    """Add validator family ``name`` (a UsdValidation validator's name, ``UvAffinity``) with its ``doc``."""
+    if name in FAMILIES:
+        raise ValueError(f"family {name} is registered already")
+    FAMILIES[name] = doc
+    return name
+
+
+def family_codes(name: str) -> tuple[str, ...]:
+    """The codes of the rules of family ``name``, in code order."""
+    return tuple(code for code, rule in RULES.items() if rule.family == name)
+
+
+def family_doc(name: str) -> str:
+    """``quad-affinity Q201-Q205, Q902: <doc>``: the family's codes (:func:`code_spans`) and its doc."""
+    return f"quad-affinity {code_spans(family_codes(name))}: {FAMILIES[name]}"
+
+
+def code_spans(codes) -> str:
+    """``codes`` (in code order) as text, runs of consecutive codes as ranges: ``Q201-Q205, Q902``."""
+    runs: list[list[str]] = []
+    for code in codes:
+        if runs and code[0] == runs[-1][-1][0] and int(code[1:]) == int(runs[-1][-1][1:]) + 1:
+            runs[-1].append(code)
+        else:
+            runs.append([code])
+    return ", ".join(run[0] if len(run) == 1 else f"{run[0]}-{run[-1]}" for run in runs)
+
+
+def fix_left_rules() -> list[Rule]:
+    """The rules whose flagged quads ``affinity fix`` leaves (:attr:`Rule.fix_leaves`), the one that names the
+    reason first (:attr:`Rule.fix_precedence`)."""
+    return sorted((rule for rule in RULES.values() if rule.fix_leaves), key=lambda rule: rule.fix_precedence)
+
+
+def fix_uncut_rules() -> list[Rule]:
+    """The rules whose flagged quads a refined neighbour never cuts (:attr:`Rule.fix_uncut`), in code order."""
+    return [rule for rule in RULES.values() if rule.fix_uncut]
+
+
+def masking_rules(attribute: str | None = None) -> list[Rule]:
+    """The rules whose defect takes over scored rules (:attr:`Rule.masks`), in code order: those masking
+    ``attribute`` where given."""
+    return [rule for rule in RULES.values() if rule.masks and (attribute is None or attribute in rule.masks)]
 
 
 def register(rule: Rule) -> Rule:
@@ -191,6 +263,10 @@ def register(rule: Rule) -> Rule:
         raise ValueError(f"rule {rule.code} is registered already")
     if rule.level not in LEVELS or rule.scope not in ("quad", "mesh") or rule.flags not in ("above", "at-or-below"):
         raise ValueError(f"rule {rule.code}: level, scope or flags out of range")
+    if rule.family not in FAMILIES:
+        raise ValueError(f"rule {rule.code}: family {rule.family!r} is not registered (register_family)")
+    if bool(rule.masks) != (rule.unmeasurable is not None) or (rule.masks and not rule.cause):
+        raise ValueError(f"rule {rule.code}: masks, unmeasurable and cause go together")
     RULES[rule.code] = rule
     ordered = sorted(RULES.items())
     RULES.clear()

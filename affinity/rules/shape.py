@@ -4,15 +4,30 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..geometry import degeneracy, fold_degrees, folded_fraction, interior_angles, is_bowtie
+from ..geometry import degeneracy, fold_degrees, folded_fraction, interior_angles, is_bowtie, zero_area
+from .families import QUAD_SHAPE
 from .registry import Measured, rule
 
 REFERENCES = ("Bloomenthal 2022, §3.4 (nonplanar and degenerate quads); "
               "Hormann & Tarini 2004, §4 (concave and self-crossing quads).")
+#: The attributes of the scored rules a quad without area or a bow-tie takes over (one finding per defect).
+EVERY_ATTRIBUTE = ("texcoords", "colors", "normals")
+
+
+def no_area(quads) -> np.ndarray:
+    """(Q,) bool: the quads whose whole area is at or below Q201's threshold (a pole quad, one repeated corner,
+    is a triangle with area: not these)."""
+    return zero_area(quads.planar, quads.settings.threshold("Q201"))
+
+
+def self_crossing(quads) -> np.ndarray:
+    """(Q,) bool: the bow-ties (Q204's test)."""
+    return is_bowtie(quads.planar)
 
 
 @rule(code="Q201", name="degenerate-quad", unit="relative area", default_threshold=1e-9, flags="at-or-below",
-      worst="lowest", references=REFERENCES)
+      worst="lowest", family=QUAD_SHAPE, masks=EVERY_ATTRIBUTE, unmeasurable=no_area, cause="it has no area",
+      fix_leaves="degenerate", fix_precedence=0, fix_uncut=True, references=REFERENCES)
 def degenerate(quads) -> Measured:
     """Zero area, collapsed edge or repeated corner.
 
@@ -58,7 +73,7 @@ def degenerate(quads) -> Measured:
 
 
 @rule(code="Q202", name="nonplanar-quad", unit="degrees", default_threshold=45.0, folding=True,
-      references=REFERENCES)
+      family=QUAD_SHAPE, fix_leaves="nonplanar", fix_precedence=2, references=REFERENCES)
 def nonplanar(quads) -> Measured:
     """The split folds: the two triangles meet at an angle along the diagonal.
 
@@ -113,7 +128,7 @@ def at_most_straight(quads) -> np.ndarray:
 
 
 @rule(code="Q203", name="concave-quad", level="info", unit="degrees", default_threshold=180.0,
-      references=REFERENCES, bound=at_most_straight)
+      family=QUAD_SHAPE, fix_uncut=True, references=REFERENCES, bound=at_most_straight)
 def concave(quads) -> Measured:
     """One corner is reflex.
 
@@ -156,7 +171,9 @@ def concave(quads) -> Measured:
     return Measured(rows, interior_angles(quads.planar).max(axis=1)[rows])
 
 
-@rule(code="Q204", name="bowtie-quad", level="error", unit="folded fraction", references=REFERENCES)
+@rule(code="Q204", name="bowtie-quad", level="error", unit="folded fraction", family=QUAD_SHAPE,
+      masks=EVERY_ATTRIBUTE, unmeasurable=self_crossing, cause="it has no consistent orientation",
+      fix_leaves="bowtie", fix_precedence=1, fix_uncut=True, references=REFERENCES)
 def bowtie(quads) -> Measured:
     """The quad crosses itself.
 

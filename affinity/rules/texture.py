@@ -5,11 +5,27 @@ from __future__ import annotations
 import numpy as np
 
 from ..geometry import relative_signed_area
+from .families import UV_LAYOUT
 from .registry import Measured, rule
 
+#: The uv quad without area: routing by view reads its threshold (a degenerate uv quad routes by the lint's error).
+UV_DEGENERATE = "Q301"
 
-@rule(code="Q301", name="uv-degenerate", unit="relative area", default_threshold=1e-9, flags="at-or-below",
-      worst="lowest", attribute="texcoords")
+
+def collapsed_uv(quads) -> np.ndarray:
+    """(Q,) bool: the quads whose uv collapses to a line or a point (Q301's test at its threshold)."""
+    from .registry import RULES
+
+    collapsed = np.zeros(len(quads), dtype=bool)
+    if quads.tables.tables.get("texcoords") is not None:
+        area = uv_degenerate(quads)
+        collapsed[area.rows] = RULES[UV_DEGENERATE].flagged(area.values, quads.settings.threshold(UV_DEGENERATE))
+    return collapsed
+
+
+@rule(code=UV_DEGENERATE, name="uv-degenerate", unit="relative area", default_threshold=1e-9, flags="at-or-below",
+      worst="lowest", attribute="texcoords", family=UV_LAYOUT, masks=("texcoords",), unmeasurable=collapsed_uv,
+      cause="the texture smears over it", fix_leaves="uv-degenerate", fix_precedence=3)
 def uv_degenerate(quads) -> Measured:
     """Zero area in texture space.
 
@@ -60,7 +76,7 @@ def uv_degenerate(quads) -> Measured:
 
 
 @rule(code="Q302", name="uv-flipped", level="info", unit="relative area", worst="lowest", attribute="texcoords",
-      mirroring=True)
+      mirroring=True, family=UV_LAYOUT)
 def uv_flipped(quads) -> Measured:
     """Texture orientation reversed against the surface.
 

@@ -1,9 +1,8 @@
 """Which texture file each quad reads, and the texel grid of its uv.
 
 A face reads the texture maps of its material (``Mesh.material_maps``); faces
-without a material read those of the mesh's first material that has maps (as
-``Mesh.texture_path`` does). A UDIM map is one file per tile, the tile chosen by
-the quad's uv centre (:func:`affinity.loaders.texturemaps.udim_tile_of`).
+without a material read those of the mesh's first material that has maps. A UDIM map is one file per
+tile, the tile chosen by the quad's uv centre (:func:`affinity.loaders.texturemaps.udim_tile_of`).
 """
 
 from __future__ import annotations

@@ -3,7 +3,7 @@
 - :mod:`affinity.usd.validators` is the plug-in module that ``plugin/plugInfo.json``
   names: imported by USD's plug-in registry (found through ``PXR_PLUGINPATH_NAME``,
   the folder ``affinity usd-plugin`` prints), it registers one validator per rule
-  family (:data:`affinity.usd.families.FAMILIES`) under the keyword ``quad-affinity``.
+  family (:func:`affinity.usd.families.families`) under the keyword ``quad-affinity``.
   Registration happens there and only there: importing :mod:`affinity` or this
   package costs nothing (no ``pxr``).
 - :mod:`affinity.usd.nvidia` is the ``usd_validation_nvidia`` entry point: one rule

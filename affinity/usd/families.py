@@ -1,8 +1,9 @@
 """The validator families: which rules each UsdValidation validator and NVIDIA rule runs.
 
-One validator per rule family, named after it; the three affinity families carry a
-fixer (``affinity fix``'s refinement). Error names are the rule names
-(``uv-disaffine``), so a fixer is tied to its rule's errors.
+One validator per rule family (:data:`affinity.rules.FAMILIES`), named after it, running the rules that
+name it (:attr:`affinity.rules.Rule.family`); a family whose rules are all scored carries a fixer
+(``affinity fix``'s refinement). Error names are the rule names (``uv-disaffine``), so a fixer is tied to
+its rule's errors. The plug-in's ``plugInfo.json`` lists the same families (a test compares them).
 """
 
 from __future__ import annotations
@@ -21,16 +22,22 @@ class Family:
     doc: str
 
 
-FAMILIES = (
-    Family("UvAffinity", ("Q101",), True,
-           "quad-affinity Q101: texture coordinates that are not an affine image of the quad (a crease along the "
-           "split diagonal), in texels."),
-    Family("ColorAffinity", ("Q102",), True,
-           "quad-affinity Q102: vertex colours that are not an affine image of the quad, in 1/255 steps."),
-    Family("NormalAffinity", ("Q103",), True,
-           "quad-affinity Q103: normals that are not an affine image of the quad, in degrees."),
-    Family("QuadShape", ("Q201", "Q202", "Q203", "Q204", "Q205"), False,
-           "quad-affinity Q201-Q205: degenerate, nonplanar, concave and bow-tie quads, meshes without faces."),
-    Family("UvLayout", ("Q301", "Q302"), False,
-           "quad-affinity Q301-Q302: quads with no area in texture space, or mirrored against the surface."),
-)
+def families() -> tuple[Family, ...]:
+    """Every registered family with rules, from the rule registry as it is now (a rule registered at run time
+    is reported by its family)."""
+    from ..rules import FAMILIES, RULES, family_codes, family_doc
+
+    made = []
+    for name in FAMILIES:
+        codes = family_codes(name)
+        if codes:
+            made.append(Family(name, codes, all(RULES[code].scored for code in codes), family_doc(name)))
+    return tuple(made)
+
+
+def unreadable_family() -> str:
+    """The family that says why a prim (or its stage) cannot be read: Q901's."""
+    from ..rules import UNREADABLE
+
+    return UNREADABLE.family
+

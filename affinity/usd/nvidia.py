@@ -2,7 +2,7 @@
 
 The package's ``usd_validation_nvidia`` entry point is :class:`QuadAffinityPlugin`;
 its ``on_startup`` registers one rule class per family of
-:data:`affinity.usd.families.FAMILIES` (``UvAffinityChecker``, ...) in the category
+:func:`affinity.usd.families.families` (``UvAffinityChecker``, ...) in the category
 ``quad-affinity`` (``nvidia_usd_validate -c quad-affinity``). A rule reports each
 finding at its mesh prim (for a mesh several prims take from one geometry layer, the
 first of them; the message names the layer and every referencing prim) through
@@ -19,7 +19,7 @@ from __future__ import annotations
 from usd_validation_nvidia import BaseRuleChecker, Suggestion, register_rule, unregister_rule
 
 from . import KEYWORD
-from .families import FAMILIES, Family
+from .families import Family, families
 
 CATEGORY = KEYWORD
 
@@ -32,6 +32,7 @@ class _FamilyChecker(BaseRuleChecker):
     def CheckPrim(self, prim) -> None:
         from pxr import UsdGeom
 
+        from ..rules.wording import unreadable_line
         from .stage import exception_reason, family_findings, finding_message
 
         if not prim.IsA(UsdGeom.Mesh):
@@ -39,12 +40,12 @@ class _FamilyChecker(BaseRuleChecker):
         try:
             said = family_findings(self.family, prim)
         except Exception as error:  # the validator's run goes on: one error naming the prim
-            self._AddError(message=f"{prim.GetPath()}: Q901 unreadable: {exception_reason(error)}", at=prim)
+            self._AddError(message=unreadable_line(str(prim.GetPath()), exception_reason(error)), at=prim)
             return
         for note in said.notes:
             self._AddInfo(message=f"note: {note}", at=prim)
         if said.unreadable is not None:
-            self._AddError(message=f"{prim.GetPath()}: Q901 unreadable: {' '.join(said.unreadable.split())}", at=prim)
+            self._AddError(message=unreadable_line(str(prim.GetPath()), said.unreadable), at=prim)
         for f in said.findings:
             if f.level == "info":
                 self._AddInfo(message=finding_message(f), at=prim)
@@ -72,7 +73,7 @@ def _checker(family: Family) -> type:
                                                               "__module__": __name__})
 
 
-CHECKERS = tuple(_checker(family) for family in FAMILIES)
+CHECKERS = tuple(_checker(family) for family in families())
 
 
 class QuadAffinityPlugin:

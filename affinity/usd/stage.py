@@ -122,14 +122,14 @@ class PrimFindings:
 
 def family_findings(family, prim) -> PrimFindings:
     """:class:`PrimFindings` of ``family`` (:class:`affinity.usd.families.Family`) on ``prim``."""
-    from .families import FAMILIES
+    from .families import families, unreadable_family
 
     check = cached_check(prim.GetStage())
     path = str(prim.GetPath())
     said = PrimFindings([])
-    if family is FAMILIES[0] and path == next(iter(check.reported_at), None):
+    if family.name == families()[0].name and path == next(iter(check.reported_at), None):
         said.notes = check.notes
-    if family.name == "QuadShape" and (check.error or path in check.bad_prims):
+    if family.name == unreadable_family() and (check.error or path in check.bad_prims):
         said.unreadable = check.error or check.bad_prims[path]
     if check.reported_at.get(path) == path:
         said.findings = [f for f in check.findings.get(path, []) if f.code in family.codes]

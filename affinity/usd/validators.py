@@ -2,7 +2,7 @@
 
 USD's plug-in registry imports this module (``plugin/plugInfo.json`` names it) the
 first time a validator of ours is asked for. Each family of
-:data:`affinity.usd.families.FAMILIES` becomes the prim validator
+:func:`affinity.usd.families.families` becomes the prim validator
 ``affinity.usd.validators:<Family>`` for ``UsdGeomMesh`` prims, with the keyword
 ``quad-affinity``. It runs on the stage as ``affinity check`` runs on its file
 (:mod:`affinity.usd.stage`: the same loader, the settings that govern the root
@@ -29,8 +29,9 @@ from __future__ import annotations
 
 from pxr import Sdf, UsdValidation
 
+from ..rules.wording import unreadable_line
 from . import KEYWORD, usd_too_old
-from .families import FAMILIES, Family
+from .families import Family, families
 from .stage import exception_reason
 
 MODULE = __name__
@@ -72,7 +73,7 @@ def family_errors(family: Family, prim) -> list:
 
 def _unreadable(stage, path: str, reason: str):
     return UsdValidation.ValidationError("unreadable", UsdValidation.ValidationErrorType.Error, [_site(stage, path)],
-                                         f"{path}: Q901 unreadable: {' '.join(reason.split())}")
+                                         unreadable_line(path, reason))
 
 
 def _validator(family: Family):
@@ -121,7 +122,7 @@ def _fixer(family: Family):
 def register() -> None:
     """Register every family's validator (and fixer) under ``affinity.usd.validators:<Family>``."""
     registry = UsdValidation.ValidationRegistry()
-    for family in FAMILIES:
+    for family in families():
         fixers = [_fixer(family)] if family.fixable else []
         registry.RegisterPluginPrimValidator(f"{MODULE}:{family.name}", _validator(family), fixers)
 
