@@ -383,7 +383,8 @@ def publish(check_run, args) -> int:
         from ..output import at_or_above
 
         check_run.reports, check_run.hidden = at_or_above(check_run.reports, args.level)
-    _write_output_file(args.output_file, lambda out: _write_output(check_run, args, out))
+    inputs = [report.path for report in check_run.reports] + list(getattr(args, "results", []))
+    _write_output_file(args.output_file, lambda out: _write_output(check_run, args, out), inputs)
     if _failed(check_run.reports, args.fail_on_skip):
         return EXIT_ERROR
     return EXIT_CLEAN if args.exit_zero or not _fails(gated, args.fail_on) else EXIT_FINDINGS
@@ -401,15 +402,17 @@ def _fails(reports, fail_on: str) -> bool:
     return any(len(h) and h.level_ranks().min() <= LEVELS.index(fail_on) for r in reports for h in r.hits)
 
 
-def _write_output_file(path: str | None, write) -> None:
+def _write_output_file(path: str | None, write, inputs=()) -> None:
     """``write(out)`` to stdout, or to ``path`` atomically (a failed run leaves no partial file; ``-`` is
-    standard output, written whole too)."""
+    standard output, written whole too); never through a link to a file, nor over one of ``inputs``
+    (:func:`affinity.atomic.refuse_unsafe`)."""
     if path is None:
         write(sys.stdout)
         return
-    from ..atomic import atomic_write
+    from ..atomic import atomic_write, refuse_unsafe
 
     try:
+        refuse_unsafe(path, inputs)
         with atomic_write(path) as out:
             write(out)
     except OSError as err:

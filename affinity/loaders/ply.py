@@ -25,6 +25,7 @@ import numpy as np
 from ..errors import MeshError, SkippedFile
 from ..mesh import Mesh
 from .faces import check_indices, polygon_mesh, ragged_positions, unit_colors, whole_indices
+from .numbers import out_of_range, out_of_range_reason
 from .regular import open_regular
 from .text import read_rows
 
@@ -374,8 +375,12 @@ def strip_triangles(counts, items, row_lines):
             np.asarray(row_lines, dtype=np.int64)[row[:-2][keep]], int((whole & degenerate).sum()))
 
 def _require_finite(path, values, lines) -> None:
-    """MeshError at the line of the first row of ``values`` (n, k) with a NaN or inf."""
-    bad = ~np.isfinite(values).all(axis=1)
+    """MeshError at the line of the first row of ``values`` (n, k) with a NaN, an inf or a value
+    beyond :data:`~.numbers.LARGEST`."""
+    bad = out_of_range(values).any(axis=1)
     if bad.any():
         row = int(np.argmax(bad))
-        raise MeshError(path, lines if np.isscalar(lines) else int(lines[row]), f"value {values[row]} is not finite")
+        line = lines if np.isscalar(lines) else int(lines[row])
+        if np.isfinite(values[row]).all():
+            raise MeshError(path, line, out_of_range_reason(values[row][out_of_range(values[row])][0]))
+        raise MeshError(path, line, f"value {values[row]} is not finite")

@@ -52,6 +52,7 @@ import numpy as np
 from ..errors import MeshError, SkippedFile
 from ..mesh import Mesh
 from .formats import format_named
+from .numbers import out_of_range, out_of_range_reason
 from .resources import Resource
 from .usdlayers import geometry_source, layer_assets, may_hold_mesh, prim_type_names, regular_layers, subdivision_note
 
@@ -245,7 +246,9 @@ def _array(value, dtype, width: int | None = None) -> np.ndarray:
 
 
 def _finite(name: str, values: np.ndarray) -> np.ndarray:
-    if not np.isfinite(values).all():
+    if out_of_range(values).any():
+        if np.isfinite(values).all():
+            raise _BadPrim(f"{name}: {out_of_range_reason(values[out_of_range(values)][0])}")
         raise _BadPrim(f"{name} has NaN or Inf values")
     return values
 

@@ -37,6 +37,8 @@ def _corners(width: int, height: int, uv: np.ndarray):
 def _wrapped_texels(texel: np.ndarray, size: int) -> np.ndarray:
     """(N,) int64: integer texel indices ``texel`` (N,) (float or int) repeated into [0, size); a bit mask for
     a power-of-two size (the common case: no division per texel)."""
+    if texel.dtype.kind == "f" and len(texel) and not (-2.0**62 < texel.min() and texel.max() < 2.0**62):
+        texel = np.fmod(texel, size)  # beyond int64 (uv of 1e15 and up): fmod is exact, and keeps the texel
     texel = texel.astype(np.int64, copy=False)
     if size & (size - 1) == 0:
         return texel & (size - 1)
