@@ -106,20 +106,23 @@ def test_sigterm_to_check_j2_leaves_no_process_in_20_trials(big_meshes, tmp_path
     """SIGTERM at 20 moments of a ``check -j 2`` run (while the workers check, and while they send their
     results): the run and both workers are gone 5 s later, every time."""
     rng = random.Random(53)
-    hung = []
-    for trial in range(20):
-        run = start("check", "--no-cache", "-j", "2", "--format", "json", "-o", str(tmp_path / f"out{trial}.json"),
-                    ".", cwd=big_meshes)
-        try:
-            assert wait_for(lambda: len(children(run.pid)) == 2, 60), "the two workers never started"
-            workers = children(run.pid)
-            time.sleep(rng.uniform(0.0, 1.5))
-            os.kill(run.pid, signal.SIGTERM)
-            gone = wait_for(lambda: not alive(run.pid) and not any(map(alive, workers)), 5)
-            if not gone:
-                hung.append((trial, alive(run.pid), [alive(w) for w in workers]))
-        finally:
-            run.kill()
-            run.wait()
-        assert "Traceback" not in run.stderr.read()
+    hung = [trial for trial in range(20) if not _gone_after_sigterm(big_meshes, tmp_path / f"out{trial}.json",
+                                                                     rng.uniform(0.0, 1.5))]
     assert hung == []
+
+
+def _gone_after_sigterm(folder: Path, out: Path, delay: float) -> bool:
+    """Whether ``check -j 2`` of ``folder``, sent SIGTERM ``delay`` s after its workers started, and both
+    workers are gone 5 s later (and it printed no traceback)."""
+    run = start("check", "--no-cache", "-j", "2", "--format", "json", "-o", str(out), ".", cwd=folder)
+    try:
+        assert wait_for(lambda: len(children(run.pid)) == 2, 60), "the two workers never started"
+        workers = children(run.pid)
+        time.sleep(delay)
+        os.kill(run.pid, signal.SIGTERM)
+        gone = wait_for(lambda: not alive(run.pid) and not any(map(alive, workers)), 5)
+    finally:
+        run.kill()
+        run.wait()
+    assert "Traceback" not in run.stderr.read()
+    return gone
