@@ -2,8 +2,8 @@
 
 A texture whose header claims more than :data:`DECODE_BUDGET` pixels is never
 decoded (a 100,000 x 100,000 PNG header would ask for 30 GB); decoded textures
-are kept as (H, W, 4) uint8 (four bytes a texel, as Pillow holds them), at most :data:`CACHE_BYTES` of them at a time
-(least recently used dropped first), keyed by path, size and modification time,
+are kept as (H, W, 4) uint8 (four bytes a texel, as Pillow holds them), at most :data:`CACHE_BYTES` of them and
+their pyramids at a time (least recently used dropped first), keyed by path, size and modification time,
 so each texture is decoded once per run however many meshes or rules read it.
 Peak memory for textures: :data:`CACHE_BYTES` plus one texture being decoded
 (at most ``DECODE_BUDGET x 4`` bytes, twice while Pillow hands its copy over) and its min/max
@@ -24,7 +24,7 @@ from ..loaders.imagesize import ImageHeader, ImageUnreadable, open_image_file, r
 
 #: Pixels (width x height) a texture may have to be decoded: 8192 x 8192.
 DECODE_BUDGET = 1 << 26
-#: Decoded texture bytes kept between meshes of one run.
+#: Bytes of decoded textures and their pyramids kept between meshes of one run.
 CACHE_BYTES = 1 << 29
 
 
@@ -56,6 +56,13 @@ class DecodedTexture:
     channels: int
 
     @property
+    def held_bytes(self) -> int:
+        """Bytes the texture holds: its texels and the bands of its pyramids built so far (the decode cache's
+        measure: the pyramids of a texture read all over hold about 1.3 times its texels)."""
+        pyramids = [vars(self).get("pyramid"), *vars(self).get("slopes", ())]
+        return self.texels.nbytes + sum(p.built_bytes for p in pyramids if p is not None)
+
+    @property
     def pixels(self) -> np.ndarray:
         """(H, W, C) uint8, read-only: the texture's channels of :attr:`texels` (a view)."""
         return self.texels[..., :self.channels]
@@ -76,34 +83,12 @@ class DecodedTexture:
         texel moved. The steps are computed for the rows queries reach."""
         from .filtering import RangePyramid
 
+        # The pyramids hold the texels, not the texture: a bound method would make a cycle (texture ->
+        # pyramid -> method -> texture) that only the cyclic collector frees, long after the cache dropped it.
         height, width = self.texels.shape[:2]
-        return tuple(RangePyramid(minima=False, rows=partial(self._channel_steps, axis=axis),
-                                  fold=self._largest_step, shape=(height, width, 1)) for axis in (1, 0))
-
-    def _channel_steps(self, start: int, stop: int, axis: int) -> np.ndarray:
-        """(stop - start, W, 4) uint8: per channel of :attr:`texels`, |difference| from each texel of rows
-        ``start`` to ``stop`` to the next one along ``axis`` (1: the next column, 0: the next row), wrapping.
-        Whole four-byte texels are subtracted: contiguous, and no reduction per texel."""
-        texels = self.texels
-        rows = texels[start:stop]
-        steps = np.empty_like(rows)
-        if axis == 1:  # the last column wraps to the first
-            pairs = ((rows[:, :-1], rows[:, 1:], steps[:, :-1]), (rows[:, -1:], rows[:, :1], steps[:, -1:]))
-        else:  # the last row wraps to the first
-            pairs = ((rows[:-1], texels[start + 1:stop], steps[:-1]),
-                     (rows[-1:], texels[stop % len(texels)][None], steps[-1:]))
-        for texel, neighbour, out in pairs:  # |a - b| in uint8, no copy of the neighbours
-            np.maximum(texel, neighbour, out=out)
-            out -= np.minimum(texel, neighbour)
-        return steps
-
-    def _largest_step(self, steps: np.ndarray) -> np.ndarray:
-        """(..., 1) uint8: the largest of :meth:`_channel_steps`'s (..., 4) over the texture's channels
-        (elementwise: faster than a reduction over a short axis)."""
-        largest = steps[..., :1].copy()
-        for channel in range(1, self.channels):
-            np.maximum(largest, steps[..., channel:channel + 1], out=largest)
-        return largest
+        return tuple(RangePyramid(minima=False, rows=partial(_channel_steps, self.texels, axis=axis),
+                                  fold=partial(_largest_step, channels=self.channels), shape=(height, width, 1))
+                     for axis in (1, 0))
 
     @cached_property
     def packed(self):
@@ -121,6 +106,32 @@ class DecodedTexture:
         step = max(1, int(np.sqrt(self.pixels.shape[0] * self.pixels.shape[1] / 65536)))
         red, green, blue = self.pixels[::step, ::step, :3].reshape(-1, 3).mean(axis=0)
         return blue >= 0.7 * 255 and blue > red and blue > green
+
+
+def _channel_steps(texels: np.ndarray, start: int, stop: int, axis: int) -> np.ndarray:
+    """(stop - start, W, 4) uint8: per channel of ``texels`` (H, W, 4) uint8, |difference| from each texel of
+    rows ``start`` to ``stop`` to the next one along ``axis`` (1: the next column, 0: the next row), wrapping.
+    Whole four-byte texels are subtracted: contiguous, and no reduction per texel."""
+    rows = texels[start:stop]
+    steps = np.empty_like(rows)
+    if axis == 1:  # the last column wraps to the first
+        pairs = ((rows[:, :-1], rows[:, 1:], steps[:, :-1]), (rows[:, -1:], rows[:, :1], steps[:, -1:]))
+    else:  # the last row wraps to the first
+        pairs = ((rows[:-1], texels[start + 1:stop], steps[:-1]),
+                 (rows[-1:], texels[stop % len(texels)][None], steps[-1:]))
+    for texel, neighbour, out in pairs:  # |a - b| in uint8, no copy of the neighbours
+        np.maximum(texel, neighbour, out=out)
+        out -= np.minimum(texel, neighbour)
+    return steps
+
+
+def _largest_step(steps: np.ndarray, channels: int) -> np.ndarray:
+    """(..., 1) uint8: the largest of :func:`_channel_steps`'s (..., 4) over the texture's first ``channels``
+    (elementwise: faster than a reduction over a short axis)."""
+    largest = steps[..., :1].copy()
+    for channel in range(1, channels):
+        np.maximum(largest, steps[..., channel:channel + 1], out=largest)
+    return largest
 
 
 _cache: OrderedDict = OrderedDict()
@@ -172,7 +183,7 @@ def decode(path: str, budget: int = DECODE_BUDGET) -> DecodedTexture:
     texture = DecodedTexture(path, header, *_decode_texels(path, header))
     with _cache_lock:
         _cache[key] = texture
-        while sum(t.texels.nbytes for t in _cache.values()) > CACHE_BYTES and len(_cache) > 1:
+        while sum(t.held_bytes for t in _cache.values()) > CACHE_BYTES and len(_cache) > 1:
             _cache.popitem(last=False)
     return texture
 

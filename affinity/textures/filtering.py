@@ -165,6 +165,18 @@ class RangePyramid:
         """The number of levels (the last one a single block)."""
         return len(self._levels)
 
+    @property
+    def built_bytes(self) -> int:
+        """Bytes of the bands built so far (the memory the pyramid holds beyond its ``image``: its arrays are
+        allocated up front, but their pages are touched only where bands are built)."""
+        total = 0
+        for k, ((low, high), built, band_rows) in enumerate(zip(self._levels, self._built, self._band_rows)):
+            if k == 0 and self._image is not None:
+                continue  # the image itself, not the pyramid's
+            row_bytes = high[0].nbytes if len(high) else 0
+            total += int(built.sum()) * band_rows * row_bytes * (1 if low is None or k == 0 else 2)
+        return total
+
     def channel_bounds(self, x0: np.ndarray, x1: np.ndarray, y0: np.ndarray,
                        y1: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(N, C) float64 per-channel minimum and maximum over the texel boxes [x0, x1] x [y0, y1]
