@@ -110,8 +110,8 @@ def main(argv=None) -> None:
                "render": measured(["render", mesh, "-o", str(budget / "out.png"), "-q"])}
     few, many = (rows[count][1] for count in COUNTS)
     lines = [f"`affinity check -j 1` on N meshes, each with its own {side}x{side} PNG (a 40x40 grid, a few "
-             f"quads flagged and read through the texture); fresh processes, result cache off; load average before: {load:.2f} "
-             "(a shared machine: times are indicative, peaks are not).",
+             "quads flagged and read through the texture); fresh processes, result cache off; load average "
+             f"before: {load:.2f} (a shared machine: times are indicative, peaks are not).",
              "",
              "| N | seconds | peak MB |",
              "|---:|---:|---:|",
