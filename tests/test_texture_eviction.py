@@ -1,6 +1,6 @@
 """An evicted texture frees its memory at once (issue 53): no reference cycle holds a decoded texture, its
 pyramids or its packed texels, so dropping it from the decode cache frees it without waiting for the cyclic
-garbage collector (which a folder of 4K textures outran: 4 GB for 32 meshes where the cache holds 512 MiB).
+garbage collector (which a folder of 4K textures outran: 4 GB for 32 meshes where the cache held 512 MiB).
 
 The check: a weak reference to the texture and to its texel buffer is dead right after eviction, with the
 collector switched off (``gc.disable``), after the lint has read the texture through every path (pyramid,

@@ -24,8 +24,10 @@ from ..loaders.imagesize import ImageHeader, ImageUnreadable, open_image_file, r
 
 #: Pixels (width x height) a texture may have to be decoded: 8192 x 8192.
 DECODE_BUDGET = 1 << 26
-#: Bytes of decoded textures and their pyramids kept between meshes of one run.
-CACHE_BYTES = 1 << 29
+#: Bytes of decoded textures and their pyramids kept between meshes of one run: four 4096 x 4096 textures.
+#: A folder run's peak is about this plus one mesh's work, whatever the number of meshes (measured in
+#: benchmarks/bench_texture_memory.py; 512 MiB let 32 meshes with their own 4K textures peak at 1.6x 4's).
+CACHE_BYTES = 1 << 28
 
 
 class TextureUnusable(Exception):
@@ -180,12 +182,38 @@ def decode(path: str, budget: int = DECODE_BUDGET) -> DecodedTexture:
         if key in _cache:
             _cache.move_to_end(key)
             return _cache[key]
+        _evict(header.width * header.height * 4)  # room first: the texture and the one it replaces never both
     texture = DecodedTexture(path, header, *_decode_texels(path, header))
     with _cache_lock:
         _cache[key] = texture
-        while sum(t.held_bytes for t in _cache.values()) > CACHE_BYTES and len(_cache) > 1:
-            _cache.popitem(last=False)
+        _evict(0)
     return texture
+
+
+def _evict(incoming: int) -> None:
+    """Drop the least recently used textures until those kept and ``incoming`` bytes fit :data:`CACHE_BYTES`
+    (the last one kept whatever its size), and hand the memory they freed back to the system. Called holding
+    the cache's lock."""
+    evicted = False
+    while _cache and sum(t.held_bytes for t in _cache.values()) + incoming > CACHE_BYTES and (
+            incoming or len(_cache) > 1):
+        _cache.popitem(last=False)
+        evicted = True
+    if evicted:
+        _trim_heap()
+
+
+def _trim_heap() -> None:
+    """Return the heap's free memory to the system (glibc ``malloc_trim``; a no-op elsewhere). A texture's
+    pyramid levels are under glibc's mmap threshold (16 MiB at 4096 x 4096): freed, they stay with the process
+    (``affinity check`` keeps up to 256 MiB of freed heap for the parser's temporaries), and a folder of
+    textures grew by them."""
+    import ctypes
+
+    try:
+        ctypes.CDLL(None).malloc_trim(0)
+    except (OSError, AttributeError):
+        pass
 
 
 #: Pillow's image class per header format, opened directly: ``Image.open`` would first import every common
