@@ -3,7 +3,7 @@
 - A regular file (or a new path) gets a temporary file beside it, renamed over
   it when complete; an existing file keeps its permission bits.
 - A symbolic link is followed: its target is replaced that way, and the link
-  stays a link.
+  stays a link (commands refuse such a destination first: below).
 - A character device, FIFO or socket (``-o /dev/stdout``, ``-o /dev/null``, a
   named pipe) cannot be replaced: the whole output is built in memory and
   written to it once, so a failure while producing it writes nothing.
@@ -16,6 +16,16 @@ writer fails, is interrupted or gets SIGTERM (see
 :func:`affinity.cli.console_main`); one left by a writer that was killed
 outright (SIGKILL, a power cut) is removed by the next write to NAME, once no
 process PID is running.
+
+Commands check their destinations first (:func:`refuse_unsafe`): an output path
+(``affinity fix``'s default ``NAME.fixed.EXT``, the ``-o`` of check, merge, render, report and
+fix) that is a symbolic link to a file, or to nothing yet, is refused: an asset repository that
+commits ``vase.fixed.obj -> vase.obj`` (or a link to any other file) would otherwise turn a fix
+in CI into a write of the link's target. A link to a device, FIFO or socket is a stream and is
+written as above; so is a link to one of the process's own descriptors (``-o /dev/stdout``, a
+link to ``/proc/self/fd/1``, whatever the shell redirected it to). A path that resolves (links,
+``..``) to one of the run's inputs is refused too, so no input is replaced before it is read
+(``affinity fix a.obj a.fixed.obj``); ``--in-place`` asks for its own input to be replaced.
 """
 
 from __future__ import annotations
@@ -26,6 +36,7 @@ import io
 import os
 import stat
 import sys
+from collections.abc import Iterable
 from pathlib import Path
 
 #: The output path that means standard output.
@@ -126,3 +137,47 @@ def _write_once(target: Path | None, binary: bool):
         view = memoryview(data)
         while view:  # a pipe may take less than everything at once
             view = view[out.write(view):]
+
+
+class UnsafeDestination(OSError):
+    """An output path refused; ``strerror`` says why, in words that follow the path."""
+
+    def __init__(self, path, reason: str):
+        super().__init__(errno.EPERM, reason, os.fspath(path))
+
+
+def refuse_unsafe(path, inputs: Iterable = ()) -> None:
+    """Raise :class:`UnsafeDestination` when ``path`` is a symbolic link to a file (or a dangling one), or
+    resolves to one of ``inputs`` (paths of the run's input files); return quietly otherwise."""
+    if os.fspath(path) == STDOUT or _descriptor(os.fspath(path)):
+        return
+    try:
+        link = os.lstat(path)
+    except OSError:
+        link = None
+    if link is not None and stat.S_ISLNK(link.st_mode):
+        try:
+            target_mode = os.stat(path).st_mode
+        except OSError:
+            target_mode = None
+        streams = target_mode is not None and not (stat.S_ISREG(target_mode) or stat.S_ISDIR(target_mode))
+        if not streams and not _descriptor(os.readlink(path)):
+            raise UnsafeDestination(path, f"is a symbolic link (to {os.readlink(path)}): an output is never "
+                                          "written through a link; remove it or name a plain file")
+    real = os.path.realpath(path)
+    for source in inputs:
+        if os.path.realpath(source) == real:
+            raise UnsafeDestination(path, f"is the input {os.fspath(source)}: an output never replaces an input")
+
+
+def _descriptor(name: str) -> bool:
+    """Whether ``name`` names one of the process's own open descriptors (``/dev/stdout``, ``/dev/fd/N``).
+
+    >>> _descriptor("/proc/self/fd/1"), _descriptor("/dev/stderr"), _descriptor("out.json")
+    (True, True, False)
+    """
+    return name.startswith(_DESCRIPTORS) or name in ("/dev/stdout", "/dev/stderr")
+
+
+#: Where a link to one of the process's open descriptors points.
+_DESCRIPTORS = ("/proc/self/fd/", "/dev/fd/")

@@ -217,3 +217,12 @@ def test_each_shard_keeps_its_own_cache_file(library, tmp_path):
         affinity(library, "check", "--shard", f"{k}/2", ".", env=env)
     names = sorted(p.name for p in (tmp_path / "cache").glob("*.sqlite"))
     assert len(names) == 2 and names[0].endswith("-shard-1-of-2.sqlite") and names[1].endswith("-shard-2-of-2.sqlite")
+
+
+def test_a_journal_behind_a_link_is_refused_and_its_target_unchanged(library, tmp_path):
+    target = tmp_path / "elsewhere.txt"
+    target.write_text("keep me\n")
+    (tmp_path / "run.jsonl").symlink_to(target)
+    result = affinity(library, "check", "--no-cache", "--resume", str(tmp_path / "run.jsonl"), ".")
+    assert result.returncode == 2 and "is a symbolic link" in result.stderr and result.stderr.count("\n") == 1
+    assert target.read_text() == "keep me\n"

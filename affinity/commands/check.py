@@ -192,7 +192,7 @@ def add_gate_arguments(p) -> None:
                         "crease; warning also fails on the milder ones)")
     p.add_argument("--level", choices=LEVELS,
                    help="show only the findings at this level or above: error prints what fails the default gate "
-                        "(default: every level; the exit code still counts every finding)")
+                        "(default: every level, in JUnit warning; the exit code still counts every finding)")
     p.add_argument("--exit-zero", action="store_true",
                    help="exit 0 even with findings (unreadable input and --fail-on-skip still exit 2)")
     p.add_argument("--fail-on-skip", action="store_true",
@@ -328,8 +328,11 @@ def _journal(path: str | None, settings, tasks: list, shard: ShardRecord | None)
     from ..shards.results import ResultError
     from ..shards.selection import run_digest
 
+    from ..atomic import refuse_unsafe
+
     header = header_of(settings, len(tasks), run_digest([p for p, _ in tasks]), shard)
     try:
+        refuse_unsafe(path, [p for p, _ in tasks])  # a journal is written: never through a link, never an input
         journal = Journal(path, header)
     except ResultError as err:
         raise UsageError(f"--resume {printable(path)}: {err}") from None
@@ -353,6 +356,21 @@ def _journaled(journal, todo: list[int], settings, progress):
     if progress is None:
         return record
     return lambda results, total: progress(record(results, total), total)
+
+
+#: The lowest level JUnit lists without ``--level``: its testcases are what may fail, and info findings never
+#: fail a gate (a folder's 150,000 of them were 60 MB of passing testcases).
+JUNIT_LEVEL = "warning"
+
+
+def _require_some_rule(settings) -> None:
+    """A usage error when ``--select``/``--ignore`` (with the configuration) leave no rule to check: a gate
+    that checks nothing would pass every file, silently."""
+    from ..rules.registry import resolve_codes
+
+    if not resolve_codes(settings.select, settings.ignore):
+        raise UsageError(f"the selection leaves no rule to check (select {', '.join(settings.select or ['ALL'])}; "
+                         f"ignore {', '.join(settings.ignore or [])})")
 
 
 def _write_baseline(reports, path: str, quiet: bool) -> None:
@@ -384,6 +402,7 @@ def run(args) -> int:
                          "not to a journal")
     args.shard = _resolved_shard(args.shard)
     resolver = Resolver(_overrides(args), config=args.config, isolated=args.isolated)
+    _require_some_rule(resolver.resolve(os.curdir).settings)
     paths = list(args.paths)
     if args.demo:
         from ..scenes import demo_paths
@@ -441,11 +460,13 @@ def publish(check_run, args) -> int:
     ``-q``) and return the run's exit code (``--fail-on``, ``--exit-zero``, ``--fail-on-skip``; design.md): the
     gate counts every finding, whatever ``--level`` shows."""
     gated = check_run.reports
-    if args.level is not None:
+    level = args.level if args.level is not None or args.format != "junit" else JUNIT_LEVEL
+    if level is not None:
         from ..output import at_or_above
 
-        check_run.reports, check_run.hidden = at_or_above(check_run.reports, args.level)
-    _write_output_file(args.output_file, lambda out: _write_output(check_run, args, out))
+        check_run.reports, check_run.hidden = at_or_above(check_run.reports, level)
+    inputs = [report.path for report in check_run.reports] + list(getattr(args, "results", []))
+    _write_output_file(args.output_file, lambda out: _write_output(check_run, args, out), inputs)
     if _failed(check_run.reports, args.fail_on_skip):
         return EXIT_ERROR
     return EXIT_CLEAN if args.exit_zero or not _fails(gated, args.fail_on) else EXIT_FINDINGS
@@ -463,15 +484,17 @@ def _fails(reports, fail_on: str) -> bool:
     return any(len(h) and h.level_ranks().min() <= LEVELS.index(fail_on) for r in reports for h in r.hits)
 
 
-def _write_output_file(path: str | None, write) -> None:
+def _write_output_file(path: str | None, write, inputs=()) -> None:
     """``write(out)`` to stdout, or to ``path`` atomically (a failed run leaves no partial file; ``-`` is
-    standard output, written whole too)."""
+    standard output, written whole too); never through a link to a file, nor over one of ``inputs``
+    (:func:`affinity.atomic.refuse_unsafe`)."""
     if path is None:
         write(sys.stdout)
         return
-    from ..atomic import atomic_write
+    from ..atomic import atomic_write, refuse_unsafe
 
     try:
+        refuse_unsafe(path, inputs)
         with atomic_write(path) as out:
             write(out)
     except OSError as err:

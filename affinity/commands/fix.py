@@ -185,6 +185,10 @@ def _fix_one(path: str, resolver, args) -> dict:
             from ..fix.write import write_fixed
 
             out = _output_path(path, args)
+            if not args.in_place:
+                from ..atomic import refuse_unsafe
+
+                refuse_unsafe(out, args.paths)
             entry["notes"] = write_fixed(path, out, mesh, plan, f"affinity fix: {summary(plan)}")
             entry["output"] = out
     except OSError as err:

@@ -70,6 +70,9 @@ def run(args) -> int:
     except (TextureError, ValueError) as err:
         raise UsageError(str(err)) from None
     try:
+        from ..atomic import refuse_unsafe
+
+        refuse_unsafe(args.output, [path for path in (args.mesh, args.texture) if path])
         result.save_png(args.output)
     except OSError as err:
         raise UsageError(f"{printable(args.output)}: cannot write ({err.strerror or err})") from None

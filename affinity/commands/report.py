@@ -103,6 +103,18 @@ def _inputs(paths: list[str], resolver) -> list:
     return found
 
 
+def _refuse_unsafe(path: str, inputs: list[str]) -> None:
+    """Fail before the work when ``path`` is a link to a file or one of the inputs
+    (:func:`affinity.atomic.refuse_unsafe`)."""
+    from ..atomic import UnsafeDestination, refuse_unsafe
+    from ..output.names import printable
+
+    try:
+        refuse_unsafe(path, [source for source in inputs if source])
+    except UnsafeDestination as err:
+        raise UsageError(f"{printable(path)}: cannot write the report: {err.strerror}") from None
+
+
 def _write(path: str, html: str) -> None:
     from ..atomic import atomic_write
     from ..output.names import printable
@@ -140,6 +152,7 @@ def run(args) -> int:
                             place_faces=args.place_faces)
     resolver = Resolver({})
     inputs = _inputs(args.meshes, resolver)
+    _refuse_unsafe(args.output, [mesh.path for mesh in inputs] + [args.texture or ""])
     with tqdm(total=len(inputs), unit="file", file=sys.stderr, leave=False, delay=1.0,
               disable=args.quiet or not sys.stderr.isatty()) as bar:
         report = collect_run(inputs, lambda path: resolver.resolve(path).settings.for_file(path),

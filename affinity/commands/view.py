@@ -25,7 +25,7 @@ def add_parser(sub) -> None:
     p.add_argument("mesh", metavar="MESH")
     p.add_argument("--attribute", choices=attribute_choices(), type=spelling,
                    help="the score to colour by (default: the first the mesh has of "
-                        f"{', '.join(attribute_choices())})")
+                        f"{', '.join(attribute_choices())} with a flagged quad)")
     p.add_argument("--up", choices=["x", "y", "z"], help="world up axis")
     p.add_argument("--screenshot", metavar="PNG", help="render off-screen into PNG instead of opening a window")
     p.set_defaults(run=run)
@@ -37,10 +37,16 @@ def _scores(mesh, path: str, attribute: str | None):
     from ..lint import quad_scores, scored_codes
     from ..output.names import printable
 
-    codes = scored_codes(mesh, attribute)  # without an attribute: uv, else colours, else normals
+    codes = scored_codes(mesh, attribute)  # uv, colours, normals: those the mesh has
     if not codes and attribute is not None:
         raise UsageError(f"{printable(path)}: the mesh has no {attribute} attribute to score")
-    return quad_scores(mesh, file_settings(path), codes[0]) if codes else None
+    if not codes:
+        return None
+    settings = file_settings(path)
+    scores = [quad_scores(mesh, settings, code) for code in codes[: 1 if attribute is not None else None]]
+    # without --attribute, the first attribute with a flagged quad: a vertex-coloured terrain's colour findings
+    # are what to see, not its clean uv
+    return next((s for s in scores if (s.values > s.threshold).any()), scores[0])
 
 
 def run(args) -> int:

@@ -54,6 +54,23 @@ _SCALE[256:] = -_SCALE[:256]
 _MINUS, _PLUS = ord("-"), ord("+")
 #: Digits below this make a float64 exactly (2**53).
 _EXACT = _U(1 << 53)
+#: The largest magnitude a coordinate or attribute value may have. The lint's arithmetic of
+#: highest degree is the squared length of the cross product of two edges: with every
+#: value within +-M an edge is at most 2 sqrt(3) M long and that square at most 144 M^4,
+#: finite (below 1.8e308) for M below 1.06e77; 1e75 leaves a factor of 100 for the terms
+#: around it. Attributes enter at degree 2 (times a texture size of up to 2^16), well
+#: within that. A file with a larger value is unreadable (Q901 at its line), not a storm
+#: of overflow warnings.
+LARGEST = 1e75
+
+
+def out_of_range(values: np.ndarray) -> np.ndarray:
+    """Bool, shaped like ``values``: NaN, infinite, or of magnitude above :data:`LARGEST`.
+
+    >>> out_of_range(np.array([1e75, -1e76, np.inf, np.nan, 0.0])).tolist()
+    [False, True, True, True, False]
+    """
+    return ~(np.abs(values) <= LARGEST)
 
 
 def words(buf: np.ndarray) -> np.ndarray:
@@ -242,18 +259,18 @@ def parse_floats(buf, starts, ends, finite=False):
         NaN/inf only where the token spells them (``nan``, ``inf``, ``1e999``).
     bad : (n,) int64
         Flat indices of the tokens that are not numbers (``values`` there is NaN),
-        and with ``finite`` also of those that are NaN or infinite.
+        and with ``finite`` also of those that are NaN, infinite or beyond :data:`LARGEST`.
     """
     mantissa, scale_index, _, ok = _fixed_decimals(buf, starts, ends, allow_dot=True)
     values = mantissa.view(np.int64).astype(np.float64)  # < 2**53 where ok: exact
     values /= _SCALE[scale_index]
-    if ok.all():  # only slow tokens can be NaN or infinite
+    if ok.all():  # only slow tokens can be NaN, infinite or large (the fast ones are below 1e16)
         return values, np.zeros(0, dtype=np.int64)
     slow = np.flatnonzero(~ok)
     flat = values.reshape(-1)
     flat[slow], failed = _slow_floats(buf, starts.reshape(-1)[slow], ends.reshape(-1)[slow])
     if finite:
-        failed |= ~np.isfinite(flat[slow])
+        failed |= out_of_range(flat[slow])
     return values, slow[failed]
 
 
@@ -316,3 +333,12 @@ def parse_ints(buf, starts, ends):
             break  # the first is the error; junk of millions of tokens is not read one by one
     values.reshape(-1)[rest] = signed
     return values, np.array(bad, dtype=np.int64)
+
+
+def out_of_range_reason(value) -> str:
+    """The reason a file with the finite ``value`` beyond :data:`LARGEST` is unreadable.
+
+    >>> print(out_of_range_reason(1e300))
+    value 1e+300 is out of range: magnitudes above 1e+75 overflow the lint's arithmetic
+    """
+    return f"value {value} is out of range: magnitudes above {LARGEST:g} overflow the lint's arithmetic"

@@ -15,6 +15,7 @@ import numpy as np
 from ..errors import MeshError
 from ..mesh import Mesh
 from .faces import polygon_mesh, ragged_positions, unit_colors
+from .numbers import out_of_range, out_of_range_reason
 from .regular import open_regular
 from .text import read_rows
 
@@ -41,7 +42,7 @@ def load_off(path) -> Mesh:
         raise MeshError(path, int(rows.number[row]), f"vertex line has {width[row]} numbers")
     first = rows.first[:n_vertices]
     vertex_values = rows.values[: rows.first[n_vertices]]
-    infinite = ~np.isfinite(vertex_values)
+    infinite = out_of_range(vertex_values)
     if infinite.any():
         row = np.searchsorted(rows.first, np.flatnonzero(infinite), side="right") - 1
         column = np.flatnonzero(infinite) - first[row]
@@ -50,7 +51,9 @@ def load_off(path) -> Mesh:
         allowed = (has_color & (column >= colour) & (column < width[row] - 2 * has_st)
                    & np.isnan(vertex_values[infinite]))
         if not allowed.all():
-            raise MeshError(path, int(rows.number[row[np.argmax(~allowed)]]), "coordinate is not finite")
+            value = vertex_values[infinite][np.argmax(~allowed)]
+            raise MeshError(path, int(rows.number[row[np.argmax(~allowed)]]),
+                            out_of_range_reason(value) if np.isfinite(value) else "coordinate is not finite")
 
     def columns(offset, count):
         return rows.values[first[:, None] + offset + np.arange(count)]

@@ -25,6 +25,7 @@ import numpy as np
 from ..errors import MeshError, SkippedFile
 from ..mesh import Mesh
 from .faces import check_indices, polygon_mesh, ragged_positions, unit_colors, whole_indices
+from .numbers import out_of_range, out_of_range_reason
 from .regular import open_regular
 from .text import read_rows
 
@@ -52,6 +53,10 @@ class _Element:
     count: int
     properties: list
     line: int  # header line, for messages
+
+
+#: The key of the ASCII rows past the declared elements (their line numbers) among an ASCII file's columns.
+TRAILING = ":trailing lines"
 
 
 def load_ply(path) -> Mesh:
@@ -150,9 +155,9 @@ def _read_ascii(path, fh, elements, header_lines):
     if len(rows.number) < needed:
         last = int(rows.number[-1]) if len(rows.number) else header_lines
         raise MeshError(path, last, f"truncated: {len(rows.number)} data lines for {needed} element rows")
-    if len(rows.number) > needed:
-        raise MeshError(path, int(rows.number[needed]), "more data lines than the header declares")
-    columns, done = {}, 0
+    # Rows past the declared elements (trimesh's points_emptyascii.ply has one more vertex line than its header
+    # says) are left unread, as trimesh and other readers leave them, and named in a note.
+    columns, done = {TRAILING: rows.number[needed:]}, 0
     for element in elements:
         span = slice(done, done + element.count)
         first, limit = rows.first[span], rows.first[done + 1 : done + element.count + 1]
@@ -299,7 +304,10 @@ def _mesh(path, elements, columns) -> Mesh:
         raise MeshError(path, elements[names.index("face")].line, "face element has no vertex_indices list")
     sizes, corner_vertex = indices if indices is not None else (np.zeros(0, np.int64), np.zeros(0))
     face_line = columns.get("face:lines", np.zeros(len(sizes), np.int64))
-    notes = []
+    trailing = columns.get(TRAILING, ())
+    notes = [] if not len(trailing) else [
+        f"{len(trailing)} data line{'s' * (len(trailing) != 1)} after the elements the header declares "
+        f"(from line {int(trailing[0])}) not read"]
     strips = columns.get("tristrips", {})
     strips = strips.get("vertex_indices", strips.get("vertex_index"))
     if strips is not None and len(sizes) == 0:
@@ -374,8 +382,12 @@ def strip_triangles(counts, items, row_lines):
             np.asarray(row_lines, dtype=np.int64)[row[:-2][keep]], int((whole & degenerate).sum()))
 
 def _require_finite(path, values, lines) -> None:
-    """MeshError at the line of the first row of ``values`` (n, k) with a NaN or inf."""
-    bad = ~np.isfinite(values).all(axis=1)
+    """MeshError at the line of the first row of ``values`` (n, k) with a NaN, an inf or a value
+    beyond :data:`~.numbers.LARGEST`."""
+    bad = out_of_range(values).any(axis=1)
     if bad.any():
         row = int(np.argmax(bad))
-        raise MeshError(path, lines if np.isscalar(lines) else int(lines[row]), f"value {values[row]} is not finite")
+        line = lines if np.isscalar(lines) else int(lines[row])
+        if np.isfinite(values[row]).all():
+            raise MeshError(path, line, out_of_range_reason(values[row][out_of_range(values[row])][0]))
+        raise MeshError(path, line, f"value {values[row]} is not finite")

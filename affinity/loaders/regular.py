@@ -50,19 +50,19 @@ def not_regular(mode: int) -> str | None:
     return f"{kind}, not a regular file{NOT_READ}"
 
 
-def open_regular(path, budget: int | None = None):
+def open_regular(path, budget: int | None = None, kind: str = "a side file"):
     """The regular file at ``path`` opened for reading bytes (a buffered binary file object).
 
     Raises :class:`RefusedFile` (an ``OSError``) for a FIFO, socket, device or directory,
-    and, with ``budget``, for a file of more than ``budget`` bytes; other ``OSError`` s
-    (missing, no permission) as :func:`open` raises them.
+    and, with ``budget``, for a file of more than ``budget`` bytes (``kind`` names the budget's
+    files in the reason); other ``OSError`` s (missing, no permission) as :func:`open` raises them.
     """
     fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0) | getattr(os, "O_BINARY", 0))
     try:
         info = os.fstat(fd)
         reason = not_regular(info.st_mode)
         if reason is None and budget is not None and info.st_size > budget:
-            reason = f"is {_size(info.st_size)}, over the {_size(budget)} budget of a side file{NOT_READ}"
+            reason = f"is {_size(info.st_size)}, over the {_size(budget)} budget of {kind}{NOT_READ}"
         if reason is not None:
             raise RefusedFile(path, reason)
         os.set_blocking(fd, True)
@@ -72,13 +72,13 @@ def open_regular(path, budget: int | None = None):
         raise
 
 
-def read_regular(path, budget: int | None = None) -> bytes:
+def read_regular(path, budget: int | None = None, kind: str = "a side file") -> bytes:
     """Every byte of the regular file at ``path`` (see :func:`open_regular`); at most ``budget``
     bytes, :class:`RefusedFile` when the file holds more (also when it grew while read)."""
-    with open_regular(path, budget) as fh:
+    with open_regular(path, budget, kind) as fh:
         data = fh.read() if budget is None else fh.read(budget + 1)
     if budget is not None and len(data) > budget:
-        raise RefusedFile(path, f"grew past the {_size(budget)} budget of a side file while read{NOT_READ}")
+        raise RefusedFile(path, f"grew past the {_size(budget)} budget of {kind} while read{NOT_READ}")
     return data
 
 

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import MeshError
-from .numbers import PAD, parse_floats
+from .numbers import PAD, out_of_range_reason, parse_floats
 from .regular import open_regular
 
 #: Bytes read per chunk: large enough that per-chunk overhead (and the GIL it holds,
@@ -378,11 +378,14 @@ def _drop_comments(buf, starts, ends, line_end):
 
 def floats_or_raise(tokens: Tokens, path, which: np.ndarray, finite: bool = False) -> np.ndarray:
     """(n,) float64 values of the tokens ``which``; MeshError on the first that is
-    not a number (or, with ``finite``, not a finite one)."""
+    not a number (or, with ``finite``, not a finite one within :data:`~.numbers.LARGEST`)."""
     values, bad = parse_floats(tokens.buf, tokens.starts[which], tokens.ends[which], finite)
     if len(bad):
         token = which[bad[0]]
-        kind = "a number" if np.isnan(values[bad[0]]) and "nan" not in tokens.text(token).lower() else "a finite number"
+        value = values[bad[0]]
+        if np.isfinite(value):
+            raise MeshError(path, tokens.line_of_token(token), out_of_range_reason(tokens.text(token)))
+        kind = "a number" if np.isnan(value) and "nan" not in tokens.text(token).lower() else "a finite number"
         raise MeshError(path, tokens.line_of_token(token), f"not {kind}: {tokens.text(token)!r}")
     return values
 

@@ -52,6 +52,7 @@ import numpy as np
 from ..errors import MeshError, SkippedFile
 from ..mesh import Mesh
 from .formats import format_named
+from .numbers import out_of_range, out_of_range_reason
 from .resources import Resource
 from .usdlayers import geometry_source, layer_assets, may_hold_mesh, prim_type_names, regular_layers, subdivision_note
 
@@ -238,14 +239,22 @@ def _mesh_prims(stage, time) -> tuple[list, list[str]]:
     return prims, notes
 
 
-def _array(value, dtype, width: int | None = None) -> np.ndarray:
-    """A ``Vt`` array (None when unauthored) as NumPy: (n,) or (n, width)."""
+def _array(attribute, time, dtype, width: int | None = None) -> np.ndarray:
+    """The ``Vt`` array value of ``attribute`` at ``time`` (empty when unauthored) as NumPy: (n,) or (n, width);
+    _BadPrim when it is of another type (``string points``: not numbers, or not ``width`` of them)."""
     shape = (-1,) if width is None else (-1, width)
-    return np.asarray([] if value is None else value, dtype=dtype).reshape(shape)
+    value = attribute.Get(time)
+    try:
+        return np.asarray([] if value is None else value, dtype=dtype).reshape(shape)
+    except (ValueError, TypeError):
+        raise _BadPrim(f"{attribute.GetName()} holds {type(value).__name__} values, not "
+                       f"{'numbers' if width is None else f'{width}-component values'}") from None
 
 
 def _finite(name: str, values: np.ndarray) -> np.ndarray:
-    if not np.isfinite(values).all():
+    if out_of_range(values).any():
+        if np.isfinite(values).all():
+            raise _BadPrim(f"{name}: {out_of_range_reason(values[out_of_range(values)][0])}")
         raise _BadPrim(f"{name} has NaN or Inf values")
     return values
 
@@ -255,9 +264,9 @@ def _read_prim(prim, time, xforms, uv_primvar: str | None) -> Mesh:
     from pxr import UsdGeom
 
     usd_mesh = UsdGeom.Mesh(prim)
-    points = _finite("points", _array(usd_mesh.GetPointsAttr().Get(time), np.float64, 3))
-    sizes = _array(usd_mesh.GetFaceVertexCountsAttr().Get(time), np.int64)
-    corner_vertex = _array(usd_mesh.GetFaceVertexIndicesAttr().Get(time), np.int64)
+    points = _finite("points", _array(usd_mesh.GetPointsAttr(), time, np.float64, 3))
+    sizes = _array(usd_mesh.GetFaceVertexCountsAttr(), time, np.int64)
+    corner_vertex = _array(usd_mesh.GetFaceVertexIndicesAttr(), time, np.int64)
     _check_topology(sizes, corner_vertex, len(points))
     face_start = np.concatenate(([0], np.cumsum(sizes)))
     matrix = np.array(xforms.GetLocalToWorldTransform(prim))  # (4, 4), row vectors: p' = p M
@@ -329,11 +338,14 @@ def _primvar(primvar, time, width: int) -> _Primvar | None:
         return None
     name = primvar.GetAttr().GetName()
     values = primvar.Get(time)
-    values = np.asarray([] if values is None else values, dtype=np.float64)
+    try:
+        values = np.asarray([] if values is None else values, dtype=np.float64)
+    except (ValueError, TypeError):
+        raise _BadPrim(f"{name} holds {type(values).__name__} values, not {width}-component values") from None
     if values.size and (values.ndim != 2 or values.shape[1] != width):
         raise _BadPrim(f"{name} is {primvar.GetTypeName()}, not {width}-component values")
     values = values.reshape(-1, width)
-    indices = _array(primvar.GetIndices(time), np.int64) if primvar.IsIndexed() else None
+    indices = _array(primvar.GetIndicesAttr(), time, np.int64) if primvar.IsIndexed() else None
     return _Primvar(name, _finite(name, values), str(primvar.GetInterpolation()), indices)
 
 
@@ -360,7 +372,7 @@ def _normals(usd_mesh, primvars, time) -> _Primvar | None:
     normals = _primvar(primvars.GetPrimvar("normals"), time, width=3)
     if normals is not None or not usd_mesh.GetNormalsAttr().HasValue():
         return normals
-    values = _finite("normals", _array(usd_mesh.GetNormalsAttr().Get(time), np.float64, 3))
+    values = _finite("normals", _array(usd_mesh.GetNormalsAttr(), time, np.float64, 3))
     return _Primvar("normals", values, str(usd_mesh.GetNormalsInterpolation()))
 
 

@@ -22,6 +22,7 @@ from __future__ import annotations
 import os
 import xml.etree.ElementTree as ElementTree
 
+from .regular import SIDE_FILE_BUDGET, read_regular
 from .texturemaps import TextureMap
 
 #: Surface shader inputs by role (UsdPreviewSurface, standard_surface, open_pbr_surface, gltf_pbr).
@@ -145,7 +146,7 @@ def mtlx_document_maps(path: str, material: str | None = None, every: bool = Fal
     first; with ``every``, of every material) in the MaterialX document ``path``; empty when it cannot be
     read."""
     try:
-        root = ElementTree.parse(path).getroot()
+        root = ElementTree.fromstring(read_regular(path, SIDE_FILE_BUDGET))  # a FIFO would block for good
     except (OSError, ElementTree.ParseError):
         return []
     nodes = _named_nodes(root)

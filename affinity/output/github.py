@@ -17,6 +17,7 @@ values also ``:`` and ``,``.
 
 from __future__ import annotations
 
+import re
 import sys
 from typing import TextIO
 
@@ -45,10 +46,14 @@ _DATA_ESCAPES = (("%", "%25"), ("\r", "%0D"), ("\n", "%0A"))
 _PROPERTY_ESCAPES = _DATA_ESCAPES + ((":", "%3A"), (",", "%2C"))
 
 
+#: The other C0 controls and DEL (ESC would reach a terminal that shows the log raw): percent-escaped too.
+_CONTROLS = re.compile("[\\x00-\\x08\\x0b\\x0c\\x0e-\\x1f\\x7f]")
+
+
 def _escape(text: str, escapes) -> str:
     for raw, escaped in escapes:  # "%" first, so escapes are not escaped again
         text = text.replace(raw, escaped)
-    return text
+    return _CONTROLS.sub(lambda control: f"%{ord(control[0]):02X}", text)
 
 
 def annotation(level: str, message: str, file: str, line: int = 0, col: int = 0, title: str = "") -> str:

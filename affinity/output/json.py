@@ -52,6 +52,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
 from typing import TextIO
 
 import numpy as np
@@ -109,10 +110,19 @@ def _finding_rows(settings):
 
 def json_values(c: Columns) -> np.ndarray:
     """(n, w) uint8: the values as JSON text (:func:`.rows.formatted`): a finite float as repr writes it, as
-    ``json`` does; NaN and the infinities as ``NaN``, ``Infinity``, ``-Infinity``."""
+    ``json`` does; NaN and the infinities, which strict JSON (RFC 8259) has no token for, as ``null``."""
     if np.isfinite(c.values).all():
         return rows.floats(c.value, "%r")
-    return rows.formatted(list(map(json.dumps, c.value)), "%s")
+    return rows.formatted([json_number(value) for value in c.value], "%s")
+
+
+def json_number(value: float) -> str:
+    """``value`` as strict JSON text: ``null`` for NaN and the infinities.
+
+    >>> json_number(0.1), json_number(float("inf"))
+    ('0.1', 'null')
+    """
+    return json.dumps(value) if math.isfinite(value) else "null"
 
 
 def _ends(c: Columns, unit: str, tail: str) -> tuple[np.ndarray, list[str]]:
@@ -141,7 +151,7 @@ def _summary(run: CheckRun) -> dict:
 
 def write(run: CheckRun, out: TextIO) -> None:
     """The document, its findings streamed file by file (in source order within a file)."""
-    compact = {"separators": (",", ":")}
+    compact = {"separators": (",", ":"), "allow_nan": False}
     head = {"schema": SCHEMA, "version": VERSION, "settings": dataclasses.asdict(run.settings),
             "files": [_file_entry(r) for r in run.reports]}
     out.write(json.dumps(head, **compact)[:-1] + ',"findings":[')

@@ -9,7 +9,8 @@ measurement); one below it is reported
 without failing, its text line in the testcase's ``<system-out>``, so the
 report's failures are what fails the run. A clean file gets one passing
 testcase, an unreadable file one testcase with an ``<error>`` (type Q901), a
-skipped file one with ``<skipped>``.
+skipped file one with ``<skipped>``. Without ``--level``, ``affinity check`` leaves the info
+findings out of JUnit (:data:`affinity.commands.check.JUNIT_LEVEL`): they never fail a gate.
 
 The XML is written as text, file by file and a block of findings at a time:
 time and memory grow with the findings, with small constants. Characters XML

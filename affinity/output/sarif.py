@@ -72,7 +72,7 @@ from . import (
     working_relative,
 )
 from .cap import cap_findings
-from .json import json_values
+from .json import json_number, json_values
 
 SARIF_VERSION = "2.1.0"
 SARIF_SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
@@ -203,7 +203,7 @@ def _result_rows(location: dict, rule_index: dict[str, int]):
                 f'{head}{sarif_level(level)}","message":{{"text":{encode(f"{text}, {label}" if label else text)}}},'
                 f'"locations":[{compact(located)}],'
                 f'"partialFingerprints":{{"{FINGERPRINT}":"{identity}"}},'
-                f'"properties":{{"name":{encode(c.name)},"face":{face},"value":{encode(value)}{shared}{level}",'
+                f'"properties":{{"name":{encode(c.name)},"face":{face},"value":{json_number(value)}{shared}{level}",'
                 f'"group":{encode(group)}{"" if prim is None else PRIM + encode(prim)}}}}}')
         return results
 
@@ -356,5 +356,5 @@ RESULTS = "\0results\0"
 
 def write(run: CheckRun, out: TextIO) -> None:
     log, results = document(run)
-    head, tail = json.dumps(log, separators=(",", ":")).split(json.dumps(RESULTS), 1)
+    head, tail = json.dumps(log, separators=(",", ":"), allow_nan=False).split(json.dumps(RESULTS), 1)
     out.write(head + results + tail + "\n")

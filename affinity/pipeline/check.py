@@ -177,21 +177,26 @@ def _workers(tasks: list[tuple[str, Settings]], jobs: int | None) -> int:
 
 def _check_here(tasks: list[tuple[str, Settings]], jobs: int | None, usd) -> Iterator[FileReport]:
     """The reports of ``tasks`` in order, checked in this process or a local process pool."""
-    paths = [path for path, _ in tasks]
-    settings = [s for _, s in tasks]
     check = partial(check_file, usd=usd)
     workers = _workers(tasks, jobs)
     if workers <= 1:
-        yield from map(check, paths, settings)
+        yield from (check(path, settings) for path, settings in tasks)
         return
 
     from .. import lint, loaders  # noqa: F401  imported before the workers fork, so each inherits them
-    from .workers import local_pool
+    from .workers import map_in_workers
 
     # Small chunks balance uneven file sizes; a few per worker keep the pickling overhead low.
     chunksize = max(1, len(tasks) // (workers * 8))
-    with local_pool(workers) as pool:
-        yield from pool.map(check, paths, settings, chunksize=chunksize)
+    yield from map_in_workers(check, tasks, workers, chunksize, _worker_died)
+
+
+#: The Q901 reason of a file whose check killed its worker, and a fresh worker after it.
+WORKER_DIED = "worker died while checking it, and again in a fresh worker (killed, out of memory, or a crash)"
+
+
+def _worker_died(task: tuple[str, Settings]) -> FileReport:
+    return FileReport(task[0], error=WORKER_DIED, error_line=0, transient=True)
 
 
 def _tracked(results: Iterator, total: int, progress) -> Iterator:

@@ -15,6 +15,7 @@ from __future__ import annotations
 import base64
 import io
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -35,12 +36,25 @@ TEMPLATES = Path(__file__).parent / "templates"
 #: Stand-in for the view's style and scripts (three.js and ``templates/view3d.js``): the page puts them in after
 #: folding its line breaks (:func:`affinity.report.page.compact`), which three.js's shader strings need kept.
 VIEW_SCRIPTS = "\x00view scripts\x00"
+#: Largest float32: attribute values beyond it (uv at 1e70, say) are drawn clipped to it.
+_FLOAT32_MAX = float(np.finfo(np.float32).max)
 #: Outline colour of a flagged face by its worst finding's level.
 LEVEL_COLOURS = {"error": "#ff1a99", "warning": "#f59e0b", "info": "#3b82f6"}
 
 
 def _b64(array: np.ndarray, dtype) -> str:
     return base64.b64encode(np.ascontiguousarray(array, dtype=np.dtype(dtype).newbyteorder("<")).tobytes()).decode()
+
+
+def _view_scale(positions: np.ndarray) -> float:
+    """A power of two (exact) that brings ``positions`` (V, 3) float64 within 2^100, so their float32 copy in the
+    view is finite (the loaders allow magnitudes up to 1e75); 1.0 for a mesh already there.
+
+    >>> _view_scale(np.array([[1e75, 0.0, 0.0]])) * 1e75 <= 2.0**100, _view_scale(np.ones((1, 3)))
+    (True, 1.0)
+    """
+    largest = float(np.abs(positions).max(initial=0.0))
+    return 1.0 if largest <= 2.0**100 else 2.0 ** (100 - math.frexp(largest)[1])
 
 
 def kept_faces(mesh: Mesh, flagged: np.ndarray, budget: int) -> np.ndarray:
@@ -82,7 +96,8 @@ def _attribute_block(mesh: Mesh, corners: np.ndarray, field: str, settings) -> d
     visible = (settings.error_above(codes[0]) or RULES[codes[0]].visible_threshold) if codes else None
     attribute = ATTRIBUTES[field]
     return {"name": attribute.name, "width": attribute.width, "unit": attribute.unit, "visible": visible,
-            "values": _b64(np.nan_to_num(values), np.float32)}
+            "values": _b64(np.nan_to_num(values, posinf=_FLOAT32_MAX, neginf=-_FLOAT32_MAX).clip(
+                -_FLOAT32_MAX, _FLOAT32_MAX), np.float32)}
 
 
 def drawn_fields(result: MeshResult) -> list[str]:
@@ -172,9 +187,10 @@ def view_data(result: MeshResult, budget: int = VIEW_QUAD_BUDGET) -> tuple[dict,
         notes.append(f"the 3-D view keeps the {int((worst_level > 0).sum()):,} flagged faces and their "
                      f"neighbourhoods: {left:,} of {mesh.n_faces:,} faces are left out of it to keep the page small")
     eye, target, fov = result.camera
+    scale = _view_scale(mesh.positions[vertices])
     data = {
         "quads": len(faces),
-        "positions": _b64(mesh.positions[vertices], np.float32),
+        "positions": _b64(mesh.positions[vertices] * scale, np.float32),
         "corners": _b64(vertex_of.reshape(-1, 4), np.uint32),
         "faces": _b64(faces, np.uint32),
         "levels": _b64(worst_level[faces], np.uint8),
@@ -186,7 +202,7 @@ def view_data(result: MeshResult, budget: int = VIEW_QUAD_BUDGET) -> tuple[dict,
                   for code, rule in RULES.items()},
         "levels_order": list(LEVELS),
         "level_colours": LEVEL_COLOURS,
-        "camera": [*map(float, eye), *map(float, target), float(fov)],
+        "camera": [*(float(x) * scale for x in (*eye, *target)), float(fov)],
         "up": result.up,
         "left_out": left,
     }

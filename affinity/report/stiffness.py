@@ -100,7 +100,8 @@ def render_stability(render) -> SceneStability:
         return SceneStability(0, [])
     ndc, w = _screen_quads(render)
     quads = face[rows, cols]
-    keep = (w[quads] > 0).all(axis=1)
+    # a quad whose w leaves float32's range (coordinates near 1e38 and up) has no float32 render to compare
+    keep = (w[quads] > 0).all(axis=1) & (w[quads] < np.finfo(np.float32).max).all(axis=1)
     rows, cols, quads = rows[keep], cols[keep], quads[keep]
     height, width = face.shape
     p = np.stack([(cols + 0.5) * 2 / width - 1, 1 - (rows + 0.5) * 2 / height], axis=1)

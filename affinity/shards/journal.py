@@ -32,7 +32,14 @@ import os
 
 from ..findings import FileReport
 from ..settings import Settings
-from .results import CheckResult, ResultError, report_from_json, settings_from_json, shard_record_from_json
+from .results import (
+    CheckResult,
+    ResultError,
+    report_from_json,
+    settings_from_json,
+    shard_record_from_json,
+    strict_json,
+)
 from .selection import ShardRecord
 
 SCHEMA = "quad-affinity-journal"
@@ -167,16 +174,12 @@ def _read(path: str) -> tuple[tuple[Header, dict[int, FileReport]] | None, int]:
 
 def _parsed(line: bytes, number: int) -> dict:
     try:
-        doc = json.loads(line, parse_constant=_no_constant)
+        doc = strict_json(line.decode("utf-8"))
     except (ValueError, RecursionError) as err:
         raise ResultError(f"line {number}: not JSON ({type(err).__name__}: {str(err)[:80]})") from None
     if not isinstance(doc, dict):
         raise ResultError(f"line {number}: not a journal line")
     return doc
-
-
-def _no_constant(name: str):
-    raise ValueError(f"{name} is not JSON")
 
 
 def _header(doc: dict, number: int) -> tuple[Header, Settings]:

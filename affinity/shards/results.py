@@ -21,6 +21,7 @@ same output as the run itself. Four things are rebuilt rather than read:
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import dataclass, fields
 
 import numpy as np
@@ -31,6 +32,9 @@ from ..rules import RULES
 from ..settings import Settings
 from .selection import ShardRecord
 
+#: Bytes a shard's result may hold: some 2.5 million findings at about 400 bytes each (json.loads takes
+#: about ten times a document's size in memory).
+RESULT_BUDGET = 1 << 30
 #: Keys of a JSON file entry that are not face counts.
 _ENTRY_KEYS = {"path", "findings", "up_axis", "meters_per_unit", "notes"}
 
@@ -55,11 +59,16 @@ class CheckResult:
 
 def read_result(path: str) -> CheckResult:
     """Read the JSON result at ``path``; :class:`ResultError` when it cannot be read or is not one."""
+    from ..loaders.regular import RefusedFile, read_regular
+
     try:
-        with open(path, encoding="utf-8") as f:
-            doc = json.load(f)
+        doc = strict_json(read_regular(path, RESULT_BUDGET, "a check result").decode("utf-8"))
+    except RefusedFile as err:
+        raise ResultError(err.strerror) from None
     except OSError as err:
         raise ResultError(f"cannot read it: {err.strerror or err}") from None
+    except RecursionError:
+        raise ResultError("not a check result: JSON nested deeper than Python's reader takes") from None
     except (UnicodeDecodeError, ValueError) as err:
         raise ResultError(f"not JSON: {err}") from None
     if not isinstance(doc, dict) or doc.get("schema") != SCHEMA or doc.get("version") != VERSION:
@@ -75,6 +84,35 @@ def read_result(path: str) -> CheckResult:
         )
     except (KeyError, TypeError, ValueError, AttributeError, IndexError) as err:
         raise ResultError(f"a damaged affinity check result ({type(err).__name__}: {err})") from None
+
+
+def strict_json(text: str):
+    """``text`` parsed as RFC 8259 JSON whose numbers fit the result's columns: ValueError for ``NaN``,
+    ``Infinity``, a float beyond float64 (``1e400``) and an integer beyond int64, naming it (a
+    RecursionError for nesting deeper than Python's parser takes).
+
+    >>> strict_json('{"value": 1.5, "face": 3}')
+    {'value': 1.5, 'face': 3}
+    >>> strict_json('[1e400]')
+    Traceback (most recent call last):
+    ValueError: number out of range: 1e400
+    """
+
+    def refuse(number: str):
+        raise ValueError(f"number out of range: {number[:40]}")
+
+    def parse_float(number: str) -> float:
+        value = float(number)
+        return value if math.isfinite(value) else refuse(number)
+
+    def parse_int(number: str) -> int:
+        value = int(number) if len(number) <= 20 else refuse(number)
+        return value if -(1 << 63) <= value < 1 << 63 else refuse(number)
+
+    def constant(name: str):
+        raise ValueError(f"{name} is not a JSON number")
+
+    return json.loads(text, parse_float=parse_float, parse_int=parse_int, parse_constant=constant)
 
 
 def shard_record_from_json(entry: dict) -> ShardRecord:

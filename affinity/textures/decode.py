@@ -2,8 +2,8 @@
 
 A texture whose header claims more than :data:`DECODE_BUDGET` pixels is never
 decoded (a 100,000 x 100,000 PNG header would ask for 30 GB); decoded textures
-are kept as (H, W, 4) uint8 (four bytes a texel, as Pillow holds them), at most :data:`CACHE_BYTES` of them at a time
-(least recently used dropped first), keyed by path, size and modification time,
+are kept as (H, W, 4) uint8 (four bytes a texel, as Pillow holds them), at most :data:`CACHE_BYTES` of them and
+their pyramids at a time (least recently used dropped first), keyed by path, size and modification time,
 so each texture is decoded once per run however many meshes or rules read it.
 Peak memory for textures: :data:`CACHE_BYTES` plus one texture being decoded
 (at most ``DECODE_BUDGET x 4`` bytes, twice while Pillow hands its copy over) and its min/max
@@ -24,8 +24,10 @@ from .held import held_texture
 
 #: Pixels (width x height) a texture may have to be decoded: 8192 x 8192.
 DECODE_BUDGET = 1 << 26
-#: Decoded texture bytes kept between meshes of one run.
-CACHE_BYTES = 1 << 29
+#: Bytes of decoded textures and their pyramids kept between meshes of one run: four 4096 x 4096 textures.
+#: A folder run's peak is about this plus one mesh's work, whatever the number of meshes (measured in
+#: benchmarks/bench_texture_memory.py; 512 MiB let 32 meshes with their own 4K textures peak at 1.6x 4's).
+CACHE_BYTES = 1 << 28
 
 
 class TextureUnusable(Exception):
@@ -56,6 +58,13 @@ class DecodedTexture:
     channels: int
 
     @property
+    def held_bytes(self) -> int:
+        """Bytes the texture holds: its texels and the bands of its pyramids built so far (the decode cache's
+        measure: the pyramids of a texture read all over hold about 1.3 times its texels)."""
+        pyramids = [vars(self).get("pyramid"), *vars(self).get("slopes", ())]
+        return self.texels.nbytes + sum(p.built_bytes for p in pyramids if p is not None)
+
+    @property
     def pixels(self) -> np.ndarray:
         """(H, W, C) uint8, read-only: the texture's channels of :attr:`texels` (a view)."""
         return self.texels[..., :self.channels]
@@ -76,34 +85,12 @@ class DecodedTexture:
         texel moved. The steps are computed for the rows queries reach."""
         from .filtering import RangePyramid
 
+        # The pyramids hold the texels, not the texture: a bound method would make a cycle (texture ->
+        # pyramid -> method -> texture) that only the cyclic collector frees, long after the cache dropped it.
         height, width = self.texels.shape[:2]
-        return tuple(RangePyramid(minima=False, rows=partial(self._channel_steps, axis=axis),
-                                  fold=self._largest_step, shape=(height, width, 1)) for axis in (1, 0))
-
-    def _channel_steps(self, start: int, stop: int, axis: int) -> np.ndarray:
-        """(stop - start, W, 4) uint8: per channel of :attr:`texels`, |difference| from each texel of rows
-        ``start`` to ``stop`` to the next one along ``axis`` (1: the next column, 0: the next row), wrapping.
-        Whole four-byte texels are subtracted: contiguous, and no reduction per texel."""
-        texels = self.texels
-        rows = texels[start:stop]
-        steps = np.empty_like(rows)
-        if axis == 1:  # the last column wraps to the first
-            pairs = ((rows[:, :-1], rows[:, 1:], steps[:, :-1]), (rows[:, -1:], rows[:, :1], steps[:, -1:]))
-        else:  # the last row wraps to the first
-            pairs = ((rows[:-1], texels[start + 1:stop], steps[:-1]),
-                     (rows[-1:], texels[stop % len(texels)][None], steps[-1:]))
-        for texel, neighbour, out in pairs:  # |a - b| in uint8, no copy of the neighbours
-            np.maximum(texel, neighbour, out=out)
-            out -= np.minimum(texel, neighbour)
-        return steps
-
-    def _largest_step(self, steps: np.ndarray) -> np.ndarray:
-        """(..., 1) uint8: the largest of :meth:`_channel_steps`'s (..., 4) over the texture's channels
-        (elementwise: faster than a reduction over a short axis)."""
-        largest = steps[..., :1].copy()
-        for channel in range(1, self.channels):
-            np.maximum(largest, steps[..., channel:channel + 1], out=largest)
-        return largest
+        return tuple(RangePyramid(minima=False, rows=partial(_channel_steps, self.texels, axis=axis),
+                                  fold=partial(_largest_step, channels=self.channels), shape=(height, width, 1))
+                     for axis in (1, 0))
 
     @cached_property
     def packed(self):
@@ -121,6 +108,32 @@ class DecodedTexture:
         step = max(1, int(np.sqrt(self.pixels.shape[0] * self.pixels.shape[1] / 65536)))
         red, green, blue = self.pixels[::step, ::step, :3].reshape(-1, 3).mean(axis=0)
         return blue >= 0.7 * 255 and blue > red and blue > green
+
+
+def _channel_steps(texels: np.ndarray, start: int, stop: int, axis: int) -> np.ndarray:
+    """(stop - start, W, 4) uint8: per channel of ``texels`` (H, W, 4) uint8, |difference| from each texel of
+    rows ``start`` to ``stop`` to the next one along ``axis`` (1: the next column, 0: the next row), wrapping.
+    Whole four-byte texels are subtracted: contiguous, and no reduction per texel."""
+    rows = texels[start:stop]
+    steps = np.empty_like(rows)
+    if axis == 1:  # the last column wraps to the first
+        pairs = ((rows[:, :-1], rows[:, 1:], steps[:, :-1]), (rows[:, -1:], rows[:, :1], steps[:, -1:]))
+    else:  # the last row wraps to the first
+        pairs = ((rows[:-1], texels[start + 1:stop], steps[:-1]),
+                 (rows[-1:], texels[stop % len(texels)][None], steps[-1:]))
+    for texel, neighbour, out in pairs:  # |a - b| in uint8, no copy of the neighbours
+        np.maximum(texel, neighbour, out=out)
+        out -= np.minimum(texel, neighbour)
+    return steps
+
+
+def _largest_step(steps: np.ndarray, channels: int) -> np.ndarray:
+    """(..., 1) uint8: the largest of :func:`_channel_steps`'s (..., 4) over the texture's first ``channels``
+    (elementwise: faster than a reduction over a short axis)."""
+    largest = steps[..., :1].copy()
+    for channel in range(1, channels):
+        np.maximum(largest, steps[..., channel:channel + 1], out=largest)
+    return largest
 
 
 _cache: OrderedDict = OrderedDict()
@@ -178,12 +191,38 @@ def decode(path: str, budget: int = DECODE_BUDGET) -> DecodedTexture:
         if key in _cache:
             _cache.move_to_end(key)
             return _cache[key]
+        _evict(header.width * header.height * 4)  # room first: the texture and the one it replaces never both
     texture = DecodedTexture(path, header, *_decode_texels(path, header))
     with _cache_lock:
         _cache[key] = texture
-        while sum(t.texels.nbytes for t in _cache.values()) > CACHE_BYTES and len(_cache) > 1:
-            _cache.popitem(last=False)
+        _evict(0)
     return texture
+
+
+def _evict(incoming: int) -> None:
+    """Drop the least recently used textures until those kept and ``incoming`` bytes fit :data:`CACHE_BYTES`
+    (the last one kept whatever its size), and hand the memory they freed back to the system. Called holding
+    the cache's lock."""
+    evicted = False
+    while _cache and sum(t.held_bytes for t in _cache.values()) + incoming > CACHE_BYTES and (
+            incoming or len(_cache) > 1):
+        _cache.popitem(last=False)
+        evicted = True
+    if evicted:
+        _trim_heap()
+
+
+def _trim_heap() -> None:
+    """Return the heap's free memory to the system (glibc ``malloc_trim``; a no-op elsewhere). A texture's
+    pyramid levels are under glibc's mmap threshold (16 MiB at 4096 x 4096): freed, they stay with the process
+    (``affinity check`` keeps up to 256 MiB of freed heap for the parser's temporaries), and a folder of
+    textures grew by them."""
+    import ctypes
+
+    try:
+        ctypes.CDLL(None).malloc_trim(0)
+    except (OSError, AttributeError):
+        pass
 
 
 #: Pillow's image class per header format, opened directly: ``Image.open`` would first import every common

@@ -37,6 +37,8 @@ def _corners(width: int, height: int, uv: np.ndarray):
 def _wrapped_texels(texel: np.ndarray, size: int) -> np.ndarray:
     """(N,) int64: integer texel indices ``texel`` (N,) (float or int) repeated into [0, size); a bit mask for
     a power-of-two size (the common case: no division per texel)."""
+    if texel.dtype.kind == "f" and len(texel) and not (-2.0**62 < texel.min() and texel.max() < 2.0**62):
+        texel = np.fmod(texel, size)  # beyond int64 (uv of 1e15 and up): fmod is exact, and keeps the texel
     texel = texel.astype(np.int64, copy=False)
     if size & (size - 1) == 0:
         return texel & (size - 1)
@@ -162,6 +164,18 @@ class RangePyramid:
     def levels(self) -> int:
         """The number of levels (the last one a single block)."""
         return len(self._levels)
+
+    @property
+    def built_bytes(self) -> int:
+        """Bytes of the bands built so far (the memory the pyramid holds beyond its ``image``: its arrays are
+        allocated up front, but their pages are touched only where bands are built)."""
+        total = 0
+        for k, ((low, high), built, band_rows) in enumerate(zip(self._levels, self._built, self._band_rows)):
+            if k == 0 and self._image is not None:
+                continue  # the image itself, not the pyramid's
+            row_bytes = high[0].nbytes if len(high) else 0
+            total += int(built.sum()) * band_rows * row_bytes * (1 if low is None or k == 0 else 2)
+        return total
 
     def channel_bounds(self, x0: np.ndarray, x1: np.ndarray, y0: np.ndarray,
                        y1: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -3,7 +3,9 @@
 - **scan** (:mod:`.scan`): the file is read in chunks of whole lines (``\\``
   continuations joined); each chunk is tokenized once at whitespace and '/', and its lines
   are classified by their keyword (``v``, ``vt``, ``vn``, ``f``). Statements without bulk
-  (``g``, ``o``, ``usemtl``, ``mtllib``, ``s``, ``l``, ...) are rare and read one by one.
+  (``g``, ``o``, ``usemtl``, ``mtllib``, ``s``, ``l``, ...) are rare and read one by one; a
+  chunk holding more of them than :data:`~.scan.STATEMENT_BUDGET` plus four per geometry line
+  is not a mesh (Q901 at the statement past the budget), before any is read.
 - **vertex tables** (:mod:`.vertices`): the numbers of all lines of one kind are parsed in
   one call and reshaped by their per-line counts.
 - **faces** (:mod:`.faces`): a face token's role in its corner (``v``, ``vt`` or ``vn``
@@ -43,7 +45,7 @@ from ..text import BufferReader, NotText, read_chunks, tokenize
 from . import alike
 from .assembly import Assembly
 from .faces import face_corners
-from .scan import LONG_LINE, WIDTHS, F, Part, V, line_kinds, read_statement, require_statement
+from .scan import LONG_LINE, WIDTHS, F, Part, V, line_kinds, read_statement, require_geometry, require_statement
 from .vertices import check_colors, element_rows, reject_slashes
 
 #: Chunks parsed in parallel (NumPy releases the GIL inside its loops).
@@ -121,6 +123,7 @@ def _parse_chunk(chunk, path, fast: bool) -> Part:
     statements = np.flatnonzero((counts > 0) & (kind == 0))
     if len(statements) and not kind.any():
         require_statement(tokens, path, statements, chunk.offset)
+    require_geometry(tokens, path, statements, len(kind) - len(statements))
     if len(statements):
         faces_before = np.cumsum(kind == F)
         for line in statements:

@@ -125,6 +125,27 @@ def require_statement(tokens: Tokens, path, lines: np.ndarray, offset: int) -> N
                     f" not an OBJ file")
 
 
+#: Statements without geometry (``o``, ``g``, ``s``, ``usemtl``, ``mtllib``, ``l``, ...) a chunk of
+#: :data:`~affinity.loaders.text.CHUNK_BYTES` (2 MiB) may hold beyond four per v/vt/vn/f line of it. Each
+#: is read in Python (some 5 us): 4,096 of them cost about what the chunk's 2 MiB of geometry costs,
+#: while four per geometry line cover an exporter that writes ``g``, ``usemtl`` and ``s`` before every
+#: face. More is text that holds no mesh (64 MB of ``o x`` lines took 40 s before it was found empty).
+STATEMENT_BUDGET = 4096
+#: Statements without geometry allowed per v/vt/vn/f line of a chunk, beyond :data:`STATEMENT_BUDGET`.
+STATEMENTS_PER_GEOMETRY_LINE = 4
+
+
+def require_geometry(tokens: Tokens, path, statements: np.ndarray, geometry_lines: int) -> None:
+    """MeshError at the first of a chunk's ``statements`` (line indices of its statements without geometry)
+    past :data:`STATEMENT_BUDGET` plus :data:`STATEMENTS_PER_GEOMETRY_LINE` per geometry line of the chunk."""
+    budget = STATEMENT_BUDGET + STATEMENTS_PER_GEOMETRY_LINE * geometry_lines
+    if len(statements) > budget:
+        raise MeshError(path, int(tokens.number[statements[budget]]),
+                        f"{len(statements):,} statements (o, g, s, usemtl, mtllib, ...) beside {geometry_lines:,} "
+                        f"v/vt/vn/f lines in a stretch of the file: more than {STATEMENT_BUDGET:,} plus "
+                        f"{STATEMENTS_PER_GEOMETRY_LINE} per geometry line, not a mesh")
+
+
 def read_statement(tokens: Tokens, path, line, faces_before, part: Part) -> None:
     """Handle one rare line: ``g``/``o``/``usemtl`` become events (``mtllib`` lines are read from the
     file's bytes with the resources, :func:`affinity.loaders.resources.mtllib_statements`)."""
