@@ -12,7 +12,8 @@ Spot's control mesh also gets Bfr's limit uv against the cage's bilinear uv (UV 
 - ``drift_{fvar}`` (S, 7) float64: base face, u, v, limit uv, cage uv (Bfr), for ``--limit-samples``;
 - ``options``: the oracle's extra arguments (creases, corners, holes, scheme) as one string;
 - ``aliases``: ``KEY=OTHER`` strings, for arrays equal to one stored under another key (the boundary rule
-  rarely changes the uv, nor the face-varying rule the refined topology); :func:`load_fixture` resolves them.
+  rarely changes the uv, nor the face-varying rule the refined topology); tests/helpers/osd_fixtures.py
+  resolves them.
 """
 
 from __future__ import annotations
@@ -40,6 +41,10 @@ MESHES = {
                      ["--crease", "0", "1", "1.5", "--crease", "1", "2", "1.5", "--crease", "4", "5", "10",
                       "--corner", "6", "2.5"], 0),
     "holed_grid": (OUT / "holed_grid.obj", (1, 2, 3), True, ["--hole", "5"], 0),
+    # vertices 10-14 are the row y = 2; vertex 12 sits on the seam
+    "seamed_grid": (OUT / "seamed_grid.obj", (1, 2, 3), True,
+                    ["--crease", "10", "11", "0.7", "--crease", "11", "12", "1.5", "--crease", "12", "13", "2.5",
+                     "--crease", "13", "14", "1.5", "--corner", "12", "1.2", "--corner", "18", "0.4"], 0),
     "nonquads_bilinear": (SHARED / "osd_catmark_nonquads.obj", (1, 2), True, ["--scheme", "bilinear"], 0),
 }
 
@@ -70,16 +75,6 @@ def refine(path: Path, level: int, boundary: str, fvar: str, extra: list[str], s
 
 #: The face-varying rules whose limit uv (UV drift) is sampled.
 DRIFT_RULES = ("none", "cornersPlus1", "all")
-
-
-def load_fixture(path) -> dict:
-    """The arrays of a fixture written by :func:`main`, aliases resolved: key -> array."""
-    with np.load(path) as stored:
-        arrays = {key: stored[key] for key in stored.files}
-    for alias in arrays.pop("aliases", ()):
-        key, _, target = str(alias).partition("=")
-        arrays[key] = arrays[target]
-    return arrays
 
 
 def _store(arrays: dict, aliases: list, key: str, array: np.ndarray) -> None:
