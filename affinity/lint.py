@@ -288,6 +288,12 @@ def lint_pass(mesh: Mesh, settings: Settings, visible: bool = True, scores: bool
     MeshLint: ``hits``, one RuleHits per rule with at least one finding, in rule-table order, faces in
     file order within each; ``scores``, rule code -> QuadScores (empty without ``scores``).
     """
+    if settings.subdivision != "cage":  # Q101-Q103 on the surface the renderer draws (design.md, "Subdivision")
+        from .subdivision.measured import lint_where_drawn
+
+        drawn = lint_where_drawn(mesh, settings, visible, scores)
+        if drawn is not None:
+            return drawn
     enabled = [RULES[code] for code in resolve_codes(settings.select, settings.ignore)]
     reads_textures = (visible and RULES["Q101"] in enabled and RULES["Q101"].unit_for(settings.measure) == "texels"
                       and mesh.texcoords is not None and (mesh.material_maps or mesh.material_textures))
@@ -378,7 +384,8 @@ def mesh_report(path: str, mesh, settings, inline=(), scores: bool = False) -> F
     hits, shared = share_authored_geometry(settle(linted.hits, settings, list(mesh.group_names), inline), mesh)
     return FileReport(path, counts=mesh.counts(), hits=hits, shared=shared, group_names=list(mesh.group_names),
                       prim_face_start=mesh.prim_face_start, up_axis=mesh.up_axis,
-                      meters_per_unit=mesh.meters_per_unit, notes=list(mesh.notes), scores=linted.scores)
+                      meters_per_unit=mesh.meters_per_unit,
+                      notes=list(mesh.notes if linted.notes is None else linted.notes), scores=linted.scores)
 
 
 #: Cause rule -> the attributes whose scored rules (Q101-Q103) it takes over (:class:`Unmeasurable`).
@@ -550,10 +557,12 @@ class QuadScores:
 @dataclass(frozen=True)
 class MeshLint:
     """One pass of the rules over a mesh (:func:`lint_pass`): ``hits`` (list of RuleHits, rule-table order) and
-    ``scores`` (scored rule code -> :class:`QuadScores` of every measured quad; empty unless asked)."""
+    ``scores`` (scored rule code -> :class:`QuadScores` of every measured quad; empty unless asked); ``notes``
+    replace the mesh's own where the pass measured a subdivided surface (None: the mesh's notes stand)."""
 
     hits: list[RuleHits]
     scores: dict[str, QuadScores]
+    notes: list[str] | None = None
 
 
 def scored_codes(mesh: Mesh | None = None, attribute: str | None = None) -> list[str]:

@@ -96,7 +96,19 @@ def _child_topology(topology: Topology) -> tuple[Topology, np.ndarray]:
     corners = np.empty_like(slots)
     np.put_along_axis(corners, order, slots, axis=1)
     child = Topology(4 * np.arange(len(c) + 1, dtype=np.int64), corners.ravel(), F + E + topology.n_vertices)
-    return child, order
+    # Child edges: the two halves of each parent edge (2e to its lower vertex, 2e + 1 to its higher one), then
+    # one inside each face per parent corner (2E + c, from the face point to the corner's next edge point).
+    ends = topology.edge_vertices
+    halves = np.stack([np.repeat(F + np.arange(E), 2), F + E + ends.ravel()], axis=1)
+    inner = np.stack([topology.corner_face, F + topology.corner_edge], axis=1)
+    v = topology.corner_vertex
+    next_half = 2 * topology.corner_edge + (ends[topology.corner_edge, 1] == v)
+    prev_edge = topology.corner_edge[topology.prev]
+    prev_half = 2 * prev_edge + (ends[prev_edge, 1] == v)
+    sides = np.stack([next_half, 2 * E + c, 2 * E + topology.prev, prev_half], axis=1)
+    corner_edge = np.empty_like(sides)
+    np.put_along_axis(corner_edge, order, sides, axis=1)
+    return child.given_edges(np.concatenate([halves, inner]), corner_edge.ravel()), order
 
 
 def refine_uniform(face_start: np.ndarray, corner_vertex: np.ndarray, positions: np.ndarray, level: int,
@@ -141,8 +153,7 @@ def refine_uniform(face_start: np.ndarray, corner_vertex: np.ndarray, positions:
         data = {name: refine_vertex_data(topology, masks, edge_sharpness, values) for name, values in data.items()}
         child, order = _child_topology(topology)
         F, E = topology.n_faces, topology.n_edges
-        low, high = child.edge_vertices[:, 0], child.edge_vertices[:, 1]
-        child_edge_parent = np.where((low >= F) & (low < F + E) & (high >= F + E), low - F, -1)
+        child_edge_parent = np.concatenate([np.repeat(np.arange(E), 2), np.full(child.n_edges - 2 * E, -1)])
         refined = {}
         for name, channel in fvar.items():
             channel, slots = refine_channel(topology, channel, masks, edge_sharpness, vertex_sharpness,

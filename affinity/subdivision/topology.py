@@ -72,6 +72,12 @@ class Topology:
         previous[self.face_start[:-1]] = self.face_start[1:] - 1
         return previous
 
+    def given_edges(self, edge_vertices: np.ndarray, corner_edge: np.ndarray) -> Topology:
+        """The topology with its edges known already (a refined level's, :func:`refine._child_topology`):
+        ``edge_vertices`` (E, 2) int64, the lower vertex first; ``corner_edge`` (C,) int64."""
+        self.__dict__["_edges"] = (edge_vertices, corner_edge)
+        return self
+
     @cached_property
     def _edges(self) -> tuple[np.ndarray, np.ndarray]:
         a, b = self.corner_vertex, self.corner_vertex[self.next]
@@ -163,14 +169,11 @@ class Topology:
         """(V, K) float64: at each vertex, the sum over its edges (all, or those where ``edges`` (E,) bool)
         of the value at the edge's other end, ``per_edge_end`` (V, K) a value per vertex."""
         ends = self.edge_vertices if edges is None else self.edge_vertices[edges]
-        total = np.zeros((self.n_vertices, per_edge_end.shape[1]))
-        np.add.at(total, ends[:, 0], per_edge_end[ends[:, 1]])
-        np.add.at(total, ends[:, 1], per_edge_end[ends[:, 0]])
-        return total
+        return sum_by(np.concatenate([ends[:, 0], ends[:, 1]]),
+                      np.concatenate([per_edge_end[ends[:, 1]], per_edge_end[ends[:, 0]]]), self.n_vertices)
 
 
 def sum_by(index: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
     """(n, K) float64 sums of ``values`` (m, K) grouped by ``index`` (m,) int64 in [0, n)."""
-    total = np.zeros((n, values.shape[1]))
-    np.add.at(total, index, values)
-    return total
+    return np.stack([np.bincount(index, values[:, k], minlength=n) for k in range(values.shape[1])], axis=1) \
+        if values.shape[1] else np.zeros((n, 0))
