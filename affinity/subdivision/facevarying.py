@@ -359,3 +359,49 @@ def _sibling(value_vertex: np.ndarray, n_vertices: int) -> np.ndarray:
     index = np.arange(T)
     local = index - start[value_vertex]
     return np.where(count[value_vertex] == 2, start[value_vertex] + 1 - local, index)
+
+
+def limit_values(topology: Topology, channel: Channel, edge_sharpness: np.ndarray,
+                 vertex_sharpness: np.ndarray) -> np.ndarray:
+    """(T, K) float64 each value's limit (Far's PrimvarRefiner::LimitFaceVarying) on a level whose faces are
+    all quads: a matched value by its vertex's limit mask (smooth: n/(n+5) of itself, 4/(n(n+5)) of each
+    edge neighbour and 1/(n(n+5)) of each diagonal one; crease: 2/3 of itself and 1/6 of each sharp edge's
+    other end; corner: itself), a value on a seam 2/3 of itself and 1/6 of each seam neighbour (a smooth
+    boundary) or itself (a sharp corner). The linear rule ``all`` keeps every value."""
+    from .catmark import CORNER, CREASE, vertex_rule
+
+    values, cv, v = channel.values, channel.corner_value, channel.value_vertex
+    if channel.linear:
+        return values.copy()
+    T, V = len(values), topology.n_vertices
+    first = topology.edge_first_corner
+    at_low = topology.corner_vertex[first] == topology.edge_vertices[:, 0]
+    low = np.where(at_low[:, None], values[cv[first]], values[cv[topology.next[first]]])
+    high = np.where(at_low[:, None], values[cv[topology.next[first]]], values[cv[first]])
+
+    def around(edges):
+        ends = topology.edge_vertices[edges]
+        return sum_by(np.concatenate([ends[:, 0], ends[:, 1]]), np.concatenate([high[edges], low[edges]]), V)
+
+    sharp = edge_sharpness > 0
+    ends = topology.edge_vertices.ravel()
+    rule = vertex_rule(vertex_sharpness, np.bincount(ends, np.repeat(sharp, 2), minlength=V).astype(int))
+    n = topology.vertex_face_count.astype(np.float64)
+    n[n == 0] = 1.0
+    vertex_value = np.zeros(V, dtype=np.int64)
+    vertex_value[v] = np.arange(T)
+    x = values[vertex_value]
+    diagonal = sum_by(topology.corner_vertex, values[cv[topology.next[topology.next]]], V)
+    smooth = x * (n / (n + 5))[:, None] + (4 * around(np.arange(topology.n_edges)) + diagonal) / (n * (n + 5))[:, None]
+    crease = (4 * x + around(np.flatnonzero(sharp))) / 6
+    limit = np.where((rule == CORNER)[:, None], x, np.where((rule == CREASE)[:, None], crease, smooth))
+    out = values.copy()
+    matched = ~channel.mismatch
+    out[matched] = limit[v[matched]]
+    seam = channel.mismatch & channel.crease
+    if seam.any():
+        end_sum = np.zeros_like(values)
+        for _, bounding, _, far in _span_sides(topology, channel):
+            end_sum += sum_by(cv, np.where(bounding[:, None], values[far], 0.0), T)
+        out[seam] = ((4 * values + end_sum) / 6)[seam]
+    return out

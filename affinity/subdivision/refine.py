@@ -7,12 +7,12 @@ at corner k of f (a quad's children keep its orientation: child k has its parent
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from .catmark import refine_vertex_data, sharpen_boundaries, vertex_masks
-from .facevarying import RULES, base_channel, refine_channel
+from .facevarying import RULES, base_channel, limit_values, refine_channel
 from .topology import Topology, decay
 
 SCHEMES = ("catmullClark", "bilinear", "loop", "none")
@@ -113,7 +113,7 @@ def _child_topology(topology: Topology) -> tuple[Topology, np.ndarray]:
 
 def refine_uniform(face_start: np.ndarray, corner_vertex: np.ndarray, positions: np.ndarray, level: int,
                    scheme: Scheme = Scheme(), channels: dict | None = None,
-                   vertex_data: dict | None = None) -> Refined:
+                   vertex_data: dict | None = None, limit: bool = False) -> Refined:
     """Refine a mesh uniformly ``level`` times.
 
     Parameters
@@ -124,6 +124,8 @@ def refine_uniform(face_start: np.ndarray, corner_vertex: np.ndarray, positions:
     channels : dict of name -> ((T, K) float64 values, (C,) int64 value index per corner), face-varying data
         refined under ``scheme.fvar`` (uv, per-corner normals)
     vertex_data : dict of name -> (V, K) float64, per-vertex data refined as the positions are
+    limit : the channels' values projected to the limit surface at level ``level`` (>= 1; positions stay
+        level points): the limit uv at each refined corner
     """
     if scheme.scheme == "loop":
         raise ValueError("Loop subdivision is not refined here")
@@ -167,6 +169,9 @@ def refine_uniform(face_start: np.ndarray, corner_vertex: np.ndarray, positions:
         base_face = base_face[topology.corner_face]
         hole = hole[topology.corner_face]
         topology = child
+    if limit:
+        fvar = {name: _with_values(channel, limit_values(topology, channel, edge_sharpness, vertex_sharpness))
+                for name, channel in fvar.items()}
     return Refined(level=level, positions=data.pop("positions"), face_start=topology.face_start,
                    corner_vertex=topology.corner_vertex, base_face=base_face, hole=hole,
                    channels={name: (channel.values, channel.corner_value) for name, channel in fvar.items()},
@@ -174,6 +179,8 @@ def refine_uniform(face_start: np.ndarray, corner_vertex: np.ndarray, positions:
 
 
 def _with_corners(channel, corner_value: np.ndarray):
-    from dataclasses import replace
-
     return replace(channel, corner_value=corner_value)
+
+
+def _with_values(channel, values: np.ndarray):
+    return replace(channel, values=values)

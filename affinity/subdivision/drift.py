@@ -1,0 +1,47 @@
+"""UV drift: how far subdivision moves the texture by itself. Under the smooth face-varying rules the limit
+surface's uv is not the cage's bilinear uv: the texture slides over the surface even where every quad is a
+parallelogram in uv. Measured at the corners of the level-``SAMPLE_LEVEL`` refinement of each face (a 9 x 9
+grid on a quad), as the distance between the limit uv (``Scheme.fvar``) and the bilinear uv (the rule
+``all``) there; the largest over the face."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .refine import Scheme, refine_uniform
+
+#: Levels of refinement whose corners sample a face: 3 puts a 9 x 9 grid on a quad (2^3 + 1 a side).
+SAMPLE_LEVEL = 3
+
+
+def uv_drift(face_start: np.ndarray, corner_vertex: np.ndarray, positions: np.ndarray, texcoords: np.ndarray,
+             corner_texcoord: np.ndarray, scheme: Scheme, level: int = SAMPLE_LEVEL) -> np.ndarray:
+    """(F, 2) float64 per face, the uv difference (limit minus bilinear) of largest length over its samples,
+    in uv units; NaN rows for faces (and holes) with no sample, all NaN when a corner lacks uv.
+
+    Parameters: the mesh's faces (F + 1,) int64, corners (C,) int64, positions (V, 3) float64, uv table
+    (T, 2) float64 and each corner's uv (C,) int64; ``scheme`` its subdivision rules.
+    """
+    n_faces = len(face_start) - 1
+    drift = np.full((n_faces, 2), np.nan)
+    if corner_texcoord is None or (corner_texcoord < 0).any() or scheme.scheme != "catmullClark":
+        return drift if scheme.scheme == "catmullClark" else np.zeros((n_faces, 2))
+    channel = {"uv": (texcoords, corner_texcoord)}
+    limit = refine_uniform(face_start, corner_vertex, positions, level, scheme, channel, limit=True)
+    linear = refine_uniform(face_start, corner_vertex, positions, level, _linear(scheme), channel)
+    values, index = limit.channels["uv"]
+    bilinear, bilinear_index = linear.channels["uv"]
+    difference = values[index] - bilinear[bilinear_index]  # (4 R, 2), the refined corners in the same order
+    length = np.hypot(difference[:, 0], difference[:, 1])
+    face = np.repeat(limit.base_face, 4)
+    drawn = np.repeat(~limit.hole, 4)
+    order = np.lexsort((-length[drawn], face[drawn]))
+    first = order[np.concatenate([[True], face[drawn][order][1:] != face[drawn][order][:-1]])]
+    drift[face[drawn][first]] = difference[drawn][first]
+    return drift
+
+
+def _linear(scheme: Scheme) -> Scheme:
+    from dataclasses import replace
+
+    return replace(scheme, fvar="all")
