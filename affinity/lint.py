@@ -270,7 +270,8 @@ def lint_mesh(mesh: Mesh, settings: Settings, visible: bool = True) -> list[Rule
     return lint_pass(mesh, settings, visible).hits
 
 
-def lint_pass(mesh: Mesh, settings: Settings, visible: bool = True, scores: bool = False) -> MeshLint:
+def lint_pass(mesh: Mesh, settings: Settings, visible: bool = True, scores: bool = False,
+              where_drawn: bool = True) -> MeshLint:
     """Apply every rule enabled by ``settings.select``/``settings.ignore`` to ``mesh``, in one pass over its quads.
 
     Q101 is in texels (each quad's texture size from its material's texture header,
@@ -287,8 +288,10 @@ def lint_pass(mesh: Mesh, settings: Settings, visible: bool = True, scores: bool
     -------
     MeshLint: ``hits``, one RuleHits per rule with at least one finding, in rule-table order, faces in
     file order within each; ``scores``, rule code -> QuadScores (empty without ``scores``).
+    With ``where_drawn`` (the default), a mesh the settings draw subdivided has Q101-Q103 measured on its
+    refined surface (:func:`affinity.subdivision.measured.lint_where_drawn`); without, on the faces given.
     """
-    if settings.subdivision != "cage":  # Q101-Q103 on the surface the renderer draws (design.md, "Subdivision")
+    if where_drawn and settings.subdivision != "cage":  # Q101-Q103 on the surface drawn (design.md, "Subdivision")
         from .subdivision.measured import lint_where_drawn
 
         drawn = lint_where_drawn(mesh, settings, visible, scores)

@@ -45,3 +45,24 @@ def _linear(scheme: Scheme) -> Scheme:
     from dataclasses import replace
 
     return replace(scheme, fvar="all")
+
+
+def mesh_uv_drift(mesh, settings) -> np.ndarray:
+    """(F, 2) float64 each face's UV drift (:func:`uv_drift`) where the mesh is drawn subdivided under
+    ``settings`` (a level above 0 or the limit surface, Catmull-Clark), NaN rows elsewhere: USD prims by
+    their own rules, other meshes by the ``fvar-interpolation`` setting."""
+    from .measured import drawn_levels, local_faces
+
+    drift = np.full((mesh.n_faces, 2), np.nan)
+    if mesh.texcoords is None:
+        return drift
+    face_scheme, schemes, levels = drawn_levels(mesh, settings)
+    for s, (scheme, level) in enumerate(zip(schemes, levels)):
+        if level == 0 or scheme.scheme != "catmullClark":
+            continue
+        faces = np.flatnonzero(face_scheme == s)
+        local = local_faces(mesh, faces, scheme)
+        uv = local.channel(mesh.texcoords, mesh.corner_texcoord)
+        if uv is not None:
+            drift[faces] = uv_drift(local.face_start, local.corner_vertex, local.positions, *uv, local.scheme)
+    return drift

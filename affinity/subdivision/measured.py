@@ -60,10 +60,10 @@ def lint_where_drawn(mesh: Mesh, settings, visible: bool = True, scores: bool = 
                           for scheme, level in zip(schemes, levels)])
     drawn_on_cage = (level_of == 0) & np.array([level != "limit" for level in levels])
     cage_face = drawn_on_cage[face_scheme]
-    cage_settings = replace(settings, subdivision="cage")
+    cage_settings = settings
     if not cage_face.any():  # the scored rules are measured on no cage face: the cage pass leaves them out
-        cage_settings = replace(cage_settings, select=[c for c in enabled if c not in scored] or ["-"], ignore=None)
-    cage = lint_pass(mesh, cage_settings, visible, scores)
+        cage_settings = replace(settings, select=[c for c in enabled if c not in scored] or ["-"], ignore=None)
+    cage = lint_pass(mesh, cage_settings, visible, scores, where_drawn=False)
     hits = {h.code: h for h in cage.hits}
     for code in scored:
         if code in hits:
@@ -73,7 +73,7 @@ def lint_where_drawn(mesh: Mesh, settings, visible: bool = True, scores: bool = 
     refined_codes = [c for c in scored if not (usd and RULES[c].attribute == "normals")]
     if pieces and refined_codes:
         refined, base, level = refined_mesh(mesh, pieces)
-        found = lint_pass(refined, replace(settings, subdivision="cage", select=refined_codes, ignore=None), visible)
+        found = lint_pass(refined, replace(settings, select=refined_codes, ignore=None), visible, where_drawn=False)
         measured = np.bincount(base, minlength=mesh.n_faces)
         for h in found.hits:
             on_base = on_base_faces(mesh, h, base, level, measured)
@@ -114,34 +114,57 @@ def refined_mesh(mesh: Mesh, pieces: list[Piece]) -> tuple[Mesh, np.ndarray, np.
     return refined, base, level
 
 
-def _refined_piece(mesh: Mesh, piece: Piece) -> dict:
-    """One piece refined, in its own vertex numbering: positions, corner_vertex, base (global faces), colors,
-    and the channels the piece has at every corner (texcoords, normals: (values, corner index))."""
-    starts, ends = mesh.face_start[piece.faces], mesh.face_start[piece.faces + 1]
+@dataclass(frozen=True)
+class LocalFaces:
+    """Some faces of a mesh in a numbering of their own (what refinement takes): ``face_start`` (n + 1,),
+    ``corner_vertex`` (C,) into ``positions`` (V', 3), the mesh's ``corners`` (C,) int64 they come from,
+    the mesh's vertices ``used`` (V',) and the ``scheme`` with its creases, corners and holes renumbered."""
+
+    face_start: np.ndarray
+    corner_vertex: np.ndarray
+    positions: np.ndarray
+    corners: np.ndarray
+    used: np.ndarray
+    scheme: Scheme
+
+    def channel(self, values: np.ndarray | None, index: np.ndarray | None) -> tuple | None:
+        """A per-corner attribute of the mesh (``values`` (T, K), ``index`` (C_mesh,)) on these faces, its
+        table cut to the values used; None where a corner lacks it."""
+        if values is None or index is None or (index[self.corners] < 0).any():
+            return None
+        taken, value_index = np.unique(index[self.corners], return_inverse=True)
+        return values[taken], value_index.ravel()
+
+
+def local_faces(mesh: Mesh, faces: np.ndarray, scheme: Scheme) -> LocalFaces:
+    """``faces`` (n,) int64 of ``mesh`` as :class:`LocalFaces` (vertices no face of theirs uses left out)."""
+    starts, ends = mesh.face_start[faces], mesh.face_start[faces + 1]
     sizes = ends - starts
     corners = np.repeat(starts - np.concatenate([[0], np.cumsum(sizes)[:-1]]), sizes) + np.arange(sizes.sum())
     used, local = np.unique(mesh.corner_vertex[corners], return_inverse=True)
-    face_start = np.concatenate([[0], np.cumsum(sizes)])
     remap = np.full(len(mesh.positions), -1, dtype=np.int64)
     remap[used] = np.arange(len(used))
-    scheme = piece.scheme
     creases = remap[scheme.crease_edges] if len(scheme.crease_edges) else scheme.crease_edges
     keep = (creases >= 0).all(axis=1) if len(creases) else np.zeros(0, dtype=bool)
     corner_vertices = remap[scheme.corner_vertices] if len(scheme.corner_vertices) else scheme.corner_vertices
     keep_corner = corner_vertices >= 0
-    holes = np.flatnonzero(np.isin(piece.faces, scheme.holes))
     local_scheme = replace(scheme, crease_edges=creases[keep], crease_sharpness=scheme.crease_sharpness[keep],
                            corner_vertices=corner_vertices[keep_corner],
-                           corner_sharpness=scheme.corner_sharpness[keep_corner], holes=holes)
-    channels = {}
-    for name, index_name in (("texcoords", "corner_texcoord"), ("normals", "corner_normal")):
-        values, index = getattr(mesh, name), getattr(mesh, index_name)
-        if values is not None and index is not None and (index[corners] >= 0).all():
-            taken, value_index = np.unique(index[corners], return_inverse=True)
-            channels[name] = (values[taken], value_index.ravel())
-    data = {} if mesh.colors is None else {"colors": mesh.colors[used]}
-    refined = refine_uniform(face_start, local.ravel(), mesh.positions[used], piece.level, local_scheme, channels,
-                             data)
+                           corner_sharpness=scheme.corner_sharpness[keep_corner],
+                           holes=np.flatnonzero(np.isin(faces, scheme.holes)))
+    return LocalFaces(np.concatenate([[0], np.cumsum(sizes)]), local.ravel(), mesh.positions[used], corners, used,
+                      local_scheme)
+
+
+def _refined_piece(mesh: Mesh, piece: Piece) -> dict:
+    """One piece refined, in its own vertex numbering: positions, corner_vertex, base (global faces), colors,
+    and the channels the piece has at every corner (texcoords, normals: (values, corner index))."""
+    local = local_faces(mesh, piece.faces, piece.scheme)
+    channels = {name: found for name, index_name in (("texcoords", "corner_texcoord"), ("normals", "corner_normal"))
+                if (found := local.channel(getattr(mesh, name), getattr(mesh, index_name))) is not None}
+    data = {} if mesh.colors is None else {"colors": mesh.colors[local.used]}
+    refined = refine_uniform(local.face_start, local.corner_vertex, local.positions, piece.level, local.scheme,
+                             channels, data)
     drawn = ~refined.hole
     kept_corners = np.repeat(drawn, 4)
     part = {"positions": refined.positions, "corner_vertex": refined.corner_vertex[kept_corners],
