@@ -205,7 +205,7 @@ NUMBERS: dict[str, dict[str, Closed | str]] = {
         "0.2": Closed(example_data(RULES["Q106"].example)["vt"][1][0]),
         "0": Closed(example_data(RULES["Q106"].example)["vt"][0][0]),
         "1": THRESHOLD + "; the u at the edge's far end, " + CONSTANT, "4": CONSTANT, "6": CONSTANT,
-        "9": "the samples a side of a quad refined three times (2^3 + 1)",
+        "5": "the samples a side of a quad refined twice (2^2 + 1)",
         "1024": "the texture-size setting's default", "1024x1024": "the texture-size setting's default",
     },
     "Q201": {"0": Closed(q201_smallest_triangle()), "1e-09": THRESHOLD},

@@ -1,6 +1,6 @@
 """UV drift (affinity.subdivision.drift) against OpenSubdiv's Bfr: the limit surface's uv against the cage's
 bilinear uv (Bfr's face-varying surfaces under the rule and under ``all``) at 9 x 9 samples of each of Spot's
-quads, committed by tests/oracle/make_fixtures.py. Issue 56's figures: median 10.5 and max 41.2 texels (1024)
+quads, committed by tests/oracle/make_fixtures.py (the measure samples 5 x 5). Issue 56's figures: median 10.5 and max 41.2 texels (1024)
 under cornersPlus1, 0 under all."""
 
 from __future__ import annotations
@@ -37,9 +37,11 @@ def test_spots_uv_drift_is_bfrs(rule):
     bfr = _bfr_drift(rule, mesh.n_faces)[quads]
     assert np.median(ours) == pytest.approx(np.median(bfr), rel=0.01)
     assert ours.max() == pytest.approx(bfr.max(), rel=0.01)
-    # Face by face too: Bfr approximates the patches next to extraordinary vertices (its default
-    # approximation level), the refined limit masks are exact there.
-    assert np.all(np.abs(ours - bfr) <= 0.02 * bfr + 1e-9)
+    # Face by face too: the 5 x 5 samples are among Bfr's 9 x 9, so a face reads at most Bfr's value (within
+    # Bfr's own approximation of the patches at extraordinary vertices, its default level), and nine faces
+    # in ten read it to 2 % (on Spot 151 of 160: the others have their worst between the 5 x 5 samples).
+    assert np.all(ours <= 1.02 * bfr + 1e-9)
+    assert np.mean(np.abs(ours - bfr) <= 0.02 * bfr + 1e-9) >= 0.9
     if rule == "cornersPlus1":
         assert np.median(ours) == pytest.approx(10.5, abs=0.05) and ours.max() == pytest.approx(41.2, abs=0.05)
 

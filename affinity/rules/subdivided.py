@@ -34,7 +34,7 @@ def uv_drift(quads) -> Measured:
         subdivisionScheme and faceVaryingLinearInterpolation, OBJ, PLY and OFF by ``fvar-interpolation``
         with ``--subdivision level:N`` or ``limit``), measures the largest distance over each quad between
         the limit surface's texture coordinates and the cage's bilinear ones, in texels (sampled at the
-        corners of the quad refined three times, a 9 x 9 grid). In the example the shared edge's u = 0.2
+        corners of the quad refined twice, a 5 x 5 grid). In the example the shared edge's u = 0.2
         moves to (0 + 4 x 0.2 + 1) / 6 = 0.3 at the limit (the smooth boundary rule): 0.1 x 1024 = 102.4
         texels.
 
