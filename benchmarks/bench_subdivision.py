@@ -61,7 +61,8 @@ def main(argv=None) -> None:
         median = statistics.median(times[level])
         goal = "-" if level == "cage" else f"{2 * 4 ** int(level.split(':')[1])}"
         table.append([level, f"{median:.2f}", f"{median / cage:.1f}", goal, f"{peaks[level]:.0f}"])
-    lines = [f"Lint of {mesh.n_faces:,} quads (Q101 and Q106) by subdivision level: {run_conditions(load_before, rounds)}.",
+    lines = [f"Lint of {mesh.n_faces:,} quads (Q101 and Q106) by subdivision level: "
+             f"{run_conditions(load_before, rounds)}.",
              "", *markdown_table(["subdivision", "seconds", "x cage", "goal (x cage)", "peak MiB"], table)]
     write_table(lines, args.out, "bench_subdivision.md")
 

@@ -1,7 +1,7 @@
 """UV drift (affinity.subdivision.drift) against OpenSubdiv's Bfr: the limit surface's uv against the cage's
 bilinear uv (Bfr's face-varying surfaces under the rule and under ``all``) at 9 x 9 samples of each of Spot's
-quads, committed by tests/oracle/make_fixtures.py (the measure samples 5 x 5). Issue 56's figures: median 10.5 and max 41.2 texels (1024)
-under cornersPlus1, 0 under all."""
+quads, committed by tests/oracle/make_fixtures.py (the measure samples 5 x 5). Issue 56's figures: median 10.5
+and max 41.2 texels (1024) under cornersPlus1, 0 under all."""
 
 from __future__ import annotations
 
