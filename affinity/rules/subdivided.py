@@ -12,15 +12,17 @@ from .registry import Measured, rule
 _LOCK = threading.Lock()
 
 
-def _drift_of(quads) -> np.ndarray:
+def _drift_of(quads) -> np.ndarray | None:
     """(F, 2) uv units: the mesh's UV drift (:func:`affinity.subdivision.drift.mesh_uv_drift`), computed once a
-    pass and kept with the pass's corner tables."""
+    pass and kept with the pass's corner tables; None where the settings draw the whole mesh as its cage."""
     from ..subdivision.drift import mesh_uv_drift
+    from ..subdivision.measured import drawn_levels
 
     tables = quads.tables
     with _LOCK:
         if not hasattr(tables, "uv_drift"):
-            tables.uv_drift = mesh_uv_drift(quads.mesh, quads.settings)
+            drawn = any(level != 0 for level in drawn_levels(quads.mesh, quads.settings)[2])
+            tables.uv_drift = mesh_uv_drift(quads.mesh, quads.settings) if drawn else None
     return tables.uv_drift
 
 
@@ -91,7 +93,10 @@ def uv_drift(quads) -> Measured:
         modifier's UV Smooth = None), which draws the cage's uv bilinearly: the drift is 0; or space the uv
         the way the smooth rules place it (Blender's UV Smooth set to the renderer's rule before baking).
     """
-    drift = _drift_of(quads)[quads.faces]
+    drift = _drift_of(quads)
+    if drift is None:
+        return Measured.nothing()
+    drift = drift[quads.faces]
     rows = np.flatnonzero(np.isfinite(drift[:, 0]))
     size = quads.texel_size(rows)
     texels = drift[rows] * size

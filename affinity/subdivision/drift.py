@@ -35,11 +35,16 @@ def uv_drift(face_start: np.ndarray, corner_vertex: np.ndarray, positions: np.nd
     bilinear, bilinear_index = linear.channels["uv"]
     difference = values[index] - bilinear[bilinear_index]  # (4 R, 2), the refined corners in the same order
     length = np.hypot(difference[:, 0], difference[:, 1])
-    face = np.repeat(limit.base_face, 4)
     drawn = np.repeat(~limit.hole, 4)
-    order = np.lexsort((-length[drawn], face[drawn]))
-    first = order[np.concatenate([[True], face[drawn][order][1:] != face[drawn][order][:-1]])]
-    drift[face[drawn][first]] = difference[drawn][first]
+    face = np.repeat(limit.base_face, 4)[drawn]  # rising: a face's refined faces are contiguous (Far's order)
+    difference, length = difference[drawn], length[drawn]
+    if not len(face):
+        return drift
+    starts = np.flatnonzero(np.concatenate([[True], face[1:] != face[:-1]]))
+    worst = np.maximum.reduceat(length, starts)
+    at_worst = np.flatnonzero(length == np.repeat(worst, np.diff(np.append(starts, len(face)))))
+    first = at_worst[np.concatenate([[True], face[at_worst][1:] != face[at_worst][:-1]])]
+    drift[face[first]] = difference[first]
     return drift
 
 
