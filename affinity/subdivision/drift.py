@@ -28,11 +28,10 @@ def uv_drift(face_start: np.ndarray, corner_vertex: np.ndarray, positions: np.nd
     drift = np.full((n_faces, 2), np.nan)
     if corner_texcoord is None or (corner_texcoord < 0).any() or scheme.scheme != "catmullClark":
         return drift if scheme.scheme == "catmullClark" else np.zeros((n_faces, 2))
-    channel = {"uv": (texcoords, corner_texcoord)}
-    limit = refine_uniform(face_start, corner_vertex, positions, level, scheme, channel, limit=True)
-    linear = refine_uniform(face_start, corner_vertex, positions, level, _linear(scheme), channel)
+    channels = {"uv": (texcoords, corner_texcoord), "bilinear": (texcoords, corner_texcoord, "all")}
+    limit = refine_uniform(face_start, corner_vertex, positions, level, scheme, channels, limit=True)
     values, index = limit.channels["uv"]
-    bilinear, bilinear_index = linear.channels["uv"]
+    bilinear, bilinear_index = limit.channels["bilinear"]  # the rule all: its limit is itself
     difference = values[index] - bilinear[bilinear_index]  # (4 R, 2), the refined corners in the same order
     length = np.hypot(difference[:, 0], difference[:, 1])
     drawn = np.repeat(~limit.hole, 4)
@@ -47,11 +46,6 @@ def uv_drift(face_start: np.ndarray, corner_vertex: np.ndarray, positions: np.nd
     drift[face[first]] = difference[first]
     return drift
 
-
-def _linear(scheme: Scheme) -> Scheme:
-    from dataclasses import replace
-
-    return replace(scheme, fvar="all")
 
 
 def mesh_uv_drift(mesh, settings) -> np.ndarray:

@@ -121,8 +121,8 @@ def refine_uniform(face_start: np.ndarray, corner_vertex: np.ndarray, positions:
     face_start : (F + 1,) int64; corner_vertex : (C,) int64; positions : (V, 3) float64
     level : int >= 0
     scheme : :class:`Scheme` (catmullClark or bilinear; loop is not refined here)
-    channels : dict of name -> ((T, K) float64 values, (C,) int64 value index per corner), face-varying data
-        refined under ``scheme.fvar`` (uv, per-corner normals)
+    channels : dict of name -> ((T, K) float64 values, (C,) int64 value index per corner[, rule]), face-varying
+        data refined under ``scheme.fvar`` or the rule given (uv, per-corner normals)
     vertex_data : dict of name -> (V, K) float64, per-vertex data refined as the positions are
     limit : the channels' values projected to the limit surface at level ``level`` (>= 1; positions stay
         level points): the limit uv at each refined corner
@@ -146,10 +146,10 @@ def refine_uniform(face_start: np.ndarray, corner_vertex: np.ndarray, positions:
     hole[np.asarray(scheme.holes, dtype=np.int64)] = True
     data = {"positions": np.asarray(positions, dtype=np.float64),
             **{name: np.asarray(values, dtype=np.float64) for name, values in vertex_data.items()}}
-    fvar = {name: base_channel(topology, values, np.asarray(index, dtype=np.int64),
-                               "all" if scheme.scheme == "bilinear" else scheme.fvar,
+    fvar = {name: base_channel(topology, channel[0], np.asarray(channel[1], dtype=np.int64),
+                               "all" if scheme.scheme == "bilinear" else (channel[2:] or (scheme.fvar,))[0],
                                edge_sharpness, vertex_sharpness, scheme.boundary)
-            for name, (values, index) in channels.items()}
+            for name, channel in channels.items()}
     for _ in range(level):
         masks = vertex_masks(topology, edge_sharpness, vertex_sharpness) if scheme.scheme != "bilinear" else None
         data = {name: refine_vertex_data(topology, masks, edge_sharpness, values) for name, values in data.items()}
