@@ -294,9 +294,9 @@ def lint_pass(mesh: Mesh, settings: Settings, visible: bool = True, scores: bool
     if where_drawn and settings.subdivision != "cage":  # Q101-Q103 on the surface drawn (design.md, "Subdivision")
         from .subdivision.measured import lint_where_drawn
 
-        drawn = lint_where_drawn(mesh, settings, visible, scores)
+        drawn = lint_where_drawn(mesh, settings, visible, scores, lint_pass)
         if drawn is not None:
-            return drawn
+            return MeshLint(*drawn)
     enabled = [RULES[code] for code in resolve_codes(settings.select, settings.ignore)]
     reads_textures = (visible and RULES["Q101"] in enabled and RULES["Q101"].unit_for(settings.measure) == "texels"
                       and mesh.texcoords is not None and (mesh.material_maps or mesh.material_textures))

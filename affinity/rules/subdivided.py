@@ -16,7 +16,7 @@ def _drift_of(quads) -> np.ndarray | None:
     """(F, 2) uv units: the mesh's UV drift (:func:`affinity.subdivision.drift.mesh_uv_drift`), computed once a
     pass and kept with the pass's corner tables; None where the settings draw the whole mesh as its cage."""
     from ..subdivision.drift import mesh_uv_drift
-    from ..subdivision.measured import drawn_levels
+    from ..subdivision.pieces import drawn_levels
 
     tables = quads.tables
     with _LOCK:

@@ -52,7 +52,7 @@ def mesh_uv_drift(mesh, settings) -> np.ndarray:
     """(F, 2) float64 each face's UV drift (:func:`uv_drift`) where the mesh is drawn subdivided under
     ``settings`` (a level above 0 or the limit surface, Catmull-Clark), NaN rows elsewhere: USD prims by
     their own rules, other meshes by the ``fvar-interpolation`` setting."""
-    from .measured import drawn_levels, local_faces
+    from .pieces import drawn_levels, local_faces
 
     drift = np.full((mesh.n_faces, 2), np.nan)
     if mesh.texcoords is None:

@@ -18,6 +18,7 @@ import numpy as np
 from ..findings import RefinedColumns, RuleHits, VisibleColumns
 from ..mesh import Mesh
 from ..rules import RULES, resolve_codes
+from .pieces import drawn_levels, local_faces
 from .refine import Scheme, refine_uniform
 
 #: Words of the USD loader's note on prims that subdivide, which a measured subdivided surface replaces.
@@ -33,22 +34,10 @@ class Piece:
     level: int
 
 
-def drawn_levels(mesh: Mesh, settings) -> tuple[np.ndarray, list[Scheme], list]:
-    """Per face, the index of its scheme (F,) int64; the schemes (a USD stage's per prim, else one: the
-    ``fvar-interpolation`` setting on USD's fallbacks); and each scheme's drawn level (0, N or "limit")."""
-    if mesh.subdivision is None:
-        schemes = [Scheme(fvar=settings.fvar_interpolation)]
-        return np.zeros(mesh.n_faces, dtype=np.int64), schemes, [settings.subdivision_level(False)]
-    schemes = list(mesh.subdivision)
-    levels = [settings.subdivision_level(True) if scheme.subdivides else 0 for scheme in schemes]
-    return mesh.face_group.astype(np.int64), schemes, levels
-
-
-def lint_where_drawn(mesh: Mesh, settings, visible: bool = True, scores: bool = False):
-    """The :class:`affinity.lint.MeshLint` of ``mesh`` with Q101-Q103 measured where the renderer draws them;
-    None where every face is drawn as its cage (then :func:`affinity.lint.lint_pass` lints as it always did)."""
-    from ..lint import MeshLint, lint_pass
-
+def lint_where_drawn(mesh: Mesh, settings, visible: bool, scores: bool, lint_pass) -> tuple | None:
+    """The lint of ``mesh`` with Q101-Q103 measured where the renderer draws them, as the fields of an
+    :class:`affinity.lint.MeshLint` (hits, scores, notes); None where every face is drawn as its cage (then
+    ``lint_pass``, :func:`affinity.lint.lint_pass` given by its caller, lints as it always did)."""
     face_scheme, schemes, levels = drawn_levels(mesh, settings)
     if all(level == 0 for level in levels):
         return None
@@ -80,7 +69,7 @@ def lint_where_drawn(mesh: Mesh, settings, visible: bool = True, scores: bool = 
             hits[h.code] = on_base if h.code not in hits else joined(hits[h.code], on_base)
     order = {code: i for i, code in enumerate(RULES)}
     kept = sorted((h for h in hits.values() if len(h)), key=lambda h: order[h.code])
-    return MeshLint(kept, cage.scores, _notes(mesh, settings, schemes, levels, scored, face_scheme))
+    return kept, cage.scores, _notes(mesh, settings, schemes, levels, scored, face_scheme)
 
 
 def refined_mesh(mesh: Mesh, pieces: list[Piece]) -> tuple[Mesh, np.ndarray, np.ndarray]:
@@ -112,48 +101,6 @@ def refined_mesh(mesh: Mesh, pieces: list[Piece]) -> tuple[Mesh, np.ndarray, np.
     )
     level = np.concatenate([np.full(len(part["base"]), piece.level) for part, piece in zip(parts, pieces)])
     return refined, base, level
-
-
-@dataclass(frozen=True)
-class LocalFaces:
-    """Some faces of a mesh in a numbering of their own (what refinement takes): ``face_start`` (n + 1,),
-    ``corner_vertex`` (C,) into ``positions`` (V', 3), the mesh's ``corners`` (C,) int64 they come from,
-    the mesh's vertices ``used`` (V',) and the ``scheme`` with its creases, corners and holes renumbered."""
-
-    face_start: np.ndarray
-    corner_vertex: np.ndarray
-    positions: np.ndarray
-    corners: np.ndarray
-    used: np.ndarray
-    scheme: Scheme
-
-    def channel(self, values: np.ndarray | None, index: np.ndarray | None) -> tuple | None:
-        """A per-corner attribute of the mesh (``values`` (T, K), ``index`` (C_mesh,)) on these faces, its
-        table cut to the values used; None where a corner lacks it."""
-        if values is None or index is None or (index[self.corners] < 0).any():
-            return None
-        taken, value_index = np.unique(index[self.corners], return_inverse=True)
-        return values[taken], value_index.ravel()
-
-
-def local_faces(mesh: Mesh, faces: np.ndarray, scheme: Scheme) -> LocalFaces:
-    """``faces`` (n,) int64 of ``mesh`` as :class:`LocalFaces` (vertices no face of theirs uses left out)."""
-    starts, ends = mesh.face_start[faces], mesh.face_start[faces + 1]
-    sizes = ends - starts
-    corners = np.repeat(starts - np.concatenate([[0], np.cumsum(sizes)[:-1]]), sizes) + np.arange(sizes.sum())
-    used, local = np.unique(mesh.corner_vertex[corners], return_inverse=True)
-    remap = np.full(len(mesh.positions), -1, dtype=np.int64)
-    remap[used] = np.arange(len(used))
-    creases = remap[scheme.crease_edges] if len(scheme.crease_edges) else scheme.crease_edges
-    keep = (creases >= 0).all(axis=1) if len(creases) else np.zeros(0, dtype=bool)
-    corner_vertices = remap[scheme.corner_vertices] if len(scheme.corner_vertices) else scheme.corner_vertices
-    keep_corner = corner_vertices >= 0
-    local_scheme = replace(scheme, crease_edges=creases[keep], crease_sharpness=scheme.crease_sharpness[keep],
-                           corner_vertices=corner_vertices[keep_corner],
-                           corner_sharpness=scheme.corner_sharpness[keep_corner],
-                           holes=np.flatnonzero(np.isin(faces, scheme.holes)))
-    return LocalFaces(np.concatenate([[0], np.cumsum(sizes)]), local.ravel(), mesh.positions[used], corners, used,
-                      local_scheme)
 
 
 def _refined_piece(mesh: Mesh, piece: Piece) -> dict:
