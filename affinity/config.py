@@ -14,6 +14,9 @@ Keys (kebab-case, as in ruff)::
     measure = "error"                # or "centre", "barycentric" ("misplacement": old name of error)
     diagonal = "both"                # "02", "13", "shortest"
     texture-size = 2048
+    subdivision = "auto"             # "cage", "level:2", "limit": which surface Q101-Q103 measure
+    profile = "game"                 # "storm", "blender-viewport", "blender-render", "film": its level for auto
+    fvar-interpolation = "cornersPlus1"  # OBJ/PLY/OFF uv rule when refined (USD meshes name their own)
     exclude = ["legacy", "wip/*.ply"]  # replaces the default skips (.git, node_modules, ...)
     extend-exclude = ["scratch"]     # adds to them
     [thresholds]                     # [tool.affinity.thresholds] in pyproject.toml
@@ -49,9 +52,12 @@ from .errors import UsageError
 from .rules import RULES
 from .settings import (
     DIAGONALS,
+    FVAR_INTERPOLATIONS,
     MEASURES,
+    PROFILES,
     Settings,
     measure_name,
+    subdivision_name,
     unknown_codes,
     unknown_levels,
     unmeasured_codes,
@@ -210,6 +216,13 @@ def _per_file_ignores(value, where: str) -> dict[str, list[str]]:
     return {glob: _codes(codes, f"{where}.{glob!r}") for glob, codes in value.items()}
 
 
+def _subdivision(value, where: str) -> str:
+    name = subdivision_name(value) if isinstance(value, str) else None
+    if name is None:
+        raise ConfigError(f"{where}: expected cage, auto, limit or level:N")
+    return name
+
+
 #: TOML key -> (Settings field, validator(value, where)).
 _KEYS = {
     "select": ("select", _selection),
@@ -225,6 +238,9 @@ _KEYS = {
     "extend-exclude": ("extend_exclude", _globs),
     "levels": ("levels", _levels),
     "per-file-ignores": ("per_file_ignores", _per_file_ignores),
+    "subdivision": ("subdivision", _subdivision),
+    "profile": ("profile", lambda v, where: _choice(v, tuple(PROFILES), where)),
+    "fvar-interpolation": ("fvar_interpolation", lambda v, where: _choice(v, FVAR_INTERPOLATIONS, where)),
 }
 
 

@@ -59,6 +59,28 @@ class VisibleColumns:
 
 
 @dataclass(eq=False)
+class RefinedColumns:
+    """Where a rule's n findings were measured on a subdivided surface (design.md, "Subdivision"): each
+    finding is its base face's worst refined face.
+
+    Attributes
+    ----------
+    levels : (n,) int8, the subdivision level measured (0: the cage)
+    flagged : (n,) int32, the base face's refined faces the rule flags
+    measured : (n,) int32, the base face's refined faces
+    """
+
+    levels: np.ndarray
+    flagged: np.ndarray
+    measured: np.ndarray
+
+    ARRAYS = ("levels", "flagged", "measured")
+
+    def subset(self, rows: np.ndarray) -> RefinedColumns:
+        return RefinedColumns(*(getattr(self, name)[rows] for name in self.ARRAYS))
+
+
+@dataclass(eq=False)
 class RuleHits:
     """Every finding of one rule in one file.
 
@@ -89,6 +111,8 @@ class RuleHits:
     visible : VisibleColumns or None
         Q101's visible reading: where it read C, ``values`` hold C and the level follows the
         ``visible-*`` settings (None: no texture was read).
+    refined : RefinedColumns or None
+        Where the findings were measured on a subdivided surface (None: on the cage).
     """
 
     code: str
@@ -102,6 +126,7 @@ class RuleHits:
     details: list[str] | None = None
     error_above: float | None = None
     visible: VisibleColumns | None = None
+    refined: RefinedColumns | None = None
 
     def __len__(self) -> int:
         return len(self.faces)
@@ -206,7 +231,8 @@ class RuleHits:
         details = None if self.details is None else np.asarray(self.details, dtype=object)[rows].tolist()
         return RuleHits(self.code, self.faces[rows], self.lines[rows], self.values[rows], self.threshold,
                         self.groups[rows], self.level, self.unit, details, self.error_above,
-                        None if self.visible is None else self.visible.subset(rows))
+                        None if self.visible is None else self.visible.subset(rows),
+                        None if self.refined is None else self.refined.subset(rows))
 
 
 @dataclass(eq=False)
@@ -377,7 +403,8 @@ def report_to_bytes(report: FileReport) -> bytes:
     kept_apart = ("hits", "prim_face_start", "scores")  # scores are the report's, never stored
     meta = {f.name: getattr(report, f.name) for f in fields(report) if f.name not in kept_apart}
     meta["hits"] = [{"code": h.code, "threshold": h.threshold, "level": h.level, "unit": h.unit,
-                     "details": h.details, "error_above": h.error_above, "visible": _visible_meta(h.visible)}
+                     "details": h.details, "error_above": h.error_above, "visible": _visible_meta(h.visible),
+                     "refined": h.refined is not None}
                     for h in report.hits]
     arrays = [array for hits in report.hits for array in _hit_arrays(hits)]
     if report.prim_face_start is not None:
@@ -419,7 +446,11 @@ def report_from_bytes(data: bytes) -> FileReport:
                 taken += len(columns)
                 visible = VisibleColumns(*columns, visible["textures"], visible["roles"], visible["units"],
                                          tuple(visible["limits"]), visible["fixed"])
-            hits.append(RuleHits(**h, **own, visible=visible))
+            refined = None
+            if h.pop("refined"):
+                refined = RefinedColumns(*arrays[taken : taken + len(RefinedColumns.ARRAYS)])
+                taken += len(RefinedColumns.ARRAYS)
+            hits.append(RuleHits(**h, **own, visible=visible, refined=refined))
         prim_face_start = arrays[taken] if len(arrays) > taken else None
         return FileReport(**meta, hits=hits, prim_face_start=prim_face_start)
     except (zlib.error, KeyError, TypeError, IndexError, AttributeError) as err:
@@ -427,7 +458,7 @@ def report_from_bytes(data: bytes) -> FileReport:
 
 
 _HIT_ARRAYS = ("faces", "lines", "values", "groups")
-_BLOB_MAGIC = b"QAR3"  # QAR2: hits carry error_above; QAR3: and Q101's visible reading
+_BLOB_MAGIC = b"QAR4"  # QAR2: hits carry error_above; QAR3: and Q101's visible reading; QAR4: and subdivision
 
 
 def _visible_meta(visible: VisibleColumns | None) -> dict | None:
@@ -439,8 +470,11 @@ def _visible_meta(visible: VisibleColumns | None) -> dict | None:
 
 
 def _hit_arrays(hits: RuleHits) -> list[np.ndarray]:
-    """The arrays :func:`report_to_bytes` stores for one rule's hits: its own, then its visible reading's."""
+    """The arrays :func:`report_to_bytes` stores for one rule's hits: its own, its visible reading's, then where
+    it was refined."""
     arrays = [getattr(hits, name) for name in _HIT_ARRAYS]
     if hits.visible is not None:
         arrays += [getattr(hits.visible, name) for name in VisibleColumns.ARRAYS]
+    if hits.refined is not None:
+        arrays += [getattr(hits.refined, name) for name in RefinedColumns.ARRAYS]
     return arrays

@@ -260,7 +260,8 @@ def lint_mesh(mesh: Mesh, settings: Settings, visible: bool = True) -> list[Rule
     return lint_pass(mesh, settings, visible).hits
 
 
-def lint_pass(mesh: Mesh, settings: Settings, visible: bool = True, scores: bool = False) -> MeshLint:
+def lint_pass(mesh: Mesh, settings: Settings, visible: bool = True, scores: bool = False,
+              where_drawn: bool = True) -> MeshLint:
     """Apply every rule enabled by ``settings.select``/``settings.ignore`` to ``mesh``, in one pass over its quads.
 
     Q101 is in texels (each quad's texture size from its material's texture header,
@@ -277,7 +278,15 @@ def lint_pass(mesh: Mesh, settings: Settings, visible: bool = True, scores: bool
     -------
     MeshLint: ``hits``, one RuleHits per rule with at least one finding, in rule-table order, faces in
     file order within each; ``scores``, rule code -> QuadScores (empty without ``scores``).
+    With ``where_drawn`` (the default), a mesh the settings draw subdivided has Q101-Q103 measured on its
+    refined surface (:func:`affinity.subdivision.measured.lint_where_drawn`); without, on the faces given.
     """
+    if where_drawn and settings.subdivision != "cage":  # Q101-Q103 on the surface drawn (design.md, "Subdivision")
+        from .subdivision.measured import lint_where_drawn
+
+        drawn = lint_where_drawn(mesh, settings, visible, scores, lint_pass)
+        if drawn is not None:
+            return MeshLint(*drawn)
     enabled = [RULES[code] for code in resolve_codes(settings.select, settings.ignore)]
     reads_textures = (visible and any(rule.visible_reading and rule.unit_for(settings.measure) == "texels"
                                       for rule in enabled)
@@ -369,7 +378,8 @@ def mesh_report(path: str, mesh, settings, inline=(), scores: bool = False) -> F
     hits, shared = share_authored_geometry(settle(linted.hits, settings, list(mesh.group_names), inline), mesh)
     return FileReport(path, counts=mesh.counts(), hits=hits, shared=shared, group_names=list(mesh.group_names),
                       prim_face_start=mesh.prim_face_start, up_axis=mesh.up_axis,
-                      meters_per_unit=mesh.meters_per_unit, notes=list(mesh.notes), scores=linted.scores)
+                      meters_per_unit=mesh.meters_per_unit,
+                      notes=list(mesh.notes if linted.notes is None else linted.notes), scores=linted.scores)
 
 
 class Unmeasurable:
@@ -516,10 +526,12 @@ class QuadScores:
 @dataclass(frozen=True)
 class MeshLint:
     """One pass of the rules over a mesh (:func:`lint_pass`): ``hits`` (list of RuleHits, rule-table order) and
-    ``scores`` (scored rule code -> :class:`QuadScores` of every measured quad; empty unless asked)."""
+    ``scores`` (scored rule code -> :class:`QuadScores` of every measured quad; empty unless asked); ``notes``
+    replace the mesh's own where the pass measured a subdivided surface (None: the mesh's notes stand)."""
 
     hits: list[RuleHits]
     scores: dict[str, QuadScores]
+    notes: list[str] | None = None
 
 
 def scored_codes(mesh: Mesh | None = None, attribute: str | None = None) -> list[str]:

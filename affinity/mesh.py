@@ -72,6 +72,10 @@ class Mesh:
     notes : list of str
         What the loader read but did not represent, for the user (e.g. USD
         PointInstancer copies that were not expanded).
+    subdivision : list of affinity.subdivision.Scheme or None
+        USD only: per prim (group), how its faces subdivide (``subdivisionScheme``, ``interpolateBoundary``,
+        ``faceVaryingLinearInterpolation``, creases, corners, holes; vertex and face indices into this mesh).
+        None where the format names no scheme (OBJ, PLY, OFF).
     """
 
     path: str
@@ -96,6 +100,7 @@ class Mesh:
     up_axis: str | None = None
     meters_per_unit: float | None = None
     notes: list[str] = field(default_factory=list)
+    subdivision: list | None = None
 
     def __post_init__(self):
         if self.face_group is None:

@@ -32,6 +32,18 @@ DEFAULT_EXCLUDE = (
     "__pycache__", "__pypackages__", "_build", "buck-out", "build", "dist", "node_modules", "site-packages", "venv",
 )
 DIAGONALS = ("both", "02", "13", "shortest")
+#: Renderer profiles -> the subdivision level they draw (0: the cage; "limit": the limit surface).
+PROFILES = {"game": 0, "storm": 0, "blender-viewport": 1, "blender-render": 2, "film": "limit"}
+#: Face-varying linear-interpolation rules (USD's ``faceVaryingLinearInterpolation``, OpenSubdiv's Sdc).
+FVAR_INTERPOLATIONS = ("none", "cornersOnly", "cornersPlus1", "cornersPlus2", "boundaries", "all")
+
+
+def subdivision_name(text: str) -> str | None:
+    """``text`` as a ``subdivision`` setting (``cage``, ``auto``, ``limit`` or ``level:N``, N >= 0), else None."""
+    if text in ("cage", "auto", "limit"):
+        return text
+    head, _, number = text.partition(":")
+    return f"level:{int(number)}" if head == "level" and number.isdigit() else None
 
 
 def measure_name(name: str, where: str) -> str | None:
@@ -70,6 +82,9 @@ class Settings:
     ``visible_error``, ``visible_warning`` (1/255 steps, degrees for normal maps) and
     ``visible_min_shift`` (texels) level Q101's findings read through a decoded texture
     (design.md, "The visible reading"; :attr:`visible_limits`).
+    ``subdivision`` (``cage``, ``auto``, ``level:N``, ``limit``) and ``profile`` (:data:`PROFILES`) say which
+    surface Q101-Q103 measure (:attr:`subdivision_level`); ``fvar_interpolation`` is the face-varying rule
+    of meshes whose file names none (OBJ, PLY, OFF).
     """
 
     select: list[str] | None = None
@@ -88,6 +103,21 @@ class Settings:
     extend_exclude: list[str] = field(default_factory=list)
     root: str | None = None
     group_ignores: list[tuple[str, list[str]]] = field(default_factory=list)
+    subdivision: str = "auto"
+    profile: str = "game"
+    fvar_interpolation: str = "cornersPlus1"
+
+    def subdivision_level(self, scheme_subdivides: bool) -> int | str:
+        """The level Q101-Q103 measure a mesh at (0: the cage, ``"limit"``): ``level:N`` and ``limit`` as
+        they say, ``cage`` 0, ``auto`` the profile's level where the mesh's own scheme subdivides (an OBJ,
+        PLY or OFF mesh has none: its cage)."""
+        if self.subdivision.startswith("level:"):
+            return int(self.subdivision.partition(":")[2])
+        if self.subdivision == "limit":
+            return "limit"
+        if self.subdivision == "cage" or not scheme_subdivides:
+            return 0
+        return PROFILES[self.profile]
 
     @property
     def split_measure(self) -> str:

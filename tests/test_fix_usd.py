@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 from helpers.cli import run
@@ -132,8 +134,6 @@ def test_the_shared_knight_is_refined_under_the_default_profile_with_one_note_pe
 
 
 def test_under_a_subdividing_profile_every_flagged_quad_is_left_subdivided(tmp_path):
-    from types import SimpleNamespace
-
     from affinity.fix.plan import profile_subdivides
     from affinity.settings import Settings
 
@@ -144,9 +144,22 @@ def test_under_a_subdividing_profile_every_flagged_quad_is_left_subdivided(tmp_p
     assert plan.empty and plan.left_reasons.tolist() == ["subdivided"] and plan.faces_added == 0
     # the hook: a check of the cage (today's settings, or a level 0) refines; a subdividing one does not
     assert not profile_subdivides(Settings())
-    assert not profile_subdivides(SimpleNamespace(subdivision="level:0"))
-    assert profile_subdivides(SimpleNamespace(subdivision="level:2"))
-    assert profile_subdivides(SimpleNamespace(subdivision="limit"))
-    assert profile_subdivides(SimpleNamespace(subdivision="auto", profile="film"))
-    assert not profile_subdivides(SimpleNamespace(subdivision="auto", profile="film"), scheme_subdivides=False)
-    assert not profile_subdivides(SimpleNamespace(subdivision="auto", profile="storm"))
+    assert not profile_subdivides(Settings(subdivision="level:0"))
+    assert profile_subdivides(Settings(subdivision="level:2"))
+    assert profile_subdivides(Settings(subdivision="limit"))
+    assert profile_subdivides(Settings(profile="film"))
+    assert not profile_subdivides(Settings(profile="film"), scheme_subdivides=False)  # an OBJ draws its cage
+    assert not profile_subdivides(Settings(profile="storm"))
+
+
+def test_the_shared_knight_under_a_subdividing_profile_is_left_subdivided(shared_meshes, tmp_path):
+    """What you check is what you fix: blender-render checks level 2 of the knight (USD's fallback scheme
+    subdivides it), so the cage's flagged quads are left ``subdivided`` and nothing is written."""
+    import shutil
+
+    folder = shutil.copytree(shared_meshes / "usd" / "OpenChessSet" / "assets" / "Knight", tmp_path / "Knight")
+    cage = json.loads(run("fix", "--dry-run", "--format", "json", str(folder / "Knight.usd")).stdout)["files"][0]
+    drawn = json.loads(run("fix", "--dry-run", "--format", "json", "--profile", "blender-render",
+                           str(folder / "Knight.usd")).stdout)["files"][0]
+    assert cage["refine"] and not drawn["refine"]
+    assert drawn["left"] and {left["reason"] for left in drawn["left"]} == {"subdivided"}

@@ -28,9 +28,10 @@ def lint(tmp_path, text: str, *options: str):
 def test_use_instead_lints_clean(code, tmp_path):
     rule = PAGES[code]
     lines = rule.use_instead.splitlines()
-    assert 4 <= len(lines) <= 10 and lines[0].startswith("# "), "a tiny OBJ that says what it changed"
+    assert 4 <= len(lines) <= (16 if rule.example_flags else 10) and lines[0].startswith("# "), \
+        "a tiny OBJ that says what it changed"
     assert rule.use_instead != rule.example
-    result = lint(tmp_path, rule.use_instead, "--format", "json")
+    result = lint(tmp_path, rule.use_instead, "--format", "json", *rule.example_flags)
     assert result.returncode == 0, result.stdout + result.stderr
     report = json.loads(result.stdout)
     assert report["findings"] == [] and report["summary"]["checked"] == 1
@@ -64,10 +65,11 @@ def test_pages_show_use_instead_after_the_example(code):
     page = run("rule", code).stdout
     plain = [page.index(f"\n{title}\n") for title in ("Example", "Use instead", "How to fix")]
     assert plain == sorted(plain)
-    assert "affinity check example.obj finds nothing in it (exit 0)." in page[plain[1]:plain[2]]
+    command = " ".join(["affinity check", *PAGES[code].example_flags, "example.obj"])
+    assert f"{command} finds nothing in it (exit 0)." in page[plain[1]:plain[2]]
     first_line = PAGES[code].use_instead.splitlines()[0]
     assert f"\n        {first_line}\n" in page[plain[1]:plain[2]]
-    block = f"### Use instead\n\n```\n{PAGES[code].use_instead}```\n\n`affinity check example.obj` finds nothing"
+    block = f"### Use instead\n\n```\n{PAGES[code].use_instead}```\n\n`{command}` finds nothing"
     assert block in rule_page(PAGES[code], markdown=True)
 
 

@@ -165,6 +165,18 @@ def q201_smallest_triangle():
 
 R, Q101_WORST, Q101_CENTRE = q101_trapezoid()
 Q202_02, Q202_13 = q202_folds()
+def q106_limit_u() -> Fraction:
+    """The limit u of the example's shared edge where it meets the boundary: the smooth boundary rule's limit
+    (u_prev + 4 u + u_next) / 6 along the boundary (Catmull-Clark's B-spline boundary curve)."""
+    u = [vt[0] for vt in example_data(RULES["Q106"].example)["vt"]]
+    return (u[0] + 4 * u[1] + u[2]) / 6
+
+
+def q106_drift() -> Fraction:
+    """The example's drift in uv units: the limit u minus the cage's (the largest over the quads' samples)."""
+    return q106_limit_u() - example_data(RULES["Q106"].example)["vt"][1][0]
+
+
 THRESHOLD = "the rule's default threshold (a setting, shown by the page's Level line)"
 VISIBLE = "the visibility threshold (setting levels.CODE), shown by the page's Level line"
 CONSTANT = "a constant of the closed form printed beside it"
@@ -187,6 +199,14 @@ NUMBERS: dict[str, dict[str, Closed | str]] = {
     "Q103": {
         "9.847": Closed(q103_turn()[0]), "2": THRESHOLD, "8": VISIBLE + "; " + CONSTANT,
         "19": CONSTANT, "41": CONSTANT, "5": CONSTANT,
+    },
+    "Q106": {
+        "102.4": Closed(1024 * q106_drift()), "0.1": Closed(q106_drift()), "0.3": Closed(q106_limit_u()),
+        "0.2": Closed(example_data(RULES["Q106"].example)["vt"][1][0]),
+        "0": Closed(example_data(RULES["Q106"].example)["vt"][0][0]),
+        "1": THRESHOLD + "; the u at the edge's far end, " + CONSTANT, "4": CONSTANT, "6": CONSTANT,
+        "5": "the samples a side of a quad refined twice (2^2 + 1)",
+        "1024": "the texture-size setting's default", "1024x1024": "the texture-size setting's default",
     },
     "Q201": {"0": Closed(q201_smallest_triangle()), "1e-09": THRESHOLD},
     "Q202": {
@@ -248,13 +268,16 @@ def test_every_number_on_the_page_is_derived_or_labelled(code):
 def test_what_check_prints_for_the_example_is_its_closed_form(code, tmp_path):
     """The JSON value to 1e-12 and the text line to the digits it prints, against the page's closed form."""
     (tmp_path / "example.obj").write_text(RULES[code].example)
-    result = run("check", "--select", "ALL", "--format", "json", "example.obj", cwd=tmp_path)
-    finding, = json.loads(result.stdout)["findings"]
+    flags = RULES[code].example_flags
+    result = run("check", "--select", "ALL", "--format", "json", *flags, "example.obj", cwd=tmp_path)
+    findings = json.loads(result.stdout)["findings"]
+    assert len(findings) == RULES[code].example_output.count("\n")  # one a line the page prints
     printed = PRINTED_VALUE.search(RULES[code].example_output)["value"]
     closed = NUMBERS[code][printed]
     assert isinstance(closed, Closed), f"{code}'s printed value {printed} has no closed form"
-    assert abs(finding["value"] - closed.value) <= 1e-12 * max(1, abs(closed.value))
-    text = run("check", "--select", "ALL", "example.obj", cwd=tmp_path).stdout
+    for finding in findings:
+        assert abs(finding["value"] - closed.value) <= 1e-12 * max(1, abs(closed.value))
+    text = run("check", "--select", "ALL", *flags, "example.obj", cwd=tmp_path).stdout
     assert closed.shown_as(PRINTED_VALUE.search(text)["value"])
 
 

@@ -135,6 +135,7 @@ def add_parser(sub) -> None:
                    help="which split diagonal the affinity test measures (default: both)")
     p.add_argument("--texture-size", type=int, metavar="PX",
                    help="texture size for texel units when the mesh names no readable map_Kd (default 1024)")
+    add_subdivision_arguments(p)
     usd = p.add_argument_group("USD stages")
     usd.add_argument("--time", type=_time, metavar="T",
                      help="read the stage at time code T (default: the earliest time sample)")
@@ -183,6 +184,32 @@ def add_parser(sub) -> None:
     p.set_defaults(run=run)
 
 
+def add_subdivision_arguments(p) -> None:
+    """The options that say which surface Q101-Q103 measure (design.md, "Subdivision")."""
+    from ..rules.wording import scored_span
+    from ..settings import FVAR_INTERPOLATIONS, PROFILES
+
+    group = p.add_argument_group("subdivision")
+    group.add_argument("--subdivision", type=_subdivision, metavar="{cage,auto,level:N,limit}",
+                       help=f"measure {scored_span()} on the cage, on the mesh's own scheme at the profile's level "
+                            "(auto, the default), on the surface refined N times, or on the limit surface")
+    group.add_argument("--profile", choices=tuple(PROFILES),
+                       help="the renderer whose level auto measures: game and storm the cage (game is the "
+                            "default), blender-viewport level 1, blender-render level 2, film the limit surface")
+    group.add_argument("--fvar-interpolation", choices=FVAR_INTERPOLATIONS,
+                       help="the uv rule of OBJ/PLY/OFF meshes refined with --subdivision level:N "
+                            "(default cornersPlus1, USD's)")
+
+
+def _subdivision(text: str) -> str:
+    from ..settings import subdivision_name
+
+    name = subdivision_name(text)
+    if name is None:
+        raise argparse.ArgumentTypeError(f"invalid value: {text!r} (choose cage, auto, limit or level:N)")
+    return name
+
+
 def add_gate_arguments(p) -> None:
     """The options that decide the exit code :func:`publish` returns."""
     from ..rules import LEVELS
@@ -221,6 +248,8 @@ def _overrides(args) -> dict:
     given = {
         "select": args.select, "ignore": args.ignore, "measure": args.measure,
         "diagonal": args.diagonal, "texture_size": args.texture_size,
+        "subdivision": getattr(args, "subdivision", None), "profile": getattr(args, "profile", None),
+        "fvar_interpolation": getattr(args, "fvar_interpolation", None),
     }
     return {"thresholds": thresholds, **{k: v for k, v in given.items() if v is not None}}
 
@@ -323,12 +352,11 @@ def _journal(path: str | None, settings, tasks: list, shard: ShardRecord | None)
     if path is None:
         yield None
         return
+    from ..atomic import refuse_unsafe
     from ..output.names import printable
     from ..shards.journal import Journal, header_of
     from ..shards.results import ResultError
     from ..shards.selection import run_digest
-
-    from ..atomic import refuse_unsafe
 
     header = header_of(settings, len(tasks), run_digest([p for p, _ in tasks]), shard)
     try:

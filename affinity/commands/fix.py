@@ -43,7 +43,7 @@ def add_parser(sub) -> None:
     from ..rules import LEVELS
     from ..rules.wording import fix_left_code, scored, scored_span
     from ..settings import DIAGONALS, MEASURES
-    from .check import _codes, _measure, _selection, _threshold
+    from .check import _codes, _measure, _selection, _threshold, add_subdivision_arguments
 
     p = sub.add_parser(
         "fix", help="refine the quads the affinity rules flag, crack-free, touching nothing else",
@@ -74,6 +74,7 @@ def add_parser(sub) -> None:
                         "K, M, G allowed)")
     p.add_argument("--allow-new-findings", action="store_true",
                    help="write a result even where it adds a finding of another rule at warning or above")
+    add_subdivision_arguments(p)
     p.add_argument("--refine-nonplanar", action="store_true",
                    help=f"refine the quads {fix_left_code('nonplanar')} flags too: their pieces follow the quad's "
                         "bilinear surface, "

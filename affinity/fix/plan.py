@@ -94,18 +94,12 @@ class FixSettings:
 
 
 #: Profiles that draw the subdivided surface of a mesh whose scheme subdivides (design.md, "Subdivision").
-SUBDIVIDING_PROFILES = ("blender-viewport", "blender-render", "film")
-
-
 def profile_subdivides(settings: Settings, scheme_subdivides: bool = True) -> bool:
-    """Whether ``settings`` check the subdivided surface rather than the cage: an explicit level above 0 or the
-    limit, or ``auto`` under a profile that subdivides for a mesh whose scheme subdivides
-    (``scheme_subdivides``: a USD mesh; OBJ, PLY and OFF have no scheme). Then the fix leaves its candidates
-    ``subdivided``. Settings without a subdivision setting check the cage."""
-    subdivision = getattr(settings, "subdivision", "cage")
-    if subdivision == "auto":
-        return scheme_subdivides and getattr(settings, "profile", "game") in SUBDIVIDING_PROFILES
-    return subdivision not in ("cage", "level:0")
+    """Whether ``settings`` check the subdivided surface rather than the cage (a level above 0 or the limit,
+    :meth:`~affinity.settings.Settings.subdivision_level`) for a mesh whose own scheme subdivides or not
+    (``scheme_subdivides``: a USD mesh; OBJ, PLY and OFF have no scheme). Then the fix leaves its
+    candidates ``subdivided``: what you check is what you fix."""
+    return settings.subdivision_level(scheme_subdivides) != 0
 
 
 @dataclass(eq=False)

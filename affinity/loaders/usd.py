@@ -45,7 +45,7 @@ from __future__ import annotations
 
 import os
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -287,8 +287,14 @@ def _read_prim(prim, time, xforms, uv_primvar: str | None) -> Mesh:
             for index in (corner_vertex, corner_texcoord, corner_normal, corner_color))
     positions = _transformed(points, matrix[:3, :3]) + matrix[3, :3]
     colors = None
+    scheme = subdivision_scheme(usd_mesh, time)
     if color is not None:
+        n_points = len(positions)
         positions, corner_vertex, colors = colors_per_vertex(positions, corner_vertex, corner_color, color.values)
+        if len(positions) != n_points:  # vertices split by colour: crease indices no longer name them
+            scheme = replace(scheme, crease_edges=scheme.crease_edges[:0], crease_sharpness=scheme.crease_sharpness[:0],
+                             corner_vertices=scheme.corner_vertices[:0],
+                             corner_sharpness=scheme.corner_sharpness[:0])
     return Mesh(
         path=str(prim.GetPath()),
         positions=positions,
@@ -300,7 +306,46 @@ def _read_prim(prim, time, xforms, uv_primvar: str | None) -> Mesh:
         normals=None if normals is None else world_normals(normals.values, matrix[:3, :3]),
         corner_normal=corner_normal,
         colors=colors,
+        subdivision=[scheme],
     )
+
+
+def subdivision_scheme(usd_mesh, time):
+    """How a ``UsdGeom.Mesh`` subdivides, as an :class:`affinity.subdivision.Scheme`: its scheme and rules
+    (authored, or USD's fallbacks: catmullClark, edgeAndCorner, cornersPlus1), its creases (chains of
+    ``creaseLengths`` vertices, one sharpness a chain or an edge), corners and holes."""
+    from ..subdivision import BOUNDARY_RULES, SCHEMES, Scheme
+    from ..subdivision.facevarying import RULES
+
+    def tokens(attr, allowed, fallback):
+        value = str(attr.Get(time) or fallback)
+        return value if value in allowed else fallback
+
+    indices = _array(usd_mesh.GetCreaseIndicesAttr(), time, np.int64)
+    lengths = _array(usd_mesh.GetCreaseLengthsAttr(), time, np.int64)
+    sharpness = _array(usd_mesh.GetCreaseSharpnessesAttr(), time, np.float64)
+    edges, edge_sharpness = np.zeros((0, 2), dtype=np.int64), np.zeros(0)
+    if len(lengths) and lengths.sum() == len(indices) and (lengths >= 2).all():
+        starts = np.concatenate([[0], np.cumsum(lengths)[:-1]])
+        chain = np.repeat(np.arange(len(lengths)), lengths - 1)
+        first = np.concatenate([np.arange(s, s + n - 1) for s, n in zip(starts, lengths)])
+        edges = np.stack([indices[first], indices[first + 1]], axis=1)
+        if len(sharpness) == len(lengths):
+            edge_sharpness = sharpness[chain]
+        elif len(sharpness) == len(edges):
+            edge_sharpness = sharpness
+        else:
+            edges = edges[:0]
+    corners = _array(usd_mesh.GetCornerIndicesAttr(), time, np.int64)
+    corner_sharpness = _array(usd_mesh.GetCornerSharpnessesAttr(), time, np.float64)
+    if len(corners) != len(corner_sharpness):
+        corners, corner_sharpness = corners[:0], corner_sharpness[:0]
+    return Scheme(scheme=tokens(usd_mesh.GetSubdivisionSchemeAttr(), SCHEMES, "catmullClark"),
+                  boundary=tokens(usd_mesh.GetInterpolateBoundaryAttr(), BOUNDARY_RULES, "edgeAndCorner"),
+                  fvar=tokens(usd_mesh.GetFaceVaryingLinearInterpolationAttr(), RULES, "cornersPlus1"),
+                  crease_edges=edges, crease_sharpness=edge_sharpness, corner_vertices=corners,
+                  corner_sharpness=corner_sharpness,
+                  holes=_array(usd_mesh.GetHoleIndicesAttr(), time, np.int64))
 
 
 def _transformed(rows: np.ndarray, linear: np.ndarray) -> np.ndarray:
@@ -496,4 +541,16 @@ def _concatenate(path: str, parts: list[Mesh], prim_paths: list[str]) -> Mesh:
         colors=colors,
         texcoords=texcoords, corner_texcoord=corner_texcoord,
         normals=normals, corner_normal=corner_normal,
+        subdivision=_offset_schemes(parts),
     )
+
+
+def _offset_schemes(parts: list[Mesh]) -> list | None:
+    """The prims' :class:`affinity.subdivision.Scheme` with vertex and face indices into the joined mesh."""
+    if any(p.subdivision is None for p in parts):
+        return None
+    vertex = np.cumsum([0] + [len(p.positions) for p in parts])
+    face = np.cumsum([0] + [p.n_faces for p in parts])
+    return [replace(scheme, crease_edges=scheme.crease_edges + v, corner_vertices=scheme.corner_vertices + v,
+                    holes=scheme.holes + f)
+            for p, v, f in zip(parts, vertex, face) for scheme in p.subdivision]

@@ -130,16 +130,20 @@ class Finding:
     bound: str | None = None
     texture: str | None = None
     role: str | None = None
+    subdivision_level: int | None = None
+    refined_faces_flagged: int | None = None
 
 
 #: The Finding fields only a USD stage fills: left out of structured output where they are None.
 USD_FIELDS = ("prim", "layer", "layer_prim", "prims", "prim_values")
 #: The fields of Q101's visible reading (design.md): set where C was read through a texture, else left out.
 VISIBLE_FIELDS = ("shift", "bound", "texture", "role")
+#: Where a finding was measured on a subdivided surface (design.md, "Subdivision"): left out for the cage.
+REFINED_FIELDS = ("subdivision_level", "refined_faces_flagged")
 #: The fields of geometry several prims reference (:attr:`Columns.shared`).
 SHARED_FIELDS = USD_FIELDS[1:]
 #: The Finding fields left out of structured output where they are None.
-OPTIONAL_FIELDS = (*USD_FIELDS, *VISIBLE_FIELDS)
+OPTIONAL_FIELDS = (*USD_FIELDS, *VISIBLE_FIELDS, *REFINED_FIELDS)
 
 
 def shared_fields(f: Finding) -> dict | None:
@@ -237,7 +241,8 @@ class Columns:
         visible = self.visible or [{}] * len(self)
         return [Finding(self.path, line, column, self.code, self.name, face, value,
                         read.get("threshold", self.threshold), read.get("unit", self.unit), level, group, message, prim,
-                        **(where or {}), **{name: read[name] for name in VISIBLE_FIELDS if name in read})
+                        **(where or {}),
+                        **{name: read[name] for name in (*VISIBLE_FIELDS, *REFINED_FIELDS) if name in read})
                 for line, column, face, value, level, group, message, prim, where, read in zip(
                     self.line, self.column, self.face, self.value, self.level, self.group, self.message, self.prim,
                     shared, visible)]
@@ -246,7 +251,9 @@ class Columns:
     def of(cls, f: Finding) -> Columns:
         """One finding as columns."""
         where = shared_fields(f)
-        read = {name: getattr(f, name) for name in VISIBLE_FIELDS} if f.shift is not None else None
+        read = {name: getattr(f, name) for name in VISIBLE_FIELDS} if f.shift is not None else {}
+        read.update({name: getattr(f, name) for name in REFINED_FIELDS if getattr(f, name) is not None})
+        read = read or None
         return cls(f.path, f.code, f.name, f.unit, f.threshold, np.array([f.line]), np.array([f.column]),
                    np.array([f.face]), np.array([f.value], dtype=float),
                    np.array([LEVELS.index(f.level)], dtype=np.int8), [f.group], [f.message], [f.prim],
@@ -275,6 +282,11 @@ def columns(report: FileReport, hits: RuleHits, take: np.ndarray, ranks: np.ndar
     group = names[np.where((groups >= 0) & (groups < len(report.group_names)), groups, -1)].tolist()
     visible = None if hits.visible is None else _visible_fields(hits, take, report.path)
     remarks = [None] * len(take) if visible is None else [read.pop("remark", None) for read in visible]
+    if hits.refined is not None:
+        visible = visible or [{} for _ in range(len(take))]
+        for read, level, flagged in zip(visible, hits.refined.levels[take].tolist(),
+                                        hits.refined.flagged[take].tolist()):
+            read.update(subdivision_level=level, refined_faces_flagged=flagged)
     message = [rule.summary] * len(take)
     details = None if hits.details is None else list(map(hits.details.__getitem__, take.tolist()))
     # Remarks are few (a note on one finding, causes on some): only the rows that have one are joined.

@@ -57,6 +57,7 @@ from .. import __version__
 from ..findings import FileReport
 from ..rules import LEVELS, RULES, UNREADABLE, number_spec, rule_page
 from . import (
+    REFINED_FIELDS,
     VALUE_TOKEN,
     VISIBLE_FIELDS,
     CheckRun,
@@ -242,7 +243,7 @@ def _rich_result(c: Columns, located: dict, where: dict | None, read: dict, iden
     properties = {"name": c.name, "face": face, "value": value, "threshold": read.get("threshold", c.threshold),
                   "unit": read.get("unit", c.unit), "level": level, "group": group,
                   **({} if prim is None else {"prim": prim}),
-                  **{name: read[name] for name in VISIBLE_FIELDS if read.get(name) is not None}}
+                  **{name: read[name] for name in (*VISIBLE_FIELDS, *REFINED_FIELDS) if read.get(name) is not None}}
     result = {"ruleId": c.code, "ruleIndex": rule_index, "level": sarif_level(level),
               "message": {"text": text + authored_where(where)}, "locations": [located],
               "partialFingerprints": {FINGERPRINT: identity}, "properties": properties}
@@ -316,7 +317,7 @@ def _folder_uri(folder: Path) -> str:
 
 def document(run: CheckRun) -> tuple[dict, str]:
     """The SARIF log as Python objects, its results standing in as ``[RESULTS]``, and the results as JSON text."""
-    properties: dict = {}
+    properties: dict = {"profile": run.settings.profile, "subdivision": run.settings.subdivision}
     if run.max_findings is not None:
         properties["truncated"] = truncation(run, run.max_findings)
     if run.statistics:
@@ -345,7 +346,7 @@ def document(run: CheckRun) -> tuple[dict, str]:
             "columnKind": "unicodeCodePoints",
             "results": [RESULTS],
             **({} if run.shard is None else {"automationDetails": {"id": shard_category(run.shard)}}),
-            **({"properties": properties} if properties else {}),
+            "properties": properties,
         }],
     }, results
 

@@ -4,6 +4,7 @@
 - :mod:`.shape`: Q201-Q204, the quad's own shape;
 - :mod:`.file`: Q205 no-faces, and Q901 unreadable (documented, never linted);
 - :mod:`.texture`: Q301-Q302, the quad in texture space;
+- :mod:`.subdivided`: Q106, what subdivision does to the texture (UV drift);
 - :mod:`.docs`: a rule's page and the README's table, from the registry.
 
 A rule is its check decorated with ``@rule(code=..., name=..., ...)``, one signature for
@@ -13,7 +14,7 @@ its module only: lint, the report, SARIF, ``affinity rules`` and the README tabl
 read :data:`RULES`.
 """
 
-from . import affinity, file, shape, texture  # noqa: F401  each registers its rules
+from . import affinity, file, shape, subdivided, texture  # noqa: F401  each registers its rules
 from .docs import SECTIONS, number_spec, number_text, rule_page, rules_table, threshold_text, with_unit
 from .file import UNREADABLE
 from .registry import (

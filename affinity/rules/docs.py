@@ -72,16 +72,18 @@ def _file(obj: str, outcome: str, markdown: bool) -> str:
 def _example(rule: Rule, markdown: bool) -> str:
     """The example OBJ, then what ``affinity check example.obj`` prints for it."""
     output = rule.example_output.rstrip("\n")
+    command = " ".join(["affinity check", *rule.example_flags, "example.obj"])
     if markdown:
-        printed = f"`affinity check example.obj` prints:\n\n```\n{output}\n```"
+        printed = f"`{command}` prints:\n\n```\n{output}\n```"
     else:
-        printed = "affinity check example.obj prints:\n\n" + textwrap.indent(output, "        ")
+        printed = f"{command} prints:\n\n" + textwrap.indent(output, "        ")
     return _file(rule.example, printed if output else "", markdown)
 
 
 def _use_instead(rule: Rule, markdown: bool) -> str:
     """The example fixed the way the page's *How to fix* says: ``affinity check`` finds it clean."""
-    command = "`affinity check example.obj`" if markdown else "affinity check example.obj"
+    command = " ".join(["affinity check", *rule.example_flags, "example.obj"])
+    command = f"`{command}`" if markdown else command
     return _file(rule.use_instead, f"{command} finds nothing in it (exit 0).", markdown)
 
 

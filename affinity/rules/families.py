@@ -10,4 +10,5 @@ COLOR_AFFINITY = register_family("ColorAffinity", "vertex colours that are not a
 NORMAL_AFFINITY = register_family("NormalAffinity", "normals that are not an affine image of the quad, in degrees.")
 QUAD_SHAPE = register_family("QuadShape", "degenerate, nonplanar, concave and bow-tie quads, meshes without faces, "
                                           "missing resources.")
-UV_LAYOUT = register_family("UvLayout", "quads with no area in texture space, or mirrored against the surface.")
+UV_LAYOUT = register_family("UvLayout", "quads with no area in texture space, mirrored against the surface, or "
+                                        "whose texture drifts under subdivision.")

@@ -144,6 +144,8 @@ class Rule:
     example : a 4- to 8-line OBJ that triggers this rule and no other
     example_output : the text lines ``affinity check`` prints for ``example``
         saved as ``example.obj`` (a test lints it and compares)
+    example_flags : the command-line flags the example is checked with (Q106: ``--subdivision limit``, an OBJ
+        is a cage otherwise); its page shows them
     use_instead : ``example`` fixed the way ``fix`` says: an input ``affinity check`` finds clean
         (ruff's second half of a rule's page; a test lints it)
     references : the paper and section the rule comes from
@@ -178,6 +180,7 @@ class Rule:
     why: str
     example: str
     example_output: str = ""
+    example_flags: tuple[str, ...] = ()
     use_instead: str = ""
     fix: str
     references: str = ""
