@@ -125,6 +125,8 @@ def add_parser(sub) -> None:
                      help="read the stage at time code T (default: the earliest time sample)")
     usd.add_argument("--uv-primvar", metavar="NAME",
                      help="texture coordinates from primvar NAME (default: st, else the first texCoord2f primvar)")
+    usd.add_argument("--all-variants", action="store_true",
+                     help="read the textures of every variant's material binding (default: the stage's selection)")
     config = p.add_argument_group("configuration")
     config.add_argument("--config", metavar="FILE",
                         help="use this affinity.toml/pyproject.toml for every file instead of searching")
@@ -360,7 +362,8 @@ def run(args) -> int:
     cluster = _cluster(args, run_options, show_progress)
     with _result_cache(args, run_options) as cache:
         reports = check_files(tasks, args.jobs, _progress_bar() if show_progress else None,
-                              usd=UsdOptions(args.time, args.uv_primvar), cache=cache, cluster=cluster)
+                              usd=UsdOptions(args.time, args.uv_primvar, args.all_variants), cache=cache,
+                              cluster=cluster)
     report_problems(reports, args.quiet, args.fail_on_skip)
     if args.write_baseline:
         _write_baseline(reports, args.write_baseline, args.quiet)

@@ -53,6 +53,7 @@ from ..errors import MeshError, SkippedFile
 from ..mesh import Mesh
 from .formats import format_named
 from .resources import Resource
+from .usddiagnostics import captured_diagnostics
 from .usdlayers import geometry_source, layer_assets, may_hold_mesh, prim_type_names, regular_layers, subdivision_note
 
 USD_SUFFIXES = format_named("usd").suffixes
@@ -66,11 +67,13 @@ _TEXT_LINE = re.compile(r"\.usda?:(\d+):\d+: ")
 
 @dataclass(frozen=True)
 class UsdOptions:
-    """How to read a stage: ``time`` (None: the earliest time sample) and the uv primvar
-    name (None: ``st``, else the first ``texCoord2*`` primvar)."""
+    """How to read a stage: ``time`` (None: the earliest time sample), the uv primvar
+    name (None: ``st``, else the first ``texCoord2*`` primvar) and whether the textures of every
+    variant's material binding are read (``all_variants``; default: the stage's selection)."""
 
     time: float | None = None
     uv_primvar: str | None = None
+    all_variants: bool = False
 
 
 class _BadPrim(Exception):
@@ -101,17 +104,20 @@ def load_usd(path, options: UsdOptions | None = None) -> Mesh:
         from pxr import Tf, Usd
     except ImportError:
         raise MeshError(path, 0, f"reading USD needs usd-core: {INSTALL}") from None
-    try:
-        layers, complete = regular_layers(path)  # held open until the stage is: pxr reads each once
-        if complete and not any(may_hold_mesh(prim_type_names(layer)) for layer in layers):
-            raise SkippedFile(path, "no-mesh")
-        stage = Usd.Stage.Open(os.fspath(path))
-        del layers
-    except Tf.ErrorException as error:
-        reason = pxr_reason(error)
-        line = _TEXT_LINE.search(reason)  # .usda parse errors say where: "file.usda:7:9: ..."
-        raise MeshError(path, int(line.group(1)) if line else 0, f"cannot open the stage: {reason}") from None
-    mesh = load_stage(stage, os.fspath(path), options)
+    said: list[str] = []  # usd-core's diagnostics, one note per problem
+    with captured_diagnostics(os.path.dirname(os.path.abspath(path)), said):
+        try:
+            layers, complete = regular_layers(path)  # held open until the stage is: pxr reads each once
+            if complete and not any(may_hold_mesh(prim_type_names(layer)) for layer in layers):
+                raise SkippedFile(path, "no-mesh")
+            stage = Usd.Stage.Open(os.fspath(path))
+            del layers
+        except Tf.ErrorException as error:
+            reason = pxr_reason(error)
+            line = _TEXT_LINE.search(reason)  # .usda parse errors say where: "file.usda:7:9: ..."
+            raise MeshError(path, int(line.group(1)) if line else 0, f"cannot open the stage: {reason}") from None
+        mesh = load_stage(stage, os.fspath(path), options)
+    mesh.notes += said
     mesh.resources = [Resource(role="usd-asset", name=asset, path=os.path.normpath(absolute))
                       for asset, absolute in layer_assets(path)]
     return mesh
@@ -167,11 +173,11 @@ def load_stage(stage, path: str, options: UsdOptions | None = None, prim_paths: 
     mesh.meters_per_unit = _stage_metadata(stage, "metersPerUnit", lambda: float(UsdGeom.GetStageMetersPerUnit(stage)),
                                            notes)
     mesh.notes = notes
-    _bind_materials(mesh, prims, options.uv_primvar)
+    _bind_materials(mesh, prims, options.uv_primvar, options.all_variants)
     return mesh
 
 
-def _bind_materials(mesh: Mesh, prims: list, uv_primvar: str | None) -> None:
+def _bind_materials(mesh: Mesh, prims: list, uv_primvar: str | None, all_variants: bool = False) -> None:
     """Each prim's bound material (``material_names``, ``face_material`` per prim) and the textures it reads
     through the uv primvar (``material_maps``, :mod:`affinity.loaders.usdmaterials`)."""
     from pxr import Tf
@@ -181,7 +187,7 @@ def _bind_materials(mesh: Mesh, prims: list, uv_primvar: str | None) -> None:
     names, per_prim = [], []
     for prim in prims:
         try:
-            material, maps = prim_material_maps(prim, uv_primvar)
+            material, maps = prim_material_maps(prim, uv_primvar, all_variants)
         except Tf.ErrorException:
             material, maps = None, []
         if material is not None and material not in names:
