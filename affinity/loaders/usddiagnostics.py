@@ -47,8 +47,9 @@ def diagnostic_notes(commentaries: list[str], folder: str) -> list[str]:
     >>> said = ("In </Set/A/Materials>: Could not open asset @/s/a/x.mtlx@ for reference introduced by "
     ...         "@/s/a/look.usd@</X/Materials> -- Cannot determine file format for @/s/a/x.mtlx:SDF_FORMAT_ARGS:"
     ...         "target=usd@. (instantiating stage on stage @/s/set.usda@ <0x5560>)")
-    >>> diagnostic_notes([said, said.replace("/Set/A/", "/Set/B/")], "/s")
-    ['a/look.usd references a/x.mtlx (at </X/Materials>), which usd-core cannot compose (cannot determine file format): its materials are read from its MaterialX XML']
+    >>> notes = diagnostic_notes([said, said.replace("/Set/A/", "/Set/B/")], "/s")
+    >>> len(notes), notes[0][:70]
+    (1, 'a/look.usd references a/x.mtlx (at </X/Materials>), which usd-core can')
     """
     notes = []
     for commentary in commentaries:
