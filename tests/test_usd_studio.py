@@ -102,3 +102,14 @@ def test_the_chess_set_says_each_uncomposable_look_once_and_nothing_raw(chess_se
     notes = [line for line in stderr.splitlines() if "cannot compose" in line]
     assert sorted(re.search(r"assets/(\w+)/\1_look\.usd references assets/\1/\1_mat\.mtlx", line).group(1)
                   for line in notes) == list(PIECES)
+
+
+def test_a_look_layer_is_a_checked_file_and_fail_on_skip_passes_the_asset_folder(tmp_path):
+    studio_asset(tmp_path)
+    report, _ = check_json(".", cwd=tmp_path)
+    files = {entry["path"]: entry for entry in report["files"]}
+    look = files["assets/Piece/Piece_look.usd"]
+    assert "skipped" not in look and (look["faces"], look["findings"]) == (0, 0)
+    assert not [entry for entry in report["files"] if "skipped" in entry]
+    gated = run("check", "--no-cache", "--isolated", "--format", "json", "--fail-on-skip", ".", cwd=tmp_path)
+    assert (gated.returncode, json.loads(gated.stdout)["summary"]) == (1, report["summary"])

@@ -54,7 +54,15 @@ from ..mesh import Mesh
 from .formats import format_named
 from .resources import Resource
 from .usddiagnostics import captured_diagnostics
-from .usdlayers import geometry_source, layer_assets, may_hold_mesh, prim_type_names, regular_layers, subdivision_note
+from .usdlayers import (
+    geometry_source,
+    holds_look,
+    layer_assets,
+    may_hold_mesh,
+    prim_type_names,
+    regular_layers,
+    subdivision_note,
+)
 
 USD_SUFFIXES = format_named("usd").suffixes
 INSTALL = "pip install 'quad-affinity[usd]'"
@@ -95,7 +103,9 @@ def load_usd(path, options: UsdOptions | None = None) -> Mesh:
 
     Raises MeshError (line 0, the prim path in the reason) when usd-core is
     missing, the stage cannot be opened or traversed, or a prim's topology or
-    values are invalid; SkippedFile (``no-mesh``) when it has no mesh to check. A stage none of whose
+    values are invalid; SkippedFile (``no-mesh``) when it has no mesh to check and no look (a stage
+    whose layers hold materials or bindings, :func:`~affinity.loaders.usdlayers.holds_look`, is an empty
+    mesh: checked, without findings). A stage none of whose
     layers holds a prim spec that may be a mesh (:func:`~affinity.loaders.usdlayers.may_hold_mesh`) is
     skipped without composing it: on a stage of 100,000 empty prims composing took 1.2 s, the look
     at the layer's specs 0.23 s.
@@ -108,19 +118,37 @@ def load_usd(path, options: UsdOptions | None = None) -> Mesh:
     with captured_diagnostics(os.path.dirname(os.path.abspath(path)), said):
         try:
             layers, complete = regular_layers(path)  # held open until the stage is: pxr reads each once
-            if complete and not any(may_hold_mesh(prim_type_names(layer)) for layer in layers):
-                raise SkippedFile(path, "no-mesh")
-            stage = Usd.Stage.Open(os.fspath(path))
+            type_names = [prim_type_names(layer) for layer in layers]
+            look = any(map(holds_look, layers, type_names))
+            if complete and not any(map(may_hold_mesh, type_names)):
+                stage = None
+            else:
+                stage = Usd.Stage.Open(os.fspath(path))
             del layers
         except Tf.ErrorException as error:
             reason = pxr_reason(error)
             line = _TEXT_LINE.search(reason)  # .usda parse errors say where: "file.usda:7:9: ..."
             raise MeshError(path, int(line.group(1)) if line else 0, f"cannot open the stage: {reason}") from None
-        mesh = load_stage(stage, os.fspath(path), options)
+        try:
+            if stage is None:
+                raise SkippedFile(path, "no-mesh")
+            mesh = load_stage(stage, os.fspath(path), options)
+        except SkippedFile:
+            if not look:
+                raise
+            mesh = _look_only(path)
     mesh.notes += said
     mesh.resources = [Resource(role="usd-asset", name=asset, path=os.path.normpath(absolute))
                       for asset, absolute in layer_assets(path)]
     return mesh
+
+
+def _look_only(path) -> Mesh:
+    """The empty mesh of a stage whose layers hold a look and no mesh: a checked file without findings
+    (design.md, Clarifications), not a skip."""
+    return Mesh(path=os.fspath(path), positions=np.zeros((0, 3)), face_start=np.zeros(1, dtype=np.int64),
+                corner_vertex=np.zeros(0, dtype=np.int64), face_line=np.zeros(0, dtype=np.int64), group_names=[],
+                prim_face_start=np.zeros(1, dtype=np.int64))
 
 
 def load_stage(stage, path: str, options: UsdOptions | None = None, prim_paths: list[str] | None = None,
