@@ -378,7 +378,9 @@ def mesh_report(path: str, mesh, settings, inline=(), scores: bool = False) -> F
     hits, shared = share_authored_geometry(settle(linted.hits, settings, list(mesh.group_names), inline), mesh)
     return FileReport(path, counts=mesh.counts(), hits=hits, shared=shared, group_names=list(mesh.group_names),
                       prim_face_start=mesh.prim_face_start, up_axis=mesh.up_axis,
-                      meters_per_unit=mesh.meters_per_unit, notes=list(mesh.notes), scores=linted.scores)
+                      meters_per_unit=mesh.meters_per_unit, notes=list(mesh.notes), scores=linted.scores,
+                      prim_sources={prim: list(source) for prim, source in
+                                    zip(mesh.group_names, mesh.prim_sources or []) if source is not None})
 
 
 #: Cause rule -> the attributes whose scored rules (Q101-Q103) it takes over (:class:`Unmeasurable`).

@@ -67,6 +67,38 @@ def test_the_stage_selection_decides_the_texture_and_all_variants_reads_every_bi
         [(f["face"], f["value"], f["texture"]) for f in black["findings"]]
 
 
+FILES = ["assets/Piece/Piece.usd", "assets/Piece/Piece_geom.usd", "assets/Piece/Piece_payload.usd", "set.usda"]
+
+
+def test_a_folder_run_reports_each_authored_mesh_once_with_every_referencing_prim(tmp_path):
+    """Four files compose the piece's mesh; the set's two prims see it through textures: its findings come
+    once, from the set (the most referencing prims), as the set alone reports them, listing all five prims."""
+    studio_asset(tmp_path)
+    alone, _ = check_json("set.usda", cwd=tmp_path)
+    folder, _ = check_json(".", cwd=tmp_path)
+    assert [(f["path"], f["code"], f["face"], f["value"], f["level"]) for f in folder["findings"]] == \
+        [(f["path"], f["code"], f["face"], f["value"], f["level"]) for f in alone["findings"]]
+    for f in folder["findings"]:
+        assert (Path(f["layer"]).name, f["layer_prim"]) == ("Piece_geom.usd", AUTHORED)
+        assert f["prims"] == [*PRIMS, *(f"{path}:{AUTHORED}" for path in FILES[:3])]
+    assert {entry["path"]: entry.get("findings") for entry in folder["files"]} == \
+        {**dict.fromkeys(FILES[:3], 0), "assets/Piece/Piece_look.usd": 0, "set.usda": 2}
+    text = run("check", "--no-cache", "--isolated", ".", cwd=tmp_path).stdout
+    assert len([line for line in text.splitlines() if ": Q101 " in line]) == 2
+
+
+@pytest.mark.parametrize("fmt", ["json", "text", "sarif"])
+def test_the_shards_of_a_folder_run_merge_into_the_whole_run(tmp_path, fmt):
+    studio_asset(tmp_path)
+    options = ["--no-cache", "--isolated", "."]
+    whole = run("check", *options, "--format", fmt, cwd=tmp_path)
+    for k in (1, 2, 3):
+        shard = run("check", *options, "--shard", f"{k}/3", "--format", "json", "-o", f"shard{k}.json", cwd=tmp_path)
+        assert shard.returncode in (0, 1), shard.stderr
+    merged = run("merge", "shard1.json", "shard2.json", "shard3.json", "--format", fmt, cwd=tmp_path)
+    assert (merged.returncode, merged.stdout) == (whole.returncode, whole.stdout)
+
+
 # -- the Open Chess Set --------------------------------------------------------------------------------
 
 @pytest.fixture(scope="module")
@@ -113,3 +145,40 @@ def test_a_look_layer_is_a_checked_file_and_fail_on_skip_passes_the_asset_folder
     assert not [entry for entry in report["files"] if "skipped" in entry]
     gated = run("check", "--no-cache", "--isolated", "--format", "json", "--fail-on-skip", ".", cwd=tmp_path)
     assert (gated.returncode, json.loads(gated.stdout)["summary"]) == (1, report["summary"])
+
+
+@pytest.fixture(scope="module")
+def chess_folder_check(shared_meshes) -> tuple[dict, str]:
+    folder = shared_meshes / "usd" / "OpenChessSet"
+    if not folder.is_dir():
+        pytest.skip("the Open Chess Set is not in ../shared/meshes/usd")
+    return check_json("--fail-on-skip", str(folder))
+
+
+def test_the_chess_set_folder_reports_each_authored_mesh_once(chess_folder_check, chess_set_check):
+    """The truth is the stage alone: it composes every authored mesh, each once (its own sharing), so over the
+    folder the findings per authored mesh (layer, prim in it) are the stage's, and their number the same."""
+    folder, _ = chess_folder_check
+    stage, _ = chess_set_check
+
+    def by_authored_mesh(report):
+        sources = {(entry["path"], prim): tuple(source) for entry in report["files"]
+                   for prim, source in entry.get("prim_sources", {}).items()}
+        return sorted((*sources[f["path"], f["prim"]], f["code"], f["face"], f["level"], f["value"])
+                      for f in report["findings"])
+
+    assert len(folder["findings"]) == len(stage["findings"])
+    assert by_authored_mesh(folder) == by_authored_mesh(stage)
+    for f in folder["findings"]:
+        piece = Path(f["layer"]).name.removesuffix("_geom.usd")
+        files = {f["path"], *(prim.rsplit(":", 1)[0] for prim in f["prims"] if ":" in prim)}
+        assert {Path(name).name for name in files} == {f"{piece}.usd", f"{piece}_geom.usd", f"{piece}_payload.usd",
+                                                       "chess_set.usda"}, f
+
+
+def test_fail_on_skip_passes_the_chess_set_folder_as_without_it(chess_folder_check):
+    """The run has errors (exit 1 without the flag); with it, no look layer is a skip, so still 1."""
+    folder, stderr = chess_folder_check  # check_json asserted exit 1
+    assert folder["summary"]["skipped"] == 0 and "skipped" not in stderr
+    looks = [entry for entry in folder["files"] if entry["path"].endswith("_look.usd")]
+    assert len(looks) == len(PIECES) and all(entry["findings"] == 0 for entry in looks)

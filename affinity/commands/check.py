@@ -327,6 +327,7 @@ def run(args) -> int:
     from ..loaders.usd import UsdOptions
     from ..output import CheckRun
     from ..pipeline.check import check_files
+    from ..usd.authored import one_report_per_authored_mesh
 
     if args.baseline and args.write_baseline:
         raise UsageError("--baseline and --write-baseline exclude each other")
@@ -364,6 +365,7 @@ def run(args) -> int:
         reports = check_files(tasks, args.jobs, _progress_bar() if show_progress else None,
                               usd=UsdOptions(args.time, args.uv_primvar, args.all_variants), cache=cache,
                               cluster=cluster)
+    reports = one_report_per_authored_mesh(reports)
     report_problems(reports, args.quiet, args.fail_on_skip)
     if args.write_baseline:
         _write_baseline(reports, args.write_baseline, args.quiet)

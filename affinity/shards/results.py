@@ -32,7 +32,7 @@ from ..settings import Settings
 from .selection import ShardRecord
 
 #: Keys of a JSON file entry that are not face counts.
-_ENTRY_KEYS = {"path", "findings", "up_axis", "meters_per_unit", "notes"}
+_ENTRY_KEYS = {"path", "findings", "up_axis", "meters_per_unit", "notes", "prim_sources"}
 
 
 class ResultError(ValueError):
@@ -132,6 +132,7 @@ def _report(entry: dict, findings: list[dict], settings: Settings) -> FileReport
         up_axis=entry.get("up_axis"),
         meters_per_unit=entry.get("meters_per_unit"),
         notes=list(entry.get("notes", [])),
+        prim_sources=entry.get("prim_sources", {}),
     )
 
 
