@@ -166,7 +166,7 @@ class QuadBatch:
     @cached_property
     def planar(self) -> PlanarQuads:
         return planar_quads_by_component(self.tables.gather("positions", self.corner_indices("positions"),
-                                                            complete=False)[1])
+                                                            complete=False)[1], self.mesh.position_epsilon)
 
     def complete(self, name: str) -> tuple[np.ndarray | slice, np.ndarray]:
         """Quads that have attribute ``name`` at all four corners: ``rows`` (a slice

@@ -71,6 +71,10 @@ class Mesh:
     notes : list of str
         What the loader read but did not represent, for the user (e.g. USD
         PointInstancer copies that were not expanded).
+    position_epsilon : float
+        The machine epsilon of the positions as stored in the file (float64's unless the loader knows better:
+        a USD ``point3f[]`` is float32): what counts as rounding in the shape rules
+        (:attr:`affinity.geometry.PlanarQuads.rounding`).
     """
 
     path: str
@@ -95,6 +99,7 @@ class Mesh:
     up_axis: str | None = None
     meters_per_unit: float | None = None
     notes: list[str] = field(default_factory=list)
+    position_epsilon: float = float(np.finfo(np.float64).eps)
 
     def __post_init__(self):
         if self.face_group is None:

@@ -289,7 +289,8 @@ def _read_prim(prim, time, xforms, uv_primvar: str | None) -> Mesh:
     from pxr import UsdGeom
 
     usd_mesh = UsdGeom.Mesh(prim)
-    points = _finite("points", _array(usd_mesh.GetPointsAttr().Get(time), np.float64, 3))
+    stored = usd_mesh.GetPointsAttr().Get(time)
+    points = _finite("points", _array(stored, np.float64, 3))
     sizes = _array(usd_mesh.GetFaceVertexCountsAttr().Get(time), np.int64)
     corner_vertex = _array(usd_mesh.GetFaceVertexIndicesAttr().Get(time), np.int64)
     _check_topology(sizes, corner_vertex, len(points))
@@ -325,7 +326,15 @@ def _read_prim(prim, time, xforms, uv_primvar: str | None) -> Mesh:
         normals=None if normals is None else world_normals(normals.values, matrix[:3, :3]),
         corner_normal=corner_normal,
         colors=colors,
+        position_epsilon=_epsilon(stored),
     )
+
+
+def _epsilon(stored) -> float:
+    """The machine epsilon of a ``Vt`` array of points as stored (float32 for ``point3f[]``); float64's when
+    it holds no floats (an unauthored value)."""
+    dtype = np.asarray([] if stored is None else stored).dtype
+    return float(np.finfo(dtype if np.issubdtype(dtype, np.floating) else np.float64).eps)
 
 
 def _transformed(rows: np.ndarray, linear: np.ndarray) -> np.ndarray:
@@ -518,4 +527,5 @@ def _concatenate(path: str, parts: list[Mesh], prim_paths: list[str]) -> Mesh:
         colors=colors,
         texcoords=texcoords, corner_texcoord=corner_texcoord,
         normals=normals, corner_normal=corner_normal,
+        position_epsilon=max(p.position_epsilon for p in parts),
     )
