@@ -171,7 +171,7 @@ class FileReport:
 
     ``prim_sources`` (USD) maps each mesh prim whose geometry's source is known to ``[layer, prim path in
     it]`` (:func:`affinity.loaders.usdlayers.geometry_source`): a run keeps one report per authored mesh
-    (:func:`affinity.usd.authored.one_report_per_authored_mesh`).
+    (:func:`affinity.pipeline.authored.one_report_per_authored_mesh`).
 
     ``scores`` (only when asked, for the report: never stored) maps each scored rule the mesh has an
     attribute for to the :class:`affinity.lint.QuadScores` of every quad it measures, from the same lint.

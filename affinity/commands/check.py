@@ -326,8 +326,8 @@ def run(args) -> int:
     from ..config import Resolver
     from ..loaders.usd import UsdOptions
     from ..output import CheckRun
+    from ..pipeline.authored import one_report_per_authored_mesh
     from ..pipeline.check import check_files
-    from ..usd.authored import one_report_per_authored_mesh
 
     if args.baseline and args.write_baseline:
         raise UsageError("--baseline and --write-baseline exclude each other")

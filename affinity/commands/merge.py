@@ -33,8 +33,8 @@ def add_parser(sub) -> None:
 
 def run(args) -> int:
     from ..output import CheckRun
+    from ..pipeline.authored import one_report_per_authored_mesh
     from ..shards.merge import MergeError, merge_results
-    from ..usd.authored import one_report_per_authored_mesh
     from .check import publish, report_problems
 
     try:

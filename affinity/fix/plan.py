@@ -22,6 +22,7 @@ from ..settings import Settings
 from . import grid
 from .layout import MAX_LEVEL, Layout, edge_parameters, face_patterns, layout
 from .tessellate import face_polygons
+from .twins import alike_across_twins, readings_from_twins, twin_faces
 
 #: The scored rules a refinement removes.
 SCORED = ("Q101", "Q102", "Q103")
@@ -199,6 +200,9 @@ def plan_fix(mesh: Mesh, fix: FixSettings | None = None) -> FixPlan:
         raise ValueError(f"max_refine must be from 1 to {MAX_LEVEL}; got {fix.max_refine}")
     scored, leaving = flagged_quads(mesh, fix)
     candidates = np.unique(np.concatenate([faces for faces, _ in scored.values()] or [np.zeros(0, np.int64)]))
+    twins = twin_faces(mesh)  # USD: prims of one authored mesh get one refinement, written once
+    if twins is not None:
+        candidates = np.flatnonzero(np.isin(twins, twins[candidates]))
     if fix.faces is not None:
         candidates = np.intersect1d(candidates, np.asarray(fix.faces, dtype=np.int64))
     reasons = np.full(len(candidates), "", dtype=object)
@@ -212,11 +216,15 @@ def plan_fix(mesh: Mesh, fix: FixSettings | None = None) -> FixPlan:
         keep = (rows < len(candidates)) & (candidates[np.minimum(rows, len(candidates) - 1)] == faces)
         keep[keep] &= reasons[rows[keep]] == ""
         need[rows[keep]] = np.maximum(need[rows[keep]], needed_levels(mesh, faces[keep], values[keep], code, fix))
+    if twins is not None:
+        need, reasons = alike_across_twins(twins[candidates], need, reasons)
     reasons[(reasons == "") & (need > fix.max_refine)] = "over-cap"
     refine = reasons == ""
     refine_faces = candidates[refine]
     refine_n = need[refine]
     codes, before, after, units = _readings(mesh, refine_faces, refine_n, scored, fix)
+    if twins is not None:
+        codes, before, after, units = readings_from_twins(twins[refine_faces], codes, before, after, units)
     placed = layout(mesh, refine_faces, refine_n)
     added, bound = _face_counts(mesh, placed, refine_faces)
     left = ~refine
