@@ -204,16 +204,19 @@ def _overrides(args) -> dict:
 
 def report_problems(reports, quiet: bool, skips_fail: bool = False) -> None:
     """Unreadable files (always), skipped files (unless quiet; always when they fail the run) and the
-    loader's notes (unless quiet), one line each on stderr."""
+    loader's notes (unless quiet), one line each on stderr; a note several files say alike (a layer they all
+    compose) once, at the first."""
     from ..output.names import printable
 
+    said = set()
     for report in reports:
         path = printable(report.path)
         if report.error is not None:
             sys.stderr.write(f"{path}:{report.error_line}: Q901 unreadable: {report.error}\n")
         elif report.skipped is not None and (skips_fail or not quiet):
             sys.stderr.write(f"{path}: skipped ({report.skipped})\n")
-        for note in [] if quiet else report.notes:
+        for note in [] if quiet else [note for note in report.notes if note not in said]:
+            said.add(note)
             sys.stderr.write(f"{path}: note: {note}\n")
 
 

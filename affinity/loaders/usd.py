@@ -115,7 +115,7 @@ def load_usd(path, options: UsdOptions | None = None) -> Mesh:
     except ImportError:
         raise MeshError(path, 0, f"reading USD needs usd-core: {INSTALL}") from None
     said: list[str] = []  # usd-core's diagnostics, one note per problem
-    with captured_diagnostics(os.path.dirname(os.path.abspath(path)), said):
+    with captured_diagnostics(os.getcwd(), said):
         try:
             layers, complete = regular_layers(path)  # held open until the stage is: pxr reads each once
             type_names = [prim_type_names(layer) for layer in layers]

@@ -23,7 +23,8 @@ _CONTEXT = re.compile(r"^In <[^>]*>: |\s*\(instantiating stage on stage @[^@]*@ 
 @contextmanager
 def captured_diagnostics(folder: str, notes: list[str]):
     """Trap usd-core's warnings and status messages inside the block and append one note per distinct problem
-    to ``notes`` (paths relative to ``folder``, the stage's); without ``pxr`` the block runs as it is."""
+    to ``notes`` (paths relative to ``folder``: the working directory's, so that every file of a run that composes
+    the same layer says the same note); without ``pxr`` the block runs as it is."""
     try:
         from pxr import Tf
     except ImportError:
@@ -77,8 +78,10 @@ def _unopened_note(match, folder: str) -> str:
 
 
 def _shown(path: str, folder: str) -> str:
-    """``path`` relative to ``folder`` where it lies inside it, else as it is."""
-    if folder and os.path.isabs(path):
+    """``path`` relative to ``folder`` where it lies inside it, else as it is (a relative path: as the working
+    directory resolves it)."""
+    path = os.path.abspath(path)
+    if folder:
         relative = os.path.relpath(path, folder)
         if not relative.startswith(os.pardir):
             return relative
