@@ -142,7 +142,10 @@ def preview_surface_maps(material, uv_primvar: str) -> list[TextureMap]:
                 continue
             maps.append(TextureMap(role=ROLE_OF_INPUT.get(shader_input.GetBaseName(), "scalar"),
                                    path=_resolved(file_input.GetAttr(), asset), name=asset.path,
-                                   source=f"UsdUVTexture {texture.GetPath()}", **transform))
+                                   source=f"UsdUVTexture {texture.GetPath()}",
+                                   wrap=tuple(_wrap(USD_WRAPS, _input_value(texture, name))
+                                              for name in ("wrapS", "wrapT")),
+                                   **transform))
     return maps
 
 
@@ -253,8 +256,28 @@ def mtlx_document_maps(path: str, material: str | None = None, every: bool = Fal
             scale, offset = _tiling(image)
             maps.append(TextureMap(role=role, path=os.path.normpath(os.path.join(folder, name)), name=name,
                                    source=f"MaterialX {image.tag} {image.get('name')} ({os.path.basename(path)})",
-                                   scale=scale, offset=offset))
+                                   scale=scale, offset=offset,
+                                   wrap=tuple(_wrap(MATERIALX_WRAPS, _value(image, name))
+                                              for name in ("uaddressmode", "vaddressmode"))))
     return maps
+
+
+#: Wrap modes (:mod:`affinity.textures.wrapping`) by UsdUVTexture ``wrapS``/``wrapT`` token (``useMetadata``,
+#: the file's own, and the fallback: repeat) and by MaterialX ``uaddressmode``/``vaddressmode`` (``constant``
+#: reads the node's default outside, black unless set).
+USD_WRAPS = {"repeat": "repeat", "mirror": "mirror", "clamp": "clamp", "black": "black"}
+MATERIALX_WRAPS = {"periodic": "repeat", "mirror": "mirror", "clamp": "clamp", "constant": "black"}
+
+
+def _wrap(modes: dict, authored) -> str:
+    """The wrap mode of an authored token (None or an unknown one: repeat)."""
+    return modes.get(str(authored) if authored is not None else "", "repeat")
+
+
+def _value(image, name: str) -> str | None:
+    """The ``value`` of an image node's input ``name``; None when it has none."""
+    element = image.find(f"input[@name='{name}']")
+    return None if element is None else element.get("value")
 
 
 def _named_nodes(root) -> dict:

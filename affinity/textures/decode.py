@@ -55,6 +55,11 @@ class DecodedTexture:
     texels: np.ndarray
     channels: int
 
+    def boxed(self, low: np.ndarray, high: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Texel boxes as repeat wrapping reads them: unchanged (:class:`affinity.textures.wrapping.WrappedTexture`
+        moves them for other wrap modes)."""
+        return low, high
+
     @property
     def pixels(self) -> np.ndarray:
         """(H, W, C) uint8, read-only: the texture's channels of :attr:`texels` (a view)."""
