@@ -75,3 +75,19 @@ def test_a_link_naming_prim_and_face_flies_to_it(studio_report):
         assert f"prim={finding['prim']}&face={finding['face']}&" in evaluate(browser, session, "location.hash")
     finally:
         browser.close()
+
+
+def test_a_report_over_the_stage_and_its_geometry_layer_gives_the_mesh_once(tmp_path):
+    """As ``affinity check`` does over the same files: the set (two referencing prims) has the findings, the
+    geometry layer none."""
+    studio_asset(tmp_path)
+    built = _run("report", "-q", "set.usda", "assets/Piece/Piece_geom.usd", "-o", "report.html", cwd=tmp_path)
+    assert built.returncode == 0, built.stderr
+    checked = json.loads(_run("check", "--no-cache", "--isolated", "--format", "json", "set.usda",
+                              "assets/Piece/Piece_geom.usd", cwd=tmp_path).stdout)
+    assert {f["path"] for f in checked["findings"]} == {"set.usda"}
+    page = (tmp_path / "report.html").read_text()
+    views = [json.loads(body) for body in re.findall(
+        r'<figure class="view3d" data-view="3d".*?<script type="application/json">(.*?)</script>', page, re.S)]
+    assert [{(row["prim"], row["prim_face"]) for row in view["findings"]} for view in views] == \
+        [{(f["prim"], f["face"]) for f in checked["findings"]}, set()]
