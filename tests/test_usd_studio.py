@@ -87,11 +87,15 @@ def test_a_folder_run_reports_each_authored_mesh_once_with_every_referencing_pri
     assert len([line for line in text.splitlines() if ": Q101 " in line]) == 2
 
 
-@pytest.mark.parametrize("fmt", ["json", "text", "sarif"])
+@pytest.mark.parametrize("fmt", ["json", "text", "sarif", "github", "junit"])
 def test_the_shards_of_a_folder_run_merge_into_the_whole_run(tmp_path, fmt):
+    """Every format gives the mesh once (its two findings), and the shards merge into the whole run."""
     studio_asset(tmp_path)
     options = ["--no-cache", "--isolated", "."]
     whole = run("check", *options, "--format", fmt, cwd=tmp_path)
+    assert "Q101" in whole.stdout
+    assert not any(f"{path}:/Piece/Geom/Render:face" in whole.stdout or f"file={path}" in whole.stdout
+                   for path in FILES[:3])  # no file but the set locates a finding
     for k in (1, 2, 3):
         shard = run("check", *options, "--shard", f"{k}/3", "--format", "json", "-o", f"shard{k}.json", cwd=tmp_path)
         assert shard.returncode in (0, 1), shard.stderr
