@@ -260,6 +260,10 @@ class FileReport:
     that prim has no finding]]`` for the findings whose prims disagree (different
     textures bound).
 
+    ``prim_sources`` (USD) maps each mesh prim whose geometry's source is known to ``[layer, prim path in
+    it]`` (:func:`affinity.loaders.usdlayers.geometry_source`): a run keeps one report per authored mesh
+    (:func:`affinity.pipeline.authored.one_report_per_authored_mesh`).
+
     ``scores`` (only when asked, for the report: never stored) maps each scored rule the mesh has an
     attribute for to the :class:`affinity.lint.QuadScores` of every quad it measures, from the same lint.
     """
@@ -278,6 +282,7 @@ class FileReport:
     transient: bool = False
     shared: list[dict] = field(default_factory=list)
     scores: dict = field(default_factory=dict)
+    prim_sources: dict[str, list[str]] = field(default_factory=dict)
 
     @property
     def n_findings(self) -> int:

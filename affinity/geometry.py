@@ -208,6 +208,9 @@ class PlanarQuads:
     vector_areas : (3, 4, Q) float64 or None
         C_i = e_{i+1} x e_{i+2}, the doubled vector area of the triangle opposite
         corner i, of 3-D corners (so T_i = C_i . n / |n|); None for 2-D corners.
+    epsilon : float
+        The machine epsilon of the corners as the file stored them (float32's for a USD
+        ``point3f[]``): :attr:`rounding` scales with it.
     """
 
     areas: NDArray[np.float64]
@@ -216,6 +219,7 @@ class PlanarQuads:
     components: NDArray[np.float64]
     normals: NDArray[np.float64] | None = None
     vector_areas: NDArray[np.float64] | None = None
+    epsilon: float = float(np.finfo(np.float64).eps)
 
     @cached_property
     def xy(self) -> np.ndarray:
@@ -254,9 +258,15 @@ class PlanarQuads:
     @cached_property
     def rounding(self) -> np.ndarray:
         """(Q,) float64: doubled areas within rounding of zero for corners of this
-        magnitude, ``ROUNDING_AREA`` eps max_k |p_k| times the longest edge."""
+        magnitude, ``ROUNDING_AREA`` eps max_k |p_k| times the longest edge: eps float64's, and the
+        :attr:`epsilon` of the stored corners for a quad all of whose T_i lie within that (a float32 sliver
+        whose corners are collinear up to float32 rounding is degenerate, Q201, not a bow-tie)."""
         magnitude = np.maximum(self.components.max(axis=(0, 1)), -self.components.min(axis=(0, 1)))
-        return (ROUNDING_AREA * np.finfo(np.float64).eps) * magnitude * self.size
+        computed = (ROUNDING_AREA * np.finfo(np.float64).eps) * magnitude * self.size
+        if self.epsilon <= np.finfo(np.float64).eps:
+            return computed
+        stored = (ROUNDING_AREA * self.epsilon) * magnitude * self.size
+        return np.where(np.abs(self.areas).max(axis=1, initial=0.0) <= stored, stored, computed)
 
     def take(self, rows) -> PlanarQuads:
         """The quads selected by ``rows`` (an index array, a boolean mask or a slice)."""
@@ -265,7 +275,7 @@ class PlanarQuads:
         normals = None if self.normals is None else self.normals[:, rows]
         vector_areas = None if self.vector_areas is None else self.vector_areas[:, :, rows]
         return PlanarQuads(self.areas.T[:, rows].T, self.size[rows], self.diagonals[rows], self.components[:, :, rows],
-                           normals, vector_areas)
+                           normals, vector_areas, self.epsilon)
 
     def __len__(self) -> int:
         return len(self.size)
@@ -282,12 +292,13 @@ def planar_quads(corners: np.ndarray) -> PlanarQuads:
     return planar_quads_by_component(by_component(corners))
 
 
-def planar_quads_by_component(p: np.ndarray) -> PlanarQuads:
+def planar_quads_by_component(p: np.ndarray, epsilon: float = float(np.finfo(np.float64).eps)) -> PlanarQuads:
     """:func:`planar_quads` of corners laid out by component.
 
     Parameters
     ----------
     p : (D, 4, Q) float64, D = 3 or 2 (see :func:`by_component`)
+    epsilon : the machine epsilon of the corners as stored (:attr:`PlanarQuads.epsilon`)
     """
     e = _edges(p)
     size = np.sqrt(squared_lengths(e[:, :4]).max(axis=0))
@@ -297,7 +308,7 @@ def planar_quads_by_component(p: np.ndarray) -> PlanarQuads:
     diagonals[:, 0], diagonals[:, 1] = squared_lengths(d02), squared_lengths(d13)
     np.sqrt(diagonals, out=diagonals)
     if len(p) == 2:
-        return PlanarQuads(C.T, size, diagonals, p)
+        return PlanarQuads(C.T, size, diagonals, p, epsilon=epsilon)
     # d02 x d13 = c_0 + c_2 (c_k = C_{k-1} the corner turns): twice the vector area.
     normals = C[:, 3] + C[:, 1]
     plane = _with_stand_ins(C, normals, diagonals)
@@ -305,7 +316,7 @@ def planar_quads_by_component(p: np.ndarray) -> PlanarQuads:
     # T_i = C_i . n / |n|; a zero normal (all corners collinear) leaves T_i = C_i . n = 0.
     areas = dot_by_component(C, plane[:, None])
     np.divide(areas, plane_length, out=areas, where=plane_length > 0)
-    return PlanarQuads(areas.T, size, diagonals, p, normals, C)
+    return PlanarQuads(areas.T, size, diagonals, p, normals, C, epsilon)
 
 
 def _with_stand_ins(C: np.ndarray, normals: np.ndarray, diagonals: np.ndarray) -> np.ndarray:

@@ -166,7 +166,7 @@ class QuadBatch:
     @cached_property
     def planar(self) -> PlanarQuads:
         return planar_quads_by_component(self.tables.gather("positions", self.corner_indices("positions"),
-                                                            complete=False)[1])
+                                                            complete=False)[1], self.mesh.position_epsilon)
 
     def complete(self, name: str) -> tuple[np.ndarray | slice, np.ndarray]:
         """Quads that have attribute ``name`` at all four corners: ``rows`` (a slice
@@ -379,7 +379,9 @@ def mesh_report(path: str, mesh, settings, inline=(), scores: bool = False) -> F
     return FileReport(path, counts=mesh.counts(), hits=hits, shared=shared, group_names=list(mesh.group_names),
                       prim_face_start=mesh.prim_face_start, up_axis=mesh.up_axis,
                       meters_per_unit=mesh.meters_per_unit,
-                      notes=list(mesh.notes if linted.notes is None else linted.notes), scores=linted.scores)
+                      notes=list(mesh.notes if linted.notes is None else linted.notes), scores=linted.scores,
+                      prim_sources={prim: list(source) for prim, source in
+                                    zip(mesh.group_names, mesh.prim_sources or []) if source is not None})
 
 
 class Unmeasurable:

@@ -76,6 +76,10 @@ class Mesh:
         USD only: per prim (group), how its faces subdivide (``subdivisionScheme``, ``interpolateBoundary``,
         ``faceVaryingLinearInterpolation``, creases, corners, holes; vertex and face indices into this mesh).
         None where the format names no scheme (OBJ, PLY, OFF).
+    position_epsilon : float
+        The machine epsilon of the positions as stored in the file (float64's unless the loader knows better:
+        a USD ``point3f[]`` is float32): what counts as rounding in the shape rules
+        (:attr:`affinity.geometry.PlanarQuads.rounding`).
     """
 
     path: str
@@ -101,6 +105,7 @@ class Mesh:
     meters_per_unit: float | None = None
     notes: list[str] = field(default_factory=list)
     subdivision: list | None = None
+    position_epsilon: float = float(np.finfo(np.float64).eps)
 
     def __post_init__(self):
         if self.face_group is None:

@@ -118,7 +118,7 @@ def test_options_are_never_abbreviated(tmp_path):
 def test_stage_without_a_mesh_is_skipped(tmp_path):
     from affinity.loaders import load
 
-    path = write(tmp_path, "materials.usda", '#usda 1.0\ndef Material "Wood"\n{\n}\ndef Xform "World"\n{\n}\n')
+    path = write(tmp_path, "layout.usda", '#usda 1.0\ndef Xform "World"\n{\n    def Xform "Lamp"\n    {\n    }\n}\n')
     with pytest.raises(SkippedFile) as caught:
         load(path)
     assert caught.value.reason == "no-mesh"
@@ -126,6 +126,16 @@ def test_stage_without_a_mesh_is_skipped(tmp_path):
     assert result.returncode == 0, result.stderr
     assert json.loads(result.stdout)["files"][0]["skipped"] == "no-mesh"
     assert run("check", "--fail-on-skip", str(path)).returncode == 2
+
+
+@requires_usd
+def test_a_stage_of_materials_and_no_mesh_is_checked_without_findings(tmp_path):
+    """A look layer (design.md, Clarifications): checked, no findings, not a skip, so --fail-on-skip passes."""
+    path = write(tmp_path, "materials.usda", '#usda 1.0\ndef Material "Wood"\n{\n}\ndef Xform "World"\n{\n}\n')
+    result = run("check", "--format", "json", "--fail-on-skip", str(path))
+    assert result.returncode == 0, result.stderr
+    (entry,) = json.loads(result.stdout)["files"]
+    assert "skipped" not in entry and (entry["faces"], entry["findings"]) == (0, 0)
 
 
 @requires_usd

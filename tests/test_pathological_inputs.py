@@ -375,7 +375,7 @@ def usd_stages(folder) -> dict[str, object]:
     from pxr import Sdf
 
     write(folder, "quad.usda", QUAD_USDA)
-    write(folder, "no-mesh.usda", '#usda 1.0\ndef Scope "looks" {\n    def Material "wood" {\n    }\n}\n')
+    write(folder, "no-mesh.usda", '#usda 1.0\ndef Scope "lights" {\n    def Xform "key" {\n    }\n}\n')  # no look
     arcs = {"sublayer": '#usda 1.0\n(\n    subLayers = [@./{layer}@]\n)\n',
             "reference": '#usda 1.0\ndef Xform "top" (\n    references = @./{layer}@</quad>\n)\n{{\n}}\n',
             "payload": '#usda 1.0\ndef Xform "top" (\n    payload = @./{layer}@</quad>\n)\n{{\n}}\n'}

@@ -69,12 +69,16 @@ def test_text_and_sarif_name_the_layer_and_the_prims(tmp_path):
         assert r["relatedLocations"][0]["physicalLocation"]["artifactLocation"]["uri"] == "knight.usda"
 
 
-def test_different_stages_are_not_merged(tmp_path):
-    """The geometry layer and the stage referencing it, checked in one run: each reports its own."""
+def test_a_run_over_the_geometry_layer_and_the_stage_reports_the_mesh_once(tmp_path):
+    """The geometry layer and the stage referencing it, checked in one run (design.md, Clarifications): the
+    mesh's findings come once, from the stage (four referencing prims against one), as the stage alone gives
+    them, and list the layer's own prim too."""
     stage = referenced_stage(tmp_path)
+    alone = check_json(stage)["findings"]
     findings = check_json(stage, tmp_path / "knight.usda")["findings"]
-    assert sorted((Path(f["path"]).name, f["face"]) for f in findings) == \
-        [("knight.usda", 0), ("knight.usda", 1), ("set.usda", 0), ("set.usda", 1)]
+    assert [(Path(f["path"]).name, f["face"], f["value"]) for f in findings] == \
+        [(Path(f["path"]).name, f["face"], f["value"]) for f in alone]
+    assert all(f["prims"] == [*PRIMS, f"{tmp_path / 'knight.usda'}:/Knight"] for f in findings)
 
 
 def test_a_prim_that_authors_its_own_points_is_its_own_mesh(tmp_path):

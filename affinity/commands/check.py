@@ -142,6 +142,8 @@ def add_parser(sub) -> None:
     usd.add_argument("--uv-primvar", metavar="NAME",
                      help="texture coordinates from primvar NAME (default: st, else the first texCoord2f primvar); "
                           "in an FBX file, the uv set NAME (default: the first)")
+    usd.add_argument("--all-variants", action="store_true",
+                     help="read the textures of every variant's material binding (default: the stage's selection)")
     config = p.add_argument_group("configuration")
     config.add_argument("--config", metavar="FILE",
                         help="use this affinity.toml/pyproject.toml for every file instead of searching")
@@ -256,17 +258,20 @@ def _overrides(args) -> dict:
 
 def report_problems(reports, quiet: bool, skips_fail: bool = False) -> None:
     """Unreadable files (always), skipped files (unless quiet; always when they fail the run) and the
-    loader's notes (unless quiet), one line each on stderr."""
+    loader's notes (unless quiet), one line each on stderr; a note several files say alike (a layer they all
+    compose) once, at the first."""
     from ..output.names import printable
     from ..rules.wording import unreadable_line
 
+    said = set()
     for report in reports:
         path = printable(report.path)
         if report.error is not None:
             sys.stderr.write(unreadable_line(path, report.error, report.error_line) + "\n")
         elif report.skipped is not None and (skips_fail or not quiet):
             sys.stderr.write(f"{path}: skipped ({report.skipped})\n")
-        for note in [] if quiet else report.notes:
+        for note in [] if quiet else [note for note in report.notes if note not in said]:
+            said.add(note)
             sys.stderr.write(f"{path}: note: {note}\n")
 
 
@@ -418,6 +423,7 @@ def run(args) -> int:
     from ..config import Resolver
     from ..loaders.usd import UsdOptions
     from ..output import CheckRun
+    from ..pipeline.authored import one_report_per_authored_mesh
     from ..pipeline.check import check_files
     from ..pipeline.progress import progress_for
 
@@ -466,10 +472,12 @@ def run(args) -> int:
             progress = _journaled(journal, todo, settings, progress)
         with _result_cache(args, run_options) as cache:
             fresh = check_files([tasks[i] for i in todo], args.jobs, progress,
-                                usd=UsdOptions(args.time, args.uv_primvar), cache=cache, cluster=cluster)
+                                usd=UsdOptions(args.time, args.uv_primvar, args.all_variants), cache=cache,
+                                cluster=cluster)
     reports = [done[i] if i in done else None for i in range(len(tasks))]
     for i, report in zip(todo, fresh):
         reports[i] = report
+    reports = one_report_per_authored_mesh(reports)
     report_problems(reports, args.quiet, args.fail_on_skip)
     if args.write_baseline:
         _write_baseline(reports, args.write_baseline, args.quiet)

@@ -33,6 +33,7 @@ def add_parser(sub) -> None:
 
 def run(args) -> int:
     from ..output import CheckRun
+    from ..pipeline.authored import one_report_per_authored_mesh
     from ..shards.merge import MergeError, merge_results
     from .check import publish, report_problems
 
@@ -41,7 +42,8 @@ def run(args) -> int:
     except MergeError as err:
         sys.stderr.writelines(f"affinity merge: error: {problem}\n" for problem in err.problems)
         return EXIT_ERROR
-    report_problems(merged.reports, args.quiet, args.fail_on_skip)
-    check_run = CheckRun(merged.reports, merged.settings, baselined=merged.baselined, statistics=args.statistics,
+    reports = one_report_per_authored_mesh(merged.reports)
+    report_problems(reports, args.quiet, args.fail_on_skip)
+    check_run = CheckRun(reports, merged.settings, baselined=merged.baselined, statistics=args.statistics,
                          fail_on=args.fail_on)
     return publish(check_run, args)

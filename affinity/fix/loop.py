@@ -17,6 +17,7 @@ from .apply import build
 from .budget import estimated_bytes, within_budget
 from .layout import MAX_LEVEL, layout
 from .plan import LEVEL_ORDER, Candidates, FixPlan, FixSettings, candidates, left_by_rule, readings
+from .twins import readings_from_twins, twin_faces
 from .verify import flagged_by_rule, verify
 
 
@@ -75,6 +76,9 @@ def _plan(mesh: Mesh, found: Candidates, reasons: np.ndarray, uncut: np.ndarray,
     placed = layout(mesh, refine_faces, refine_n, frozen)
     refined = build(mesh, placed)
     codes, before, after, units = readings(mesh, refine_faces, refine_n, found.scored, fix)
+    twins = twin_faces(mesh)
+    if twins is not None:  # a face refined for its twins' sake reads as they do
+        codes, before, after, units = readings_from_twins(twins[refine_faces], codes, before, after, units)
     added = refined.mesh.n_faces - mesh.n_faces
     left = ~refine
     return FixPlan(refine_faces, refine_n, codes, before, after, units, found.faces[left],

@@ -26,6 +26,7 @@ import numpy as np
 from ..mesh import Mesh
 from ..rules import LEVELS
 from ..settings import Settings
+from .twins import alike_across_twins, twin_faces
 
 
 def left_by_rule() -> dict[str, str]:
@@ -299,6 +300,9 @@ def candidates(mesh: Mesh, fix: FixSettings) -> Candidates:
     """Lint ``mesh``, pick the flagged quads, why each is left or the level it needs (module docstring)."""
     scored, leaving = flagged_quads(mesh, fix)
     found = np.unique(np.concatenate([faces for faces, _ in scored.values()] or [np.zeros(0, np.int64)]))
+    twins = twin_faces(mesh)  # USD: prims of one authored mesh get one refinement, written once
+    if twins is not None:
+        found = np.flatnonzero(np.isin(twins, twins[found]))
     if fix.faces is not None:
         found = np.intersect1d(found, np.asarray(fix.faces, dtype=np.int64))
     reasons = np.full(len(found), "", dtype=object)
@@ -325,6 +329,8 @@ def candidates(mesh: Mesh, fix: FixSettings) -> Candidates:
         rows, keep = at[code]
         keep[keep] &= reasons[rows[keep]] == ""
         need[rows[keep]] = np.maximum(need[rows[keep]], needed_levels(mesh, faces[keep], values[keep], code, fix))
+    if twins is not None:
+        need, reasons = alike_across_twins(twins[found], need, reasons)
     reasons[(reasons == "") & (need > fix.cap)] = "over-cap"
     uncut = np.unique(np.concatenate([leaving.get(code, np.zeros(0, np.int64)) for code in uncut_by_rule()]))
     uncut = uncut[mesh.face_sizes[uncut] == 4]

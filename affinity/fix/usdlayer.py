@@ -1,7 +1,8 @@
 """A fixed USD stage as an override layer: it sublayers the input and overrides only the meshes it fixed.
 
 The input layer is never touched. For each mesh prim with a refined or re-cut face the
-layer holds an ``over`` with the prim's whole new topology (``points``,
+layer holds an ``over`` with the prim's whole new topology (prims that compose one authored mesh
+share one copy of it, written once in a ``class`` their ``over`` inherits: :func:`write_refined`) (``points``,
 ``faceVertexCounts``, ``faceVertexIndices``) and its attributes: the uv primvar the
 check read (``st``, else the first ``texCoord2*``) and ``primvars:normals``, both
 face-varying and indexed, and ``primvars:displayColor`` per vertex. Values go back from
@@ -59,11 +60,12 @@ def _indexed(values: np.ndarray, index: np.ndarray) -> tuple[np.ndarray, np.ndar
 def write_override_layer(path: str, out: str, mesh: Mesh, refined: Refined, header: str) -> list[str]:
     """Write the override layer of ``refined`` (the fix of ``mesh``, read from the stage ``path``) to ``out``;
     returns the notes on the meshes whose subdivided surface changes (:func:`subdivided_notes`)."""
-    from pxr import Sdf, Usd, UsdGeom
+    from pxr import Sdf, Usd
 
-    stage = Usd.Stage.Open(os.fspath(path))
-    time = Usd.TimeCode.EarliestTime()
-    xforms = UsdGeom.XformCache(time)
+    from ..loaders.usddiagnostics import captured_diagnostics
+
+    with captured_diagnostics("", []):  # said once already, when the stage was read for the plan
+        stage = Usd.Stage.Open(os.fspath(path))
     layer = Sdf.Layer.CreateAnonymous(".usda")
     layer.documentation = header
     source_root = stage.GetRootLayer()
@@ -71,11 +73,7 @@ def write_override_layer(path: str, out: str, mesh: Mesh, refined: Refined, head
         if source_root.pseudoRoot.HasInfo(key):
             layer.pseudoRoot.SetInfo(key, source_root.pseudoRoot.GetInfo(key))
     layer.subLayerPaths.append(os.path.relpath(os.path.abspath(path), os.path.dirname(os.path.abspath(out))))
-    fixed = refined.mesh
-    blocked = []
-    for group in np.unique(mesh.face_group[refined.replaced]).tolist():
-        prim = stage.GetPrimAtPath(mesh.group_names[group])
-        blocked += override_prim(layer, prim.GetPath(), prim, fixed, group, time, xforms)
+    blocked = write_refined(layer, stage, mesh, refined)
     if blocked:
         layer.documentation = f"{header}; blocked (they indexed the old faces): {', '.join(blocked)}"
     text = layer.ExportToString()
@@ -84,7 +82,67 @@ def write_override_layer(path: str, out: str, mesh: Mesh, refined: Refined, head
     else:
         with atomic_write(out) as f:
             f.write(text)
-    return subdivided_notes(stage, mesh, refined, time)
+    return subdivided_notes(stage, mesh, refined, Usd.TimeCode.EarliestTime())
+
+
+def write_refined(layer, stage, mesh: Mesh, refined: Refined, spec_path=None) -> list[str]:
+    """Author the fixed prims of ``refined`` (the fix of ``mesh``, read from ``stage``) in ``layer``; returns the
+    attributes blocked.
+
+    A prim whose geometry no other fixed prim shares gets an ``over`` with its fixed geometry
+    (:func:`override_prim`). Prims that compose one authored mesh (:func:`affinity.fix.twins.twin_faces`: the
+    plan refines them alike) share one fixed copy: a ``class`` under :data:`FIXED_ROOT` holds it, written
+    once from the first of them, and each prim's ``over`` inherits it (an inherit arc is stronger than the
+    reference or payload that brings the authored mesh). ``spec_path`` maps a prim's path to its spec's in
+    ``layer`` (an edit target's mapping; default: the same path).
+    """
+    from pxr import Sdf, Usd, UsdGeom
+
+    from .twins import twin_faces
+
+    spec_path = spec_path or (lambda path: path)
+    time = Usd.TimeCode.EarliestTime()
+    xforms = UsdGeom.XformCache(time)
+    fixed = refined.mesh
+    twins = twin_faces(mesh)
+    starts = mesh.prim_face_start
+    groups = np.unique(mesh.face_group[refined.replaced]).tolist()
+    owner = {g: g if twins is None else int(mesh.face_group[twins[starts[g]]]) for g in groups}
+    shared = {o for o in owner.values() if sum(1 for g in groups if owner[g] == o) > 1}
+    blocked, classes = [], {}
+    for group in groups:
+        prim = stage.GetPrimAtPath(mesh.group_names[group])
+        path = spec_path(prim.GetPath())
+        if owner[group] not in shared:
+            blocked += override_prim(layer, path, prim, fixed, group, time, xforms)
+            continue
+        if owner[group] not in classes:
+            classes[owner[group]] = _fixed_class(layer, mesh.prim_sources[group])
+            blocked += override_prim(layer, classes[owner[group]], prim, fixed, group, time, xforms)
+        Sdf.CreatePrimInLayer(layer, path).inheritPathList.Prepend(classes[owner[group]])
+    return blocked
+
+
+#: Where the fixed copies of shared geometry live in a fix's layer (an abstract class: never drawn).
+FIXED_ROOT = "/AffinityFixed"
+
+
+def _fixed_class(layer, source) -> object:
+    """A new ``class`` spec under :data:`FIXED_ROOT` in ``layer`` for the authored mesh ``source`` (layer, prim
+    path), named after them; its path."""
+    from pxr import Sdf, Tf
+
+    root = Sdf.CreatePrimInLayer(layer, FIXED_ROOT)
+    root.specifier = Sdf.SpecifierClass
+    stem = os.path.splitext(os.path.basename(source[0]))[0]
+    name = Tf.MakeValidIdentifier(f"{stem}_{source[1].strip('/').replace('/', '_')}")
+    path, k = root.path.AppendChild(name), 1
+    while layer.GetPrimAtPath(path):
+        k += 1
+        path = root.path.AppendChild(f"{name}_{k}")
+    spec = Sdf.CreatePrimInLayer(layer, path)
+    spec.specifier = Sdf.SpecifierClass
+    return path
 
 
 def override_prim(layer, spec_path, prim, fixed: Mesh, group: int, time, xforms) -> list[str]:

@@ -6,6 +6,7 @@ Which statements name texture maps is the resource registry's
 
 from __future__ import annotations
 
+import itertools
 import os
 
 from .regular import SIDE_FILE_BUDGET
@@ -62,8 +63,18 @@ def map_statements(path) -> list[tuple[str, str, TextureMap]]:
                 role=ROLES[role].texture, name=name, source=words[0],
                 path=os.path.normpath(os.path.join(folder, name.replace("\\", "/"))),
                 scale=(scale[0], scale[1] if len(scale) > 1 else 1.0),
-                offset=(offset[0], offset[1] if len(offset) > 1 else 0.0))))
+                offset=(offset[0], offset[1] if len(offset) > 1 else 0.0),
+                wrap=("clamp", "clamp") if clamped(words[1:]) else ("repeat", "repeat"))))
     return maps
+
+
+def clamped(arguments: list[str]) -> bool:
+    """Whether a texture map statement's options say ``-clamp on`` (the texture is not repeated).
+
+    >>> clamped(["-clamp", "on", "wood.png"]), clamped(["-clamp", "off", "wood.png"])
+    (True, False)
+    """
+    return any(a == "-clamp" and b.lower() == "on" for a, b in itertools.pairwise(arguments))
 
 
 def texture_file_name(arguments: list[str]) -> str:

@@ -36,6 +36,9 @@ class TextureMap:
     scale, offset, rotation : the texture is read at ``R(rotation) (uv * scale) + offset``, R a rotation by
         ``rotation`` degrees counter-clockwise (MTL ``-s``/``-o``; MaterialX ``uvtiling``/``uvoffset``; USD
         ``UsdTransform2d``: scale, then rotate, then translate)
+    wrap : what is read outside [0, 1] along u and v: ``repeat``, ``clamp``, ``mirror`` or ``black``
+        (:mod:`affinity.textures.wrapping`; MTL ``-clamp on``, UsdUVTexture ``wrapS``/``wrapT``, MaterialX
+        ``uaddressmode``/``vaddressmode``)
     """
 
     role: str | None
@@ -45,6 +48,7 @@ class TextureMap:
     scale: tuple[float, float] = (1.0, 1.0)
     offset: tuple[float, float] = (0.0, 0.0)
     rotation: float = 0.0
+    wrap: tuple[str, str] = ("repeat", "repeat")
 
     @property
     def udim(self) -> bool:

@@ -54,7 +54,16 @@ from ..mesh import Mesh
 from .formats import format_named
 from .numbers import out_of_range, out_of_range_reason
 from .resources import Resource
-from .usdlayers import geometry_source, layer_assets, may_hold_mesh, prim_type_names, regular_layers, subdivision_note
+from .usddiagnostics import captured_diagnostics
+from .usdlayers import (
+    geometry_source,
+    holds_look,
+    layer_assets,
+    may_hold_mesh,
+    prim_type_names,
+    regular_layers,
+    subdivision_note,
+)
 
 USD_SUFFIXES = format_named("usd").suffixes
 INSTALL = "pip install 'quad-affinity[usd]'"
@@ -67,11 +76,13 @@ _TEXT_LINE = re.compile(r"\.usda?:(\d+):\d+: ")
 
 @dataclass(frozen=True)
 class UsdOptions:
-    """How to read a stage: ``time`` (None: the earliest time sample) and the uv primvar
-    name (None: ``st``, else the first ``texCoord2*`` primvar)."""
+    """How to read a stage: ``time`` (None: the earliest time sample), the uv primvar
+    name (None: ``st``, else the first ``texCoord2*`` primvar) and whether the textures of every
+    variant's material binding are read (``all_variants``; default: the stage's selection)."""
 
     time: float | None = None
     uv_primvar: str | None = None
+    all_variants: bool = False
 
 
 class _BadPrim(Exception):
@@ -93,7 +104,9 @@ def load_usd(path, options: UsdOptions | None = None) -> Mesh:
 
     Raises MeshError (line 0, the prim path in the reason) when usd-core is
     missing, the stage cannot be opened or traversed, or a prim's topology or
-    values are invalid; SkippedFile (``no-mesh``) when it has no mesh to check. A stage none of whose
+    values are invalid; SkippedFile (``no-mesh``) when it has no mesh to check and no look (a stage
+    whose layers hold materials or bindings, :func:`~affinity.loaders.usdlayers.holds_look`, is an empty
+    mesh: checked, without findings). A stage none of whose
     layers holds a prim spec that may be a mesh (:func:`~affinity.loaders.usdlayers.may_hold_mesh`) is
     skipped without composing it: on a stage of 100,000 empty prims composing took 1.2 s, the look
     at the layer's specs 0.23 s.
@@ -102,20 +115,41 @@ def load_usd(path, options: UsdOptions | None = None) -> Mesh:
         from pxr import Tf, Usd
     except ImportError:
         raise MeshError(path, 0, f"reading USD needs usd-core: {INSTALL}") from None
-    try:
-        layers, complete = regular_layers(path)  # held open until the stage is: pxr reads each once
-        if complete and not any(may_hold_mesh(prim_type_names(layer)) for layer in layers):
-            raise SkippedFile(path, "no-mesh")
-        stage = Usd.Stage.Open(os.fspath(path))
-        del layers
-    except Tf.ErrorException as error:
-        reason = pxr_reason(error)
-        line = _TEXT_LINE.search(reason)  # .usda parse errors say where: "file.usda:7:9: ..."
-        raise MeshError(path, int(line.group(1)) if line else 0, f"cannot open the stage: {reason}") from None
-    mesh = load_stage(stage, os.fspath(path), options)
+    said: list[str] = []  # usd-core's diagnostics, one note per problem
+    with captured_diagnostics(os.getcwd(), said):
+        try:
+            layers, complete = regular_layers(path)  # held open until the stage is: pxr reads each once
+            type_names = [prim_type_names(layer) for layer in layers]
+            look = any(map(holds_look, layers, type_names))
+            if complete and not any(map(may_hold_mesh, type_names)):
+                stage = None
+            else:
+                stage = Usd.Stage.Open(os.fspath(path))
+            del layers
+        except Tf.ErrorException as error:
+            reason = pxr_reason(error)
+            line = _TEXT_LINE.search(reason)  # .usda parse errors say where: "file.usda:7:9: ..."
+            raise MeshError(path, int(line.group(1)) if line else 0, f"cannot open the stage: {reason}") from None
+        try:
+            if stage is None:
+                raise SkippedFile(path, "no-mesh")
+            mesh = load_stage(stage, os.fspath(path), options)
+        except SkippedFile:
+            if not look:
+                raise
+            mesh = _look_only(path)
+    mesh.notes += said
     mesh.resources = [Resource(role="usd-asset", name=asset, path=os.path.normpath(absolute))
                       for asset, absolute in layer_assets(path)]
     return mesh
+
+
+def _look_only(path) -> Mesh:
+    """The empty mesh of a stage whose layers hold a look and no mesh: a checked file without findings
+    (design.md, Clarifications), not a skip."""
+    return Mesh(path=os.fspath(path), positions=np.zeros((0, 3)), face_start=np.zeros(1, dtype=np.int64),
+                corner_vertex=np.zeros(0, dtype=np.int64), face_line=np.zeros(0, dtype=np.int64), group_names=[],
+                prim_face_start=np.zeros(1, dtype=np.int64))
 
 
 def load_stage(stage, path: str, options: UsdOptions | None = None, prim_paths: list[str] | None = None,
@@ -168,11 +202,11 @@ def load_stage(stage, path: str, options: UsdOptions | None = None, prim_paths: 
     mesh.meters_per_unit = _stage_metadata(stage, "metersPerUnit", lambda: float(UsdGeom.GetStageMetersPerUnit(stage)),
                                            notes)
     mesh.notes = notes
-    _bind_materials(mesh, prims, options.uv_primvar)
+    _bind_materials(mesh, prims, options.uv_primvar, options.all_variants)
     return mesh
 
 
-def _bind_materials(mesh: Mesh, prims: list, uv_primvar: str | None) -> None:
+def _bind_materials(mesh: Mesh, prims: list, uv_primvar: str | None, all_variants: bool = False) -> None:
     """Each prim's bound material (``material_names``, ``face_material`` per prim) and the textures it reads
     through the uv primvar (``material_maps``, :mod:`affinity.loaders.usdmaterials`)."""
     from pxr import Tf
@@ -182,7 +216,7 @@ def _bind_materials(mesh: Mesh, prims: list, uv_primvar: str | None) -> None:
     names, per_prim = [], []
     for prim in prims:
         try:
-            material, maps = prim_material_maps(prim, uv_primvar)
+            material, maps = prim_material_maps(prim, uv_primvar, all_variants)
         except Tf.ErrorException:
             material, maps = None, []
         if material is not None and material not in names:
@@ -264,7 +298,8 @@ def _read_prim(prim, time, xforms, uv_primvar: str | None) -> Mesh:
     from pxr import UsdGeom
 
     usd_mesh = UsdGeom.Mesh(prim)
-    points = _finite("points", _array(usd_mesh.GetPointsAttr(), time, np.float64, 3))
+    points_attribute = usd_mesh.GetPointsAttr()
+    points = _finite("points", _array(points_attribute, time, np.float64, 3))
     sizes = _array(usd_mesh.GetFaceVertexCountsAttr(), time, np.int64)
     corner_vertex = _array(usd_mesh.GetFaceVertexIndicesAttr(), time, np.int64)
     _check_topology(sizes, corner_vertex, len(points))
@@ -307,6 +342,7 @@ def _read_prim(prim, time, xforms, uv_primvar: str | None) -> Mesh:
         corner_normal=corner_normal,
         colors=colors,
         subdivision=[scheme],
+        position_epsilon=_epsilon(points_attribute),
     )
 
 
@@ -346,6 +382,14 @@ def subdivision_scheme(usd_mesh, time):
                   crease_edges=edges, crease_sharpness=edge_sharpness, corner_vertices=corners,
                   corner_sharpness=corner_sharpness,
                   holes=_array(usd_mesh.GetHoleIndicesAttr(), time, np.int64))
+
+
+def _epsilon(attribute) -> float:
+    """The machine epsilon of the points as ``attribute`` stores them: float16 for ``point3h[]``, float32 for
+    ``point3f[]`` (USD's usual), float64 for ``point3d[]`` and anything else."""
+    name = str(attribute.GetTypeName())
+    dtype = np.float16 if "3h" in name else np.float32 if "3f" in name else np.float64
+    return float(np.finfo(dtype).eps)
 
 
 def _transformed(rows: np.ndarray, linear: np.ndarray) -> np.ndarray:
@@ -542,6 +586,7 @@ def _concatenate(path: str, parts: list[Mesh], prim_paths: list[str]) -> Mesh:
         texcoords=texcoords, corner_texcoord=corner_texcoord,
         normals=normals, corner_normal=corner_normal,
         subdivision=_offset_schemes(parts),
+        position_epsilon=max(p.position_epsilon for p in parts),
     )
 
 

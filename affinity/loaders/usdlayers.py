@@ -102,6 +102,23 @@ def prim_type_names(layer) -> set[str]:
     return {prim_at(spec_path).typeName for spec_path in spec_paths if spec_path.IsPrimPath()} - {""}
 
 
+#: Prim types of a look: a layer that holds one (and no mesh) is a checked file with no findings, not a skip.
+LOOK_TYPES = frozenset({"Material", "Shader", "NodeGraph"})
+
+
+def holds_look(layer, type_names: set[str]) -> bool:
+    """Whether the Sdf ``layer`` (whose prim specs have ``type_names``) holds a look: a prim of
+    :data:`LOOK_TYPES`, a ``material:binding`` relationship (inside variants too) or a reference to a MaterialX
+    document, as an asset's ``*_look.usd`` does (design.md, Clarifications)."""
+    if type_names & LOOK_TYPES or any(asset.lower().endswith(".mtlx")
+                                      for asset in layer.GetCompositionAssetDependencies()):
+        return True
+    spec_paths = []
+    layer.Traverse(layer.pseudoRoot.path, spec_paths.append)
+    return any(spec_path.IsPropertyPath() and spec_path.name.startswith("material:binding")
+               for spec_path in spec_paths)
+
+
 def may_hold_mesh(type_names: set[str]) -> bool:
     """Whether a prim of one of ``type_names`` may compose to a ``UsdGeom.Mesh``: a Mesh, a type derived
     from it, or a type usd-core does not know (a plug-in's schema, or one with ``fallbackPrimTypes``)."""

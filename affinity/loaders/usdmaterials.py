@@ -34,16 +34,95 @@ ROLE_OF_INPUT = {
 _IMAGE_NODES = ("image", "tiledimage")
 
 
-def prim_material_maps(prim, uv_primvar: str | None) -> tuple[str | None, list[TextureMap]]:
-    """The path of the material bound to ``prim`` and the textures it reads through the primvar
-    ``uv_primvar`` (None: ``st``); (None, []) when no material is bound."""
+def prim_material_maps(prim, uv_primvar: str | None, all_variants: bool = False) -> tuple[str | None,
+                                                                                         list[TextureMap]]:
+    """The material bound to ``prim`` (its path; with ``all_variants``, the paths of every variant's binding joined
+    by `` | ``) and the textures it reads through the primvar ``uv_primvar`` (None: ``st``); (None, []) when no
+    material is bound."""
+    paths = bound_material_paths(prim, all_variants)
+    if not paths:
+        return None, []
+    maps = []
+    for path in paths:
+        maps += [found for found in _material_maps_at(prim.GetStage(), path, uv_primvar or "st") if found not in maps]
+    return " | ".join(map(str, paths)), maps
+
+
+def bound_material_paths(prim, all_variants: bool = False) -> list:
+    """The ``Sdf.Path`` of the material bound to ``prim`` (any purpose: all-purpose, then ``full``, then
+    ``preview``), whether or not a prim exists there; with ``all_variants`` then the paths the bindings of the
+    variants not selected name (:func:`variant_binding_paths`). Empty when nothing is bound."""
     from pxr import UsdShade
 
-    material, _ = UsdShade.MaterialBindingAPI(prim).ComputeBoundMaterial()
-    if not material:
-        return None, []
-    maps = preview_surface_maps(material, uv_primvar or "st")
-    return str(material.GetPath()), maps or materialx_maps(material.GetPrim())
+    api = UsdShade.MaterialBindingAPI(prim)
+    paths = []
+    for purpose in (UsdShade.Tokens.allPurpose, UsdShade.Tokens.full, UsdShade.Tokens.preview):
+        material, relationship = api.ComputeBoundMaterial(purpose)
+        targets = [material.GetPath()] if material else relationship.GetTargets() if relationship else []
+        if targets:
+            paths.append(targets[0])
+            break
+    if all_variants:
+        paths += [path for path in variant_binding_paths(prim) if path not in paths]
+    return paths
+
+
+def variant_binding_paths(prim) -> list:
+    """The material paths the ``material:binding`` relationships of ``prim`` name inside every variant of its
+    ancestors' (and its own) variant sets, the selected ones included, read from the Sdf specs and mapped to
+    the stage's namespace (a target under the spec's root prim moves to the composed prim's path)."""
+    from pxr import Sdf
+
+    found = []
+    ancestor = prim
+    while ancestor and not ancestor.IsPseudoRoot():
+        below = prim.GetPath().MakeRelativePath(ancestor.GetPath())
+        for spec in ancestor.GetPrimStack():
+            if spec.path.ContainsPrimVariantSelection():
+                continue
+            for variant_set in spec.variantSets.values():
+                for variant in variant_set.variants.values():
+                    inside = variant.primSpec.path if below.pathString == "." else \
+                        variant.primSpec.path.AppendPath(below)
+                    relationship = spec.layer.GetRelationshipAtPath(inside.AppendProperty("material:binding"))
+                    if relationship is None:
+                        continue
+                    for target in relationship.targetPathList.GetAddedOrExplicitItems():
+                        mapped = target.ReplacePrefix(spec.path, ancestor.GetPath()) if target.HasPrefix(spec.path) \
+                            else target
+                        if mapped not in found:
+                            found.append(Sdf.Path(mapped))
+        ancestor = ancestor.GetParent()
+    return found
+
+
+def _material_maps_at(stage, path, uv_primvar: str) -> list[TextureMap]:
+    """The textures of the material at ``path`` on ``stage``: its UsdPreviewSurface network, else the MaterialX
+    document it references; where no prim is there, the MaterialX document an ancestor's uncomposable ``.mtlx``
+    reference names (:func:`ancestor_materialx_maps`)."""
+    from pxr import UsdShade
+
+    material = UsdShade.Material(stage.GetPrimAtPath(path))
+    if material:
+        return preview_surface_maps(material, uv_primvar) or materialx_maps(material.GetPrim())
+    return ancestor_materialx_maps(stage, path)
+
+
+def ancestor_materialx_maps(stage, path) -> list[TextureMap]:
+    """The textures of the material at ``path`` that does not exist on ``stage`` because an ancestor's reference
+    to a ``.mtlx`` document cannot compose (design.md, Clarifications): the nearest ancestor prim with such a
+    reference (``/A/Materials`` referencing ``@x.mtlx@</MaterialX/Materials>``) maps ``path``
+    (``/A/Materials/M_X``) into the document (``/MaterialX/Materials/M_X``), whose last name is the
+    ``surfacematerial`` read."""
+    ancestor = path.GetParentPath()
+    while not ancestor.IsAbsoluteRootPath() and not ancestor.isEmpty:
+        prim = stage.GetPrimAtPath(ancestor)
+        reference = _mtlx_reference(prim) if prim else None
+        if reference is not None:
+            document, target = reference
+            return mtlx_document_maps(document, path.ReplacePrefix(ancestor, target).name)
+        ancestor = ancestor.GetParentPath()
+    return []
 
 
 def preview_surface_maps(material, uv_primvar: str) -> list[TextureMap]:
@@ -64,7 +143,10 @@ def preview_surface_maps(material, uv_primvar: str) -> list[TextureMap]:
                 continue
             maps.append(TextureMap(role=ROLE_OF_INPUT.get(shader_input.GetBaseName(), "scalar"),
                                    path=_resolved(file_input.GetAttr(), asset), name=asset.path,
-                                   source=f"UsdUVTexture {texture.GetPath()}", **transform))
+                                   source=f"UsdUVTexture {texture.GetPath()}",
+                                   wrap=tuple(_wrap(USD_WRAPS, _input_value(texture, name))
+                                              for name in ("wrapS", "wrapT")),
+                                   **transform))
     return maps
 
 
@@ -131,14 +213,24 @@ def _resolved(attribute, asset) -> str:
 def materialx_maps(material_prim) -> list[TextureMap]:
     """The textures of the MaterialX material a material prim references (the first ``.mtlx`` reference
     of its prim specs), read from the document's XML."""
-    for spec in material_prim.GetPrimStack():
+    reference = _mtlx_reference(material_prim)
+    if reference is None:
+        return []
+    document, target = reference
+    return mtlx_document_maps(document, target.name or None)
+
+
+def _mtlx_reference(prim) -> tuple[str, object] | None:
+    """(document path, prim path inside it) of the first ``.mtlx`` reference of ``prim``'s specs; None when it
+    has none."""
+    for spec in prim.GetPrimStack():
         for reference in spec.referenceList.GetAddedOrExplicitItems():
             if reference.assetPath.lower().endswith(".mtlx"):
                 document = spec.layer.ComputeAbsolutePath(reference.assetPath)
                 if spec.layer.realPath and not os.path.isabs(document):
                     document = os.path.join(os.path.dirname(spec.layer.realPath), reference.assetPath)
-                return mtlx_document_maps(document, reference.primPath.name or None)
-    return []
+                return document, reference.primPath
+    return None
 
 
 def mtlx_document_maps(path: str, material: str | None = None, every: bool = False) -> list[TextureMap]:
@@ -165,8 +257,28 @@ def mtlx_document_maps(path: str, material: str | None = None, every: bool = Fal
             scale, offset = _tiling(image)
             maps.append(TextureMap(role=role, path=os.path.normpath(os.path.join(folder, name)), name=name,
                                    source=f"MaterialX {image.tag} {image.get('name')} ({os.path.basename(path)})",
-                                   scale=scale, offset=offset))
+                                   scale=scale, offset=offset,
+                                   wrap=tuple(_wrap(MATERIALX_WRAPS, _value(image, name))
+                                              for name in ("uaddressmode", "vaddressmode"))))
     return maps
+
+
+#: Wrap modes (:mod:`affinity.textures.wrapping`) by UsdUVTexture ``wrapS``/``wrapT`` token (``useMetadata``,
+#: the file's own, and the fallback: repeat) and by MaterialX ``uaddressmode``/``vaddressmode`` (``constant``
+#: reads the node's default outside, black unless set).
+USD_WRAPS = {"repeat": "repeat", "mirror": "mirror", "clamp": "clamp", "black": "black"}
+MATERIALX_WRAPS = {"periodic": "repeat", "mirror": "mirror", "clamp": "clamp", "constant": "black"}
+
+
+def _wrap(modes: dict, authored) -> str:
+    """The wrap mode of an authored token (None or an unknown one: repeat)."""
+    return modes.get(str(authored) if authored is not None else "", "repeat")
+
+
+def _value(image, name: str) -> str | None:
+    """The ``value`` of an image node's input ``name``; None when it has none."""
+    element = image.find(f"input[@name='{name}']")
+    return None if element is None else element.get("value")
 
 
 def _named_nodes(root) -> dict:

@@ -83,6 +83,8 @@ def _file_entry(report: FileReport) -> dict:
     entry = {"path": report.path, **report.counts, "findings": report.n_findings}
     if report.prim_face_start is not None:
         entry.update(up_axis=report.up_axis, meters_per_unit=report.meters_per_unit, notes=report.notes)
+        if report.prim_sources:
+            entry["prim_sources"] = report.prim_sources
     return entry
 
 

@@ -15,7 +15,7 @@ import threading
 import time
 from collections import Counter
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -377,6 +377,15 @@ def _collect_pictures(item: MeshInput, file: FileReport, mesh: Mesh, settings: S
             "places": places, "closeups": closeups, "dropped": dropped}
 
 
+def _one_report_per_authored_mesh(meshes: list[MeshResult]) -> list[MeshResult]:
+    """The results with each authored USD mesh's findings in one of them, as ``affinity check`` reports a run
+    (:func:`affinity.pipeline.authored.one_report_per_authored_mesh`); the pictures stay as drawn."""
+    from ..pipeline.authored import one_report_per_authored_mesh
+
+    files = one_report_per_authored_mesh([result.file for result in meshes])
+    return [result if file is result.file else replace(result, file=file) for result, file in zip(meshes, files)]
+
+
 def collect_run(items: list[MeshInput], settings_for: Callable[[str], Settings], settings: Settings,
                 progress, options: ReportOptions = ReportOptions(), demo: bool = False,
                 start: float | None = None, fail_on: str = "error") -> ReportRun:
@@ -397,6 +406,7 @@ def collect_run(items: list[MeshInput], settings_for: Callable[[str], Settings],
         progress.set_description(os.path.basename(item.path), refresh=False)
         meshes.append(collect_mesh(item, settings_for(item.path), progress.set_postfix_str, options))
         progress.update()
+    meshes = _one_report_per_authored_mesh(meshes)
     parts = Counter({"start-up": collecting - start})
     for result in meshes:
         parts.update(result.parts)  # adds the seconds of each part

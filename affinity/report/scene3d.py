@@ -157,8 +157,17 @@ def _findings(result: MeshResult) -> tuple[list[dict], np.ndarray]:
             rows.append({"code": hits.code, "name": rule.name, "level": str(levels[i]), "face": int(hits.faces[i]),
                          "line": int(hits.lines[i]), "group": file.group_names[hits.groups[i]],
                          "value": float(hits.values[i]), "unit": str(units[i]),
-                         "attribute": ATTRIBUTE_NAMES.get(rule.attribute)})
+                         "attribute": ATTRIBUTE_NAMES.get(rule.attribute), **_in_prim(file, hits, i)})
     return rows, np.where(rank == unflagged, 0, rank).astype(np.uint8)
+
+
+def _in_prim(file, hits, i: int) -> dict:
+    """A USD finding's place as ``affinity check`` names it: ``prim`` and ``prim_face``, the face within the prim
+    (design.md, Clarifications); nothing for other formats, whose rows keep their source line."""
+    if file.prim_face_start is None:
+        return {}
+    group = int(hits.groups[i])
+    return {"prim": file.group_names[group], "prim_face": int(hits.faces[i] - file.prim_face_start[group])}
 
 
 def view_data(result: MeshResult, budget: int = VIEW_QUAD_BUDGET) -> tuple[dict, list[str]]:
@@ -205,6 +214,8 @@ def view_data(result: MeshResult, budget: int = VIEW_QUAD_BUDGET) -> tuple[dict,
         "camera": [*(float(x) * scale for x in (*eye, *target)), float(fov)],
         "up": result.up,
         "left_out": left,
+        "prims": None if result.file.prim_face_start is None else  # USD: #prim=/A/B&face=F, F within the prim
+        {"names": list(result.file.group_names), "starts": result.file.prim_face_start.tolist()},
     }
     return data, notes
 

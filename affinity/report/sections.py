@@ -204,7 +204,8 @@ def findings_section(result: MeshResult) -> Section:
         levels = hits.levels()
         worst = [
             {"face": int(hits.faces[i]), "line": int(hits.lines[i]), "level": str(levels[i]),
-             "group": result.file.group_names[hits.groups[i]], "value": _value_text(hits, int(i), unit)}
+             "group": result.file.group_names[hits.groups[i]], "value": _value_text(hits, int(i), unit), "usd": False,
+             **_in_prim(result.file, hits, int(i))}
             for i in worst_first(hits)[:WORST_LISTED]
         ]
         by_level = dict(zip(*np.unique(levels, return_counts=True)))
@@ -215,6 +216,14 @@ def findings_section(result: MeshResult) -> Section:
         })
     rows.sort(key=lambda row: LEVELS.index(row["levels"][0][0]))  # the rules with errors first
     return Section("findings", title, {"rows": rows})
+
+
+def _in_prim(file, hits, i: int) -> dict:
+    """A USD finding's face as ``affinity check`` numbers it, within its prim (``face``, and ``usd``: no source
+    line is shown); nothing for other formats."""
+    if file.prim_face_start is None or hits.faces[i] < 0:
+        return {}
+    return {"face": int(hits.faces[i] - file.prim_face_start[hits.groups[i]]), "usd": True}
 
 
 def _shown_text(result: MeshResult) -> str:

@@ -36,7 +36,7 @@ from .selection import ShardRecord
 #: about ten times a document's size in memory).
 RESULT_BUDGET = 1 << 30
 #: Keys of a JSON file entry that are not face counts.
-_ENTRY_KEYS = {"path", "findings", "up_axis", "meters_per_unit", "notes"}
+_ENTRY_KEYS = {"path", "findings", "up_axis", "meters_per_unit", "notes", "prim_sources"}
 
 
 class ResultError(ValueError):
@@ -170,6 +170,7 @@ def report_from_json(entry: dict, findings: list[dict], settings: Settings) -> F
         up_axis=entry.get("up_axis"),
         meters_per_unit=entry.get("meters_per_unit"),
         notes=list(entry.get("notes", [])),
+        prim_sources=entry.get("prim_sources", {}),
     )
 
 

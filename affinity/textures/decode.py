@@ -57,6 +57,11 @@ class DecodedTexture:
     texels: np.ndarray
     channels: int
 
+    def boxed(self, low: np.ndarray, high: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Texel boxes as repeat wrapping reads them: unchanged (:class:`affinity.textures.wrapping.WrappedTexture`
+        moves them for other wrap modes)."""
+        return low, high
+
     @property
     def held_bytes(self) -> int:
         """Bytes the texture holds: its texels and the bands of its pyramids built so far (the decode cache's

@@ -20,6 +20,7 @@ from ..rules import LEVELS
 from .binding import bound_textures, quad_uv
 from .decode import TextureUnusable, decode, why_not_decoded
 from .visible import BOTH_DIAGONALS, DIAGONAL_02, DIAGONAL_13, EXACT, visible_values
+from .wrapping import WrappedTexture
 
 #: The unit of C by what the texture holds.
 UNITS = {False: "1/255", True: "degrees"}
@@ -85,6 +86,8 @@ def visible_reading(mesh, settings, faces: np.ndarray, shifts: np.ndarray) -> tu
             size = "" if err.header is None else f"; texels of its {err.header.width}x{err.header.height} header"
             notes.setdefault(int(rows[0]), f"{bound.label}: {err}{size}")
             continue
+        if bound.map.wrap != ("repeat", "repeat"):
+            texture = WrappedTexture(texture, bound.map.wrap)
         normal_map = bound.map.role == "normal" or (bound.map.role == "height" and texture.looks_like_normal_map)
         values, bounds = visible_values(texture, xy[rows], bound.tile_uv(uv[rows]), diagonals[rows], normal_map,
                                         limits)

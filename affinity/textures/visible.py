@@ -277,6 +277,7 @@ def crease_bound(texture, low_corner: np.ndarray, high_corner: np.ndarray, shift
     bilinear texture changes over that shift (its derivative across columns is a blend of steps to the next
     column, so at most the box's largest such step, and likewise across rows): steps x shifts, the smaller
     of the two. NaN for a box with a NaN corner."""
+    low_corner, high_corner = texture.boxed(low_corner, high_corner)  # moved by the map's wrap modes
     low, high = box_extremes(texture.pyramid, low_corner, high_corner)
     with np.errstate(invalid="ignore"):
         bound = range_bound(low, high, normal_map)

@@ -413,12 +413,20 @@
 
   View.prototype.buildTable = function () {
     var view = this, body = this.figure.querySelector(".view3d-findings tbody");
+    if (this.data.prims) {  /* USD: "face" counts within the prim, the group is the prim, and no line column */
+      var heads = this.figure.querySelectorAll(".view3d-findings thead th");
+      heads[4].textContent = "prim";
+      heads[5].remove();
+    }
     this.data.findings.forEach(function (row) {
       var tr = document.createElement("tr");
       tr.tabIndex = 0;
       tr.dataset.shows = String(row.face);
       var value = Number(row.value).toPrecision(3) + " " + row.unit;
-      [row.level, row.code, String(row.face), value, row.group, String(row.line)].forEach(function (text, k) {
+      /* A USD row shows the prim and the face within it, as check prints them; it has no source line. */
+      var cells = row.prim === undefined ? [row.level, row.code, String(row.face), value, row.group, String(row.line)]
+        : [row.level, row.code, String(row.prim_face), value, row.prim];
+      cells.forEach(function (text, k) {
         var td = document.createElement("td");
         td.textContent = text;
         if (k === 0) { td.className = "level " + row.level; }
@@ -646,7 +654,8 @@
     if (face >= 0 && pixel[3] === 255 && !(pixel[0] === 255 && pixel[1] === 255 && pixel[2] === 255)) {
       var rows = this.data.findings.filter(function (row) { return row.face === face; });
       this.select(face);
-      this.say("face " + face + (rows.length ? ": " + rows.map(function (r) {
+      this.say(this.faceInUrl(face).replace("prim=", "prim ").replace("&face=", " face ").replace("face=", "face ") +
+               (rows.length ? ": " + rows.map(function (r) {
         return r.code + " " + r.name + " " + Number(r.value).toPrecision(3) + " " + r.unit;
       }).join("; ") : ": not flagged"));
       this.toUrl();
@@ -662,19 +671,35 @@
   View.prototype.toUrl = function () {
     var parts = [];
     if (document.querySelectorAll("figure[data-view='3d']").length > 1) { parts.push("file=" + this.index); }
-    if (this.selected !== null) { parts.push("face=" + this.selected); }
+    if (this.selected !== null) { parts.push(this.faceInUrl(this.selected)); }
     parts.push("camera=" + this.cameraText());
     this.ownHash = "#" + parts.join("&");
     history.replaceState(null, "", this.ownHash);
   };
 
-  /* #face=F opens on face F, #camera=EX,EY,EZ,TX,TY,TZ,FOV on that camera (both: the face selected, the camera
-     as given); #file=I picks the I-th view (0-based) of a multi-file report. */
+  /* The page's face ``face`` as a URL names it: "face=F", or for a USD stage "prim=/A/B&face=F", F within the
+     prim (as check prints it). */
+  View.prototype.faceInUrl = function (face) {
+    var prims = this.data.prims;
+    if (!prims) { return "face=" + face; }
+    var p = prims.starts.length - 2;
+    while (p > 0 && prims.starts[p] > face) { p -= 1; }
+    return "prim=" + encodeURI(prims.names[p]) + "&face=" + (face - prims.starts[p]);
+  };
+
+  /* #face=F opens on face F (with #prim=/A/B, F counts within that prim of a USD stage), #camera=EX,EY,EZ,TX,TY,
+     TZ,FOV on that camera (both: the face selected, the camera as given); #file=I picks the I-th view (0-based)
+     of a multi-file report. */
   View.prototype.fromUrl = function () {
     if (location.hash === this.ownHash) { return; }
     var params = new URLSearchParams(location.hash.slice(1)), file = Number(params.get("file") || 0);
     if (file !== this.index) { return; }
-    var face = params.get("face"), camera = params.get("camera");
+    var face = params.get("face"), camera = params.get("camera"), prim = params.get("prim");
+    if (face !== null && /^\d+$/.test(face) && prim !== null && this.data.prims) {
+      var p = this.data.prims.names.indexOf(prim);
+      face = p < 0 || Number(face) >= this.data.prims.starts[p + 1] - this.data.prims.starts[p] ? null :
+        String(this.data.prims.starts[p] + Number(face));
+    }
     if (face !== null && /^\d+$/.test(face)) {
       var rows = this.data.findings.filter(function (row) { return row.face === Number(face); });
       if (rows.length) { this.showFinding(rows[0]); } else { this.flyTo(Number(face), false); }
