@@ -201,20 +201,22 @@ def test_render_onto_a_device_node_keeps_the_node(tmp_path):
     assert stat.S_ISCHR(os.stat(device).st_mode) and os.listdir(tmp_path) == ["null"]
 
 
-def test_outputs_onto_a_symlink_keep_the_link(tmp_path):
+def test_outputs_onto_a_symlink_are_refused_and_the_link_and_its_target_kept(tmp_path):
+    """Outputs never follow links (issue 53): one line, exit 2, the link and the file it names as they were."""
     (tmp_path / "store").mkdir()
     mesh = str(write(tmp_path, "trap.obj", TRAPEZOID))  # one quad: its report is written as the demo's is
-    commands = {"image.png": [*RENDER, "-o"], "baseline.json": ["check", mesh, "--write-baseline"],
-                "report.html": ["report", mesh, "-q", "--size", "48x36", "-o"]}
+    commands = {"image.png": [*RENDER, "-o"], "report.html": ["report", mesh, "-q", "--size", "48x36", "-o"],
+                "findings.json": ["check", mesh, "--format", "json", "-o"]}
     for name, command in commands.items():
         target = tmp_path / "store" / name
         target.write_text("old")
         link = tmp_path / name
         link.symlink_to(target)
         result = run(*command, str(link))
-        assert result.returncode == 0, (name, result.stderr)
+        assert result.returncode == 2 and result.stderr.count("\n") == 1, (name, result.stderr)
+        assert "is a symbolic link" in result.stderr and "Traceback" not in result.stderr, name
         assert link.is_symlink() and os.readlink(link) == str(target), name
-        assert target.read_bytes() != b"old", name
+        assert target.read_text() == "old", name
 
 
 def test_stability_folder_files_follow_the_same_rules(tmp_path):
