@@ -4,12 +4,11 @@ reversed, each uv or colour close-up's split and exact panels differ by at least
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers.cli import run
 from helpers.closeup_panels import Closeups, decode_panel
 from helpers.corpus import SHARED_MESHES
 
@@ -57,8 +56,7 @@ def test_closeups_show_a_crease_at_least_3_pixels_across(mesh, tmp_path):
     if isinstance(mesh, str):
         mesh = _reversed_copy(SHARED_MESHES / "spot_control_mesh.obj", tmp_path)
     report = tmp_path / "report.html"
-    built = subprocess.run([sys.executable, "-m", "affinity.cli", "report", "-q", str(mesh), "-o", str(report)],
-                           capture_output=True, text=True, timeout=600)
+    built = run("report", "-q", str(mesh), "-o", str(report))
     assert built.returncode == 0, built.stderr
     parser = Closeups()
     parser.feed(report.read_text(encoding="utf-8"))

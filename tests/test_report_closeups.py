@@ -3,11 +3,10 @@
 from __future__ import annotations
 
 import re
-import subprocess
-import sys
 
 import numpy as np
 import pytest
+from helpers.cli import run
 from helpers.corpus import ABSENT, SHARED_MESHES, shared_mesh_paths
 from helpers.quads import UNIT_UV, quad_obj, trapezoid
 
@@ -454,8 +453,7 @@ def test_two_separated_flagged_patches_give_two_closeups_each_outlined(tmp_path)
     from html.parser import HTMLParser
 
     write_obj(grid_mesh(12, bent=[(2, 2), (9, 9)]), tmp_path / "two.obj")
-    result = subprocess.run([sys.executable, "-m", "affinity.cli", "report", "-q", "two.obj", "-o", "out.html"],
-                            capture_output=True, text=True, cwd=tmp_path, timeout=300)
+    result = run("report", "-q", "two.obj", "-o", "out.html", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
 
     class Figures(HTMLParser):
@@ -590,9 +588,7 @@ def test_report_options_max_views_and_a_bad_texture(tmp_path):
     write_obj(grid_mesh(6, bent=[(1, 1), (4, 4)]), tmp_path / "two.obj")
 
     def report(*args):
-        return subprocess.run([sys.executable, "-m", "affinity.cli", "report", "-q", "two.obj", "-o", "out.html",
-                               *args],
-                              capture_output=True, text=True, cwd=tmp_path, timeout=300)
+        return run("report", "-q", "two.obj", "-o", "out.html", *args, cwd=tmp_path)
 
     done = report("--max-views", "1", "--size", "200x150", "--up", "z")
     assert done.returncode == 0, done.stderr

@@ -11,12 +11,11 @@ from __future__ import annotations
 import base64
 import io
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers.cli import run
 
 from affinity.loaders import load
 
@@ -44,8 +43,7 @@ def report_figures(mesh: Path, html: Path) -> list[dict]:
     """Run ``affinity report`` on ``mesh``; each close-up figure's data attributes and decoded panels."""
     from PIL import Image
 
-    done = subprocess.run([sys.executable, "-m", "affinity.cli", "report", "-q", str(mesh), "-o", str(html)],
-                          capture_output=True, text=True, timeout=600)
+    done = run("report", "-q", str(mesh), "-o", str(html))
     assert done.returncode == 0, done.stderr
     figures = []
     for match in FIGURE.finditer(html.read_text(encoding="utf-8")):

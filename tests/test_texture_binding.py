@@ -4,12 +4,11 @@ unit"): OBJ/MTL maps with -s/-o, USD UsdPreviewSurface, a MaterialX document ref
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers.cli import run
 
 from affinity.loaders import load
 from affinity.textures.binding import bound_textures, texel_grid
@@ -187,8 +186,7 @@ def test_obj_udim_scale_and_offset(tmp_path):
 
 
 def check(path: Path) -> dict:
-    result = subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--no-cache", "--format", "json",
-                             "--select", "Q101", str(path)], capture_output=True, text=True)
+    result = run("check", "--no-cache", "--format", "json", "--select", "Q101", str(path))
     assert result.returncode in (0, 1), result.stderr
     return json.loads(result.stdout)
 
@@ -231,11 +229,10 @@ def test_the_result_cache_follows_usd_and_materialx_textures(tmp_path):
     assert [Path(p).name for p in named_files(str(stage))] == ["paint.1001.png", "paint.1002.png"]
     assert [Path(p).name for p in named_files(str(tmp_path / "look.mtlx"))] == ["wood_base.png",
                                                                                   "wood_normal.png"]
-    env = {**__import__("os").environ, "AFFINITY_CACHE_DIR": str(tmp_path / "cache")}
-
     def value() -> float:
-        result = subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--format", "json", "--select",
-                                 "Q101", str(stage)], capture_output=True, text=True, env=env)
+        with pytest.MonkeyPatch.context() as patch:
+            patch.setenv("AFFINITY_CACHE_DIR", str(tmp_path / "cache"))
+            result = run("check", "--format", "json", "--select", "Q101", str(stage))
         return json.loads(result.stdout)["findings"][0]["value"]
 
     assert value() == pytest.approx(0.0, abs=0.01)  # a flat tile hides the crease
