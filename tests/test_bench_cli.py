@@ -9,6 +9,8 @@ from helpers.cli import run
 from affinity.study.run import CHART_NAMES, CSV_NAME, SUMMARY_NAME
 from affinity.study.sweep import COLUMNS, PLAIN_METHODS
 
+pytestmark = pytest.mark.slow  # a benchmark run
+
 
 def bench(*args):
     return run("bench", *args)

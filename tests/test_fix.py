@@ -57,6 +57,7 @@ def sampled_split_error(positions: np.ndarray, uv: np.ndarray, n: int, samples: 
     return worst
 
 
+@pytest.mark.slow  # dense sampling of every piece
 @pytest.mark.parametrize(("n", "issue_texels"), [(1, 175.7), (2, 51.7), (4, 14.3), (8, 3.77), (16, 0.97)])
 def test_pieces_of_the_demo_trapezoid_fall_as_the_issue_states(n, issue_texels):
     from affinity.fix.plan import piece_scores

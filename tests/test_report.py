@@ -135,6 +135,7 @@ def demo(tmp_path_factory) -> tuple[subprocess.CompletedProcess, Path]:
     return result, folder / "report.html"
 
 
+@pytest.mark.slow  # the demo report in a process of its own
 def test_demo_report_builds_with_every_scene(demo):
     result, path = demo
     assert result.returncode == 0, result.stderr
@@ -165,6 +166,7 @@ def test_demo_report_builds_with_every_scene(demo):
     assert "trapezoid front" in study.text() and "sphere 100x40 pole" in study.text()
 
 
+@pytest.mark.slow  # the demo report in a process of its own
 def test_demo_report_prints_the_commands_run_time_and_its_parts(demo):
     """The run time on the page is the command's (the issue: a page said 2.4 s of a 30.5 s command): at
     most the process's wall time seen from outside, at least most of it (the interpreter's start and exit
@@ -186,6 +188,7 @@ def test_demo_report_prints_the_commands_run_time_and_its_parts(demo):
     assert sum(map(float, parts.values())) == pytest.approx(printed, abs=0.05 + 0.1 * printed)
 
 
+@pytest.mark.slow  # the demo report in a process of its own
 def test_demo_report_references_nothing_outside_itself(demo):
     _, path = demo
     doc = parse(path)

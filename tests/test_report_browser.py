@@ -16,7 +16,8 @@ from helpers.chromium import CHROMIUM, DevTools
 from helpers.cli import run
 from helpers.corpus import SHARED_MESHES
 
-pytestmark = pytest.mark.skipif(CHROMIUM is None, reason="no chromium installed")
+pytestmark = [pytest.mark.skipif(CHROMIUM is None, reason="no chromium installed"),
+              pytest.mark.slow]  # a browser opens the report
 VIEWPORT = (1200, 2000)
 
 

@@ -15,6 +15,8 @@ from helpers.corpus import SHARED_MESHES
 from affinity.draw.shading import FLAG_COLOUR
 from affinity.rules import RULES
 
+pytestmark = pytest.mark.slow  # a report of every shared mesh
+
 MESHES = sorted(SHARED_MESHES.glob("*.obj")) if SHARED_MESHES.is_dir() else []
 #: Rules whose close-up shows a crease of the attribute (uv, colours), from the registry.
 CREASE_RULES = tuple(code for code, rule in RULES.items() if rule.scored and rule.attribute in ("texcoords", "colors"))

@@ -554,6 +554,7 @@ def test_the_car_with_up_z_is_seen_from_the_side():
 
 
 @needs_meshes
+@pytest.mark.slow  # a report of every shared mesh
 def test_every_shared_mesh_with_flags_gets_closeups():
     from affinity.pipeline.check import load_and_check
     from affinity.report.build import ReportOptions, collect_mesh
@@ -584,6 +585,7 @@ def test_a_pixel_is_stiff_where_the_catalogue_says_the_coordinates_are_ill_condi
     assert stiff.condition > STIFF_CONDITION and stiff.stiff
 
 
+@pytest.mark.slow  # several reports
 def test_report_options_max_views_and_a_bad_texture(tmp_path):
     write_obj(grid_mesh(6, bent=[(1, 1), (4, 4)]), tmp_path / "two.obj")
 

@@ -16,6 +16,8 @@ from affinity.loaders.objwriter import write_obj
 from affinity.mesh import mesh_from_polygons
 from affinity.rules import RULES
 
+pytestmark = pytest.mark.slow  # reports of shared meshes
+
 FOLD_RULES = tuple(code for code, rule in RULES.items() if rule.folding)
 #: A step of this many 1/255 is plainly visible (the uv and colour rules' visibility threshold).
 VISIBLE_STEP = 8

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from helpers.cli import run
 from helpers.quads import UNIT_UV, quad_obj, trapezoid
 
@@ -45,6 +46,7 @@ def test_piled_up_distinct_quads_stay_within_the_budget_and_flagged_ones_are_dra
     assert np.allclose(layout.image[40, 20], OVERLAY_TINT)  # drawn over the others
 
 
+@pytest.mark.slow  # two reports of 576 flagged faces
 def test_place_faces_caps_every_closeup_and_no_two_share_a_face(tmp_path):
     """``--place-faces``: one connected group of 576 flagged faces is cut into places of at most N faces. The
     defect grows with y (a part repeating another's value within a tenth gets no close-up of its own)."""

@@ -20,7 +20,8 @@ from helpers.chromium import CHROMIUM, WEBGL_FLAGS, DevTools, evaluate, open_pag
 from helpers.cli import run
 from helpers.corpus import SHARED_MESHES
 
-pytestmark = pytest.mark.skipif(CHROMIUM is None, reason="no chromium installed")
+pytestmark = [pytest.mark.skipif(CHROMIUM is None, reason="no chromium installed"),
+              pytest.mark.slow]  # a browser draws the 3-D view of reports of the shared meshes
 
 SPOT = SHARED_MESHES / "textured" / "spot_control_mesh_textured.obj"
 MAKEHUMAN = SHARED_MESHES / "makehuman_base_hm08.obj"

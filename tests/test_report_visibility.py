@@ -19,6 +19,8 @@ from helpers.cli import run
 
 from affinity.loaders import load
 
+pytestmark = pytest.mark.slow  # a report of every shared mesh
+
 #: The pixels a close-up's place and its worst face must each cover, and the share of a uv / colour close-up
 #: where split and exact differ.
 PLACE_PIXELS = 300

@@ -16,7 +16,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-pytestmark = pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="finds processes in /proc (Linux)")
+pytestmark = [pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="finds processes in /proc (Linux)"),
+              pytest.mark.slow]  # signals sent to running processes, and waits for them
 
 #: Quads a side of the test mesh: 90,000 disaffine quads, a 7 MB JSON output that takes a second or more.
 SIDE = 300

@@ -77,6 +77,7 @@ def test_render_falls_back_to_the_checker_with_a_warning(two_meshes, tmp_path):
     assert (tmp_path / "out.png").exists()
 
 
+@pytest.mark.slow  # a report in a process of its own under a memory limit
 def test_one_huge_texture_never_loses_the_other_mesh_of_a_report(two_meshes, tmp_path):
     """The report of both meshes is written, each mesh in it; the huge one's close-ups draw the line pattern
     and say why, and the process stays far from what decoding 10^10 pixels would take."""

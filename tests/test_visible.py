@@ -103,6 +103,7 @@ def check_json(*args) -> dict:
     return json.loads(result.stdout)
 
 
+@pytest.mark.slow  # a dense reading of Spot's texture
 @pytest.mark.skipif(not SPOT.exists(), reason="../shared/meshes/textured is not in this checkout")
 def test_spot_c_matches_a_dense_independent_reading():
     """Every Q101 finding on Spot with its own texture: C within 1/255 of the dense reading, or a correct
