@@ -8,7 +8,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from helpers.cli import run
 from helpers.closeup_panels import Closeups, decode_panel
 from helpers.corpus import SHARED_MESHES
 
@@ -52,13 +51,12 @@ def _reversed_copy(source: Path, folder: Path) -> Path:
 
 @pytest.mark.parametrize("mesh", [*MESHES, "reversed spot_control_mesh.obj"],
                          ids=lambda mesh: getattr(mesh, "name", mesh))
-def test_closeups_show_a_crease_at_least_3_pixels_across(mesh, tmp_path):
+def test_closeups_show_a_crease_at_least_3_pixels_across(mesh, tmp_path, report_of):
     if not MESHES:
         pytest.skip("../shared/meshes is absent")
     if isinstance(mesh, str):
         mesh = _reversed_copy(SHARED_MESHES / "spot_control_mesh.obj", tmp_path)
-    report = tmp_path / "report.html"
-    built = run("report", "-q", str(mesh), "-o", str(report))
+    built, report = report_of(mesh)
     assert built.returncode == 0, built.stderr
     parser = Closeups()
     parser.feed(report.read_text(encoding="utf-8"))
