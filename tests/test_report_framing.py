@@ -38,7 +38,6 @@ def test_the_car_lies_on_z_and_the_figure_stands_on_y(shared_meshes):
 
 
 def test_help_says_the_default_guesses():
-
     for command in ("render", "report"):
         done = run(command, "--help")
         assert "guessed" in " ".join(done.stdout.split()), command

@@ -236,7 +236,6 @@ def test_committed_table_is_current(rows64):
 
 def test_reading_a_committed_table_needs_no_mpmath(tmp_path):
     """The report reads stability.csv; mpmath is for computing references, not for reading rows."""
-
     from affinity.stability import table
 
     row = Row("needle", "needles", "mean_value", False, "float64", 3, 1e-17, 1e-14, 1e-3, 0.0, 0.0, 0.0, "pass")
