@@ -67,9 +67,13 @@ SPAWNS_ITS_OWN_PROCESS = {
     "test_blender.py": "the check runs beside Blender's own Python",
     "test_broken_inputs.py": "a link to the process's own stdout, read as bytes",
     "test_cluster.py": "a Dask cluster and the environment it is named by",
+    "test_farm.py": "journals that survive a killed run",
     "test_fuzz.py": "a time limit on each batch of mutated files",
+    "test_huge_values.py": "the interpreter's own -W error",
+    "test_merge_untrusted.py": "a time limit on reads that would block",
     "test_pathological_inputs.py": "a time limit on reads that would block",
     "test_signals.py": "signals sent to the running command",
+    "test_worker_loss.py": "-j worker processes that die",
 }
 
 
