@@ -1,6 +1,6 @@
 """What the whole suite shares as fixtures: the real meshes of ../shared/meshes (``helpers.corpus``), and a
 temporary result cache, a cache run an hour after the test wrote its files, a count of the files
-really checked. Shared functions and constants live in ``tests/helpers/``.
+really checked, the report of a mesh built once a session. Shared functions and constants live in ``tests/helpers/``.
 
 Tests take the ``shared_meshes`` fixture (the folder) or a ``manifest_entry``
 argument (parametrized over MANIFEST.json). Without the folder those tests skip,
@@ -15,6 +15,7 @@ from pathlib import Path
 from types import SimpleNamespace
 
 import pytest
+from helpers.cli import run
 from helpers.corpus import ABSENT, MANIFEST, SHARED_MESHES, manifest_entries
 
 
@@ -37,6 +38,22 @@ def pytest_generate_tests(metafunc):
 def pytest_terminal_summary(terminalreporter):
     if not MANIFEST.is_file():
         terminalreporter.write_line(ABSENT)
+
+
+@pytest.fixture(scope="session")
+def report_of(tmp_path_factory):
+    """``affinity report -q MESH -o PAGE`` with the default options, run once a session for each mesh (the
+    modules that read a shared mesh's close-ups read the same page): ``report_of(mesh)`` -> (the run's
+    result, the page's path). The page is for reading only."""
+    built: dict[Path, tuple] = {}
+
+    def report(mesh: Path) -> tuple:
+        if mesh not in built:
+            page = tmp_path_factory.mktemp("report") / "report.html"
+            built[mesh] = run("report", "-q", str(mesh), "-o", str(page)), page
+        return built[mesh]
+
+    return report
 
 
 @pytest.fixture(autouse=True, scope="session")
@@ -79,3 +96,18 @@ def counting(monkeypatch) -> Counting:
     counter = Counting(check_module.check_file)
     monkeypatch.setattr(check_module, "check_file", counter)
     return counter
+
+
+@pytest.fixture(scope="module")
+def big_meshes(tmp_path_factory) -> Path:
+    """Sixteen copies of the grid (copies, not links: a file under two names is checked once): work for two
+    workers for a few seconds (a 90,000-quad grid takes some 0.1 s to check)."""
+    import shutil
+
+    from helpers.processes import write_grid
+
+    folder = tmp_path_factory.mktemp("big")
+    write_grid(folder / "grid0.obj")
+    for copy in range(1, 16):
+        shutil.copyfile(folder / "grid0.obj", folder / f"grid{copy}.obj")
+    return folder

@@ -2,18 +2,18 @@
 
 import csv
 import math
-import subprocess
-import sys
 
 import pytest
+from helpers.cli import run
 
 from affinity.study.run import CHART_NAMES, CSV_NAME, SUMMARY_NAME
 from affinity.study.sweep import COLUMNS, PLAIN_METHODS
 
+pytestmark = pytest.mark.slow  # a benchmark run
+
 
 def bench(*args):
-    return subprocess.run([sys.executable, "-m", "affinity.cli", "bench", *args], capture_output=True, text=True,
-                          timeout=120, check=False)
+    return run("bench", *args)
 
 
 @pytest.fixture(scope="module")

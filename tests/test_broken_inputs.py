@@ -1,7 +1,7 @@
 """Issue 17 as a user meets it: broken files, skipped files and outputs that must not be destroyed.
 
-Every command runs in a subprocess (exit code, stdout, stderr); FIFOs, links
-and device nodes are made in tmp_path.
+Every command runs as ``helpers.cli.run`` runs it (exit code, stdout, stderr: file descriptors 1
+and 2 are pipes); FIFOs, links and device nodes are made in tmp_path.
 """
 
 from __future__ import annotations

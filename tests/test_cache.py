@@ -5,7 +5,6 @@ from __future__ import annotations
 import os
 import sqlite3
 import struct
-import subprocess
 import sys
 from pathlib import Path
 
@@ -195,9 +194,9 @@ def write_assets_dir(tmp_path: Path) -> Path:
 
 
 def check_with_cache(folder: Path, cache_dir: Path | str, *extra: str):
-    env = {**os.environ, "AFFINITY_CACHE_DIR": str(cache_dir)}
-    return subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--verbose", *extra, "."],
-                          capture_output=True, text=True, cwd=folder, env=env, timeout=120)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("AFFINITY_CACHE_DIR", str(cache_dir))
+        return run("check", "--verbose", *extra, ".", cwd=folder)
 
 
 def test_second_run_gives_identical_output(tmp_path):

@@ -7,7 +7,6 @@ import os
 import shutil
 import sqlite3
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -149,9 +148,9 @@ def test_a_non_blob_report_as_a_user_meets_it(library, tmp_path):
 
 
 def run_cached(folder: Path, cache: Path) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--format", "json", str(folder)],
-                          capture_output=True, text=True, timeout=120,
-                          env={**os.environ, "AFFINITY_CACHE_DIR": str(cache)})
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("AFFINITY_CACHE_DIR", str(cache))
+        return run("check", "--format", "json", str(folder))
 
 
 def test_files_of_other_layouts_and_set_aside_ones_go_after_a_month(filled, library, capsys):

@@ -1,4 +1,4 @@
-"""`affinity check` as a user runs it: a subprocess, its exit code, stdout and stderr."""
+"""`affinity check` as a user runs it: its exit code, stdout and stderr (``helpers.cli.run``)."""
 
 from __future__ import annotations
 

@@ -22,6 +22,7 @@ from affinity.pipeline.check import check_file, check_files
 from affinity.settings import Settings
 
 pytest.importorskip("distributed")
+pytestmark = pytest.mark.slow  # a Dask cluster of worker processes
 
 
 @pytest.fixture(scope="module")

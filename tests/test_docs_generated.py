@@ -127,6 +127,7 @@ def table_shape(text: str) -> tuple[str, int]:
     return rows[0], rows[1].count("|") - 1
 
 
+@pytest.mark.slow  # every benchmark script, each in processes of its own
 @pytest.mark.parametrize("stem", sorted({b[1] for b in generated_blocks()}))
 def test_every_generating_script_runs_small(stem, tmp_path):
     script = ROOT / "benchmarks" / f"{stem}.py"

@@ -12,6 +12,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from helpers.corpus import shared_mesh_paths
+from helpers.fixing import (
+    edge_map_agrees,
+    grid_with_one_flagged_quad,
+)
 
 from affinity.fix import FixSettings, apply_fix, plan_fix, refine_mesh
 from affinity.lint import lint_mesh
@@ -57,6 +61,7 @@ def sampled_split_error(positions: np.ndarray, uv: np.ndarray, n: int, samples: 
     return worst
 
 
+@pytest.mark.slow  # dense sampling of every piece
 @pytest.mark.parametrize(("n", "issue_texels"), [(1, 175.7), (2, 51.7), (4, 14.3), (8, 3.77), (16, 0.97)])
 def test_pieces_of_the_demo_trapezoid_fall_as_the_issue_states(n, issue_texels):
     from affinity.fix.plan import piece_scores
@@ -122,23 +127,6 @@ def test_new_vertices_and_values_lie_on_the_quads_bilinear_surface():
     assert not [h for h in lint_mesh(fixed, Settings()) if h.code in SCORED]
 
 
-def grid_with_one_flagged_quad(size: int = 5) -> tuple[Mesh, int]:
-    """A flat size x size grid whose uv is the positions scaled, but the middle quad carries a
-    trapezoid of uv of its own (a uv seam around it): only that quad is flagged."""
-    xs = np.arange(size + 1, dtype=float)
-    X, Y = np.meshgrid(xs, xs)
-    positions = np.stack([X.ravel(), Y.ravel(), np.zeros(X.size)], axis=1)
-    faces = np.array([[j * (size + 1) + i, j * (size + 1) + i + 1, (j + 1) * (size + 1) + i + 1,
-                       (j + 1) * (size + 1) + i] for j in range(size) for i in range(size)])
-    middle = (size // 2) * size + size // 2
-    mesh = mesh_from_polygons("grid", positions, faces, texcoords=positions[:, :2] / size)
-    texcoords = np.vstack([mesh.texcoords, [[0.40, 0.40], [0.60, 0.40], [0.57, 0.6], [0.43, 0.6]]])
-    corner_texcoord = mesh.corner_texcoord.copy()
-    corner_texcoord[4 * middle : 4 * middle + 4] = len(mesh.texcoords) + np.arange(4)
-    mesh.texcoords, mesh.corner_texcoord = texcoords, corner_texcoord
-    return mesh, middle
-
-
 def test_a_grid_with_one_flagged_quad_becomes_quads_only_and_its_neighbours_close_to_it():
     mesh, middle = grid_with_one_flagged_quad()
     assert [(h.code, h.faces.tolist()) for h in lint_mesh(mesh, Settings())] == [("Q101", [middle])]
@@ -163,49 +151,6 @@ def test_a_grid_with_one_flagged_quad_becomes_quads_only_and_its_neighbours_clos
     assert (signed > 0).all() and signed.sum() == pytest.approx(25.0, rel=1e-12)  # none folded over another
     assert not lint_mesh(fixed, Settings())
     edge_map_agrees(mesh, fixed)
-
-
-def welded(mesh: Mesh) -> np.ndarray:
-    return np.unique(mesh.positions, axis=0, return_inverse=True)[1].reshape(-1)
-
-
-def edges_by_multiplicity(mesh: Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Undirected edges between distinct positions: ends (E, 2) welded ids, faces sharing each (E,),
-    and the positions (E, 2, 3)."""
-    ids = welded(mesh)[mesh.corner_vertex]
-    following = np.arange(len(ids)) + 1
-    face_of = np.repeat(np.arange(mesh.n_faces), mesh.face_sizes)
-    last = following == mesh.face_start[face_of + 1]
-    following[last] = mesh.face_start[face_of[last]]
-    pairs = np.sort(np.stack([ids, ids[following]], axis=1), axis=1)
-    ends_at = np.stack([mesh.corner_vertex, mesh.corner_vertex[following]], axis=1)
-    keep = pairs[:, 0] != pairs[:, 1]
-    edges, first, count = np.unique(pairs[keep], axis=0, return_index=True, return_counts=True)
-    return edges, count, mesh.positions[ends_at[keep][first]]
-
-
-def edge_map_agrees(before: Mesh, after: Mesh) -> None:
-    """No T-junction: for every number of faces k other than 2, the output's edges shared by k faces
-    cover exactly the input's (same total length, each lying on an input edge of the same k); edges
-    inside an input face are shared by 2."""
-    _, count_in, ends_in = edges_by_multiplicity(before)
-    _, count_out, ends_out = edges_by_multiplicity(after)
-    length_in = np.linalg.norm(ends_in[:, 1] - ends_in[:, 0], axis=1)
-    length_out = np.linalg.norm(ends_out[:, 1] - ends_out[:, 0], axis=1)
-    for k in sorted(set(count_in.tolist()) | set(count_out.tolist()) - {2}):
-        if k == 2:
-            continue
-        assert length_out[count_out == k].sum() == pytest.approx(length_in[count_in == k].sum(), rel=1e-9), k
-        a, b = ends_in[count_in == k, 0], ends_in[count_in == k, 1]
-        for p, q in ends_out[count_out == k][:200]:
-            on_segment = [distance_to_segments(x, a, b) < 1e-9 * (1 + np.abs(x).max()) for x in (p, q)]
-            assert (on_segment[0] & on_segment[1]).any(), (k, p, q)
-
-
-def distance_to_segments(x: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    d = b - a
-    t = np.clip(np.einsum("ij,ij->i", x - a, d) / np.einsum("ij,ij->i", d, d), 0, 1)
-    return np.linalg.norm(a + t[:, None] * d - x, axis=1)
 
 
 FLAGGED_SHARED = [p for p in shared_mesh_paths("*.obj") if p.name != "gen_spot_cc4.obj"]

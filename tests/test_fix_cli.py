@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from helpers.cli import SQUARE, TRAPEZOID, run, write
 from helpers.corpus import shared_mesh_paths
+from helpers.fixing import local_copy
 
 from affinity.fix import FixSettings, apply_fix, plan_fix, refine_mesh
 from affinity.loaders import load
@@ -23,14 +24,6 @@ def check_json(path) -> dict:
     result = run("check", "--format", "json", "--isolated", str(path))
     assert result.returncode in (0, 1), result.stderr
     return json.loads(result.stdout)
-
-
-def local_copy(path, folder):
-    """``path`` copied into ``folder`` with the MTL and PNG files beside it; the copy's path."""
-    for sibling in path.parent.glob("*"):
-        if sibling.suffix in (".mtl", ".png") or sibling == path:
-            shutil.copy(sibling, folder / sibling.name)
-    return folder / path.name
 
 
 def findings_of(path) -> list[dict]:

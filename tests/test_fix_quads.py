@@ -15,8 +15,7 @@ import numpy as np
 import pytest
 from helpers.cli import TRAPEZOID, run, write
 from helpers.corpus import shared_mesh_paths
-from test_fix import edge_map_agrees, grid_with_one_flagged_quad
-from test_fix_cli import local_copy
+from helpers.fixing import edge_map_agrees, grid_with_one_flagged_quad, local_copy
 
 from affinity.fix import FixSettings, plan_fix, refine_mesh
 from affinity.fix.patterns import SQUARE, quad_pattern

@@ -87,8 +87,8 @@ def test_the_fix_of_a_mesh_two_prims_compose_is_written_once_and_both_read_it(tm
 def test_the_validators_fixer_writes_the_same_layer_as_affinity_fix(tmp_path):
     """RefineQuads through the same code: the override layer it edits holds one points spec, and the composed
     meshes equal those of ``affinity fix``'s layer."""
+    from helpers.usd_validation import validate
     from pxr import Usd, UsdGeom
-    from test_usd_validators import validate
 
     studio_asset(tmp_path)
     assert run("fix", "set.usda", cwd=tmp_path).returncode == 0

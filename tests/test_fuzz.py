@@ -30,6 +30,7 @@ from collections import Counter
 from pathlib import Path
 
 import numpy as np
+import pytest
 from helpers.fuzzing import MUTATIONS, Hang, check_once, mutated_files, seed_files, time_limit
 from helpers.generated_obj import FIELDS
 
@@ -38,6 +39,8 @@ from affinity.lint import lint_mesh
 from affinity.loaders import load
 from affinity.loaders.obj import load_obj
 from affinity.settings import Settings
+
+pytestmark = pytest.mark.slow  # a fuzz budget of hundreds of mutated files
 
 FUZZ_FILES = int(os.environ.get("AFFINITY_FUZZ_FILES", "600"))
 FUZZ_SEED = int(os.environ.get("AFFINITY_FUZZ_SEED", "17"))

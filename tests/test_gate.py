@@ -1,7 +1,7 @@
 """`affinity check` as a gate (issue 18): levels and --fail-on, the fold angle, bounded output,
 no silent switches, where a finding is, missing resources, and walking a repository.
 
-Every test runs the command line (a subprocess) and looks at the exit code and the output.
+Every test runs the command line (``helpers.cli.run``) and looks at the exit code and the output.
 """
 
 from __future__ import annotations

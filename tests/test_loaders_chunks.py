@@ -11,6 +11,7 @@ which shares no code with the loader.
 import random
 
 import numpy as np
+import pytest
 from helpers.generated_obj import FIELDS, generate_obj
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -110,6 +111,7 @@ def assert_same_mesh(mesh, expected: dict, where: str) -> None:
     mesh.validate()
 
 
+@pytest.mark.slow  # 30 generated files, each read at every chunk size
 @settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(seed=st.integers(0, 2**32 - 1))
 def test_chunk_size_never_changes_the_mesh(tmp_path, seed):

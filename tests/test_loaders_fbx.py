@@ -14,8 +14,6 @@ import ctypes
 import json
 import os
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -154,13 +152,12 @@ def test_uv_primvar_picks_a_uv_set_by_its_fbx_name():
     assert document["files"][0]["notes"] == ["no mesh has the uv set 'Nope': texture coordinates not checked"]
 
 
-def test_the_result_cache_tells_uv_sets_apart(tmp_path):
-    path, cache = DATA / "spot_two_uv_sets.fbx", {"AFFINITY_CACHE_DIR": str(tmp_path)}
-    env = {**os.environ, **cache}
+def test_the_result_cache_tells_uv_sets_apart(tmp_path, monkeypatch):
+    path = DATA / "spot_two_uv_sets.fbx"
+    monkeypatch.setenv("AFFINITY_CACHE_DIR", str(tmp_path))
     counts = []
     for extra in ([], ["--uv-primvar", "Planar"], []):
-        result = subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--isolated", "--format", "json",
-                                 *extra, str(path)], capture_output=True, text=True, env=env, check=False)
+        result = run("check", "--isolated", "--format", "json", *extra, str(path))
         counts.append(sum(f["code"] == "Q302" for f in json.loads(result.stdout)["findings"]))
     assert counts[0] == counts[2] == 3 and counts[1] > 3
 
@@ -301,17 +298,16 @@ def test_a_scene_without_a_mesh_is_skipped_as_a_usd_look_layer_is(tmp_path):
     assert result.returncode == 0 and result.stderr.splitlines() == [f"{path}: skipped (no-mesh)"]
 
 
-def test_the_result_cache_sees_a_texture_the_fbx_file_names_change(tmp_path):
+def test_the_result_cache_sees_a_texture_the_fbx_file_names_change(tmp_path, monkeypatch):
     from PIL import Image
 
     shutil.copytree(DATA / "spot_textured_external.fbm", tmp_path / "spot_textured_external.fbm")
     path = tmp_path / "spot.fbx"
     shutil.copy(DATA / "spot_textured_external.fbx", path)
-    env = {**os.environ, "AFFINITY_CACHE_DIR": str(tmp_path / "cache")}
+    monkeypatch.setenv("AFFINITY_CACHE_DIR", str(tmp_path / "cache"))
 
     def errors() -> int:
-        result = subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--isolated", "--select", "Q101",
-                                 "--format", "json", str(path)], capture_output=True, text=True, env=env, check=False)
+        result = run("check", "--isolated", "--select", "Q101", "--format", "json", str(path))
         return sum(f["level"] == "error" for f in json.loads(result.stdout)["findings"])
 
     assert errors() > 0
@@ -324,11 +320,11 @@ def test_the_result_cache_sees_a_texture_the_fbx_file_names_change(tmp_path):
 def test_an_embedded_image_is_the_mesh_s_texture_for_drawing_too(tmp_path, shared_meshes):
     from PIL import Image
 
-    from affinity.draw.texture import load_image
+    from affinity.draw.texture import load_image, painted_texture
 
     shutil.copy(DATA / "spot_textured_embedded.fbx", tmp_path / "spot.fbx")
     mesh = load(tmp_path / "spot.fbx")
-    path = mesh.texture_path()
+    path = painted_texture(mesh)
     assert path == f"{tmp_path / 'spot.fbx'}#spot_textured_embedded.fbm/spot_texture.png" and not os.path.exists(path)
     drawn = load_image(path)
     with Image.open(shared_meshes / "textured" / "spot_texture.png") as image:

@@ -81,6 +81,7 @@ def test_fixtures_read_alike_on_both_paths(path):
     assert assert_same_outcome(path, chunk_bytes=61) == "mesh"
 
 
+@pytest.mark.slow  # a fuzz budget
 def test_fuzzed_files_read_or_fail_alike_on_both_paths(tmp_path):
     rng = random.Random(39)
     obj_seeds = [(suffix, data) for suffix, data in seed_files(rng) if suffix == ".obj"]

@@ -25,6 +25,7 @@ def in_random_plane(rng, xy):
     return np.column_stack([xy, np.zeros(4)]) @ random_plane_frame(rng) + rng.normal(size=3) * 3
 
 
+@pytest.mark.slow  # dense sampling of random quads
 def test_equals_the_sampled_supremum_on_random_convex_planar_quads():
     rng = np.random.default_rng(11)
     for _ in range(25):

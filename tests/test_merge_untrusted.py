@@ -75,7 +75,7 @@ def test_materialx_read_refuses_a_fifo(tmp_path):
     that is a FIFO with no writer: it finishes (no texture read from it) instead of blocking; in a subprocess,
     so a regression fails on the timeout rather than hanging the suite."""
     pytest.importorskip("pxr")
-    from test_texture_binding import looks, usd_quads
+    from helpers.usd_stages import looks, usd_quads
 
     os.mkfifo(tmp_path / "look.mtlx")
     material = '    def Material "Mx" (\n        references = @look.mtlx@</MaterialX/Materials/M>\n    )\n    {}\n'

@@ -23,6 +23,8 @@ from affinity.errors import MeshError, SkippedFile
 from affinity.loaders import load, text
 from affinity.loaders.regular import RefusedFile, open_regular, read_regular
 
+pytestmark = pytest.mark.slow  # each command in a process of its own with a time limit, on big and blocking files
+
 requires_usd = pytest.mark.skipif(importlib.util.find_spec("pxr") is None, reason="needs the usd extra (usd-core)")
 requires_dev_zero = pytest.mark.skipif(not os.path.exists("/dev/zero"), reason="needs /dev/zero")
 

@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 import subprocess
-import sys
 
 import numpy as np
 import pytest
+from helpers.cli import run as run_affinity
 from PIL import Image
 
 from affinity.draw.drawing import RenderOptions, render_mesh
@@ -15,8 +15,7 @@ from affinity.scenes import color_squares, latlong_sphere, trapezoid
 
 
 def run(*args: str, cwd=None) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "affinity.cli", "render", *args],
-                          capture_output=True, text=True, cwd=cwd, timeout=300)
+    return run_affinity("render", *args, cwd=cwd)
 
 
 def test_demo_render_with_no_mesh(tmp_path):

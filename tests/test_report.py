@@ -13,14 +13,13 @@ import json
 import math
 import os
 import subprocess
-import sys
 import time
 from html.parser import HTMLParser
 from pathlib import Path
 
 import numpy as np
 import pytest
-from helpers.cli import run, write
+from helpers.cli import run, run_process, write
 from helpers.quads import trapezoids
 
 from affinity.loaders.objwriter import write_obj
@@ -32,8 +31,7 @@ VOID_ELEMENTS = frozenset({"area", "base", "br", "col", "embed", "hr", "img", "i
 
 
 def run_report(*args: str, cwd: Path) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "affinity.cli", "report", *args],
-                          capture_output=True, text=True, cwd=cwd, timeout=300)
+    return run("report", *args, cwd=cwd)
 
 
 class Node:
@@ -128,14 +126,16 @@ def image_alts(node: Node) -> list[str]:
 @pytest.fixture(scope="module")
 def demo(tmp_path_factory) -> tuple[subprocess.CompletedProcess, Path]:
     """The demo report, written with no arguments at all: the built-in scenes into ./report.html.
-    ``result.wall`` is the process's wall time, seconds, measured from outside."""
+    ``result.wall`` is the process's wall time, seconds, measured from outside (a process of its own: the
+    page's run time is the command's, start-up included)."""
     folder = tmp_path_factory.mktemp("demo")
     start = time.perf_counter()
-    result = run_report(cwd=folder)
+    result = run_process("report", cwd=folder)
     result.wall = time.perf_counter() - start
     return result, folder / "report.html"
 
 
+@pytest.mark.slow  # the demo report in a process of its own
 def test_demo_report_builds_with_every_scene(demo):
     result, path = demo
     assert result.returncode == 0, result.stderr
@@ -166,6 +166,7 @@ def test_demo_report_builds_with_every_scene(demo):
     assert "trapezoid front" in study.text() and "sphere 100x40 pole" in study.text()
 
 
+@pytest.mark.slow  # the demo report in a process of its own
 def test_demo_report_prints_the_commands_run_time_and_its_parts(demo):
     """The run time on the page is the command's (the issue: a page said 2.4 s of a 30.5 s command): at
     most the process's wall time seen from outside, at least most of it (the interpreter's start and exit
@@ -187,6 +188,7 @@ def test_demo_report_prints_the_commands_run_time_and_its_parts(demo):
     assert sum(map(float, parts.values())) == pytest.approx(printed, abs=0.05 + 0.1 * printed)
 
 
+@pytest.mark.slow  # the demo report in a process of its own
 def test_demo_report_references_nothing_outside_itself(demo):
     _, path = demo
     doc = parse(path)
@@ -419,8 +421,7 @@ def test_view_screenshot_outlines_the_flagged_quads(tmp_path):
     from affinity.scenes import demo_paths
 
     out = tmp_path / "view.png"
-    result = subprocess.run([sys.executable, "-m", "affinity.cli", "view", demo_paths()[0], "--screenshot", str(out)],
-                            capture_output=True, text=True, timeout=300)
+    result = run("view", demo_paths()[0], "--screenshot", str(out))
     assert result.returncode == 0, result.stderr
     pixels = np.asarray(Image.open(out).convert("RGB")).reshape(-1, 3).astype(int)
     flag = np.array([int(FLAG_COLOUR[i:i + 2], 16) for i in (1, 3, 5)])

@@ -9,15 +9,15 @@ from __future__ import annotations
 import base64
 import io
 import json
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 from helpers.chromium import CHROMIUM, DevTools
+from helpers.cli import run
 from helpers.corpus import SHARED_MESHES
 
-pytestmark = pytest.mark.skipif(CHROMIUM is None, reason="no chromium installed")
+pytestmark = [pytest.mark.skipif(CHROMIUM is None, reason="no chromium installed"),
+              pytest.mark.slow]  # a browser opens the report
 VIEWPORT = (1200, 2000)
 
 
@@ -26,8 +26,7 @@ def loaded_report(tmp_path_factory):
     """The demo report opened in Chromium: (devtools, page session, report path)."""
     folder = tmp_path_factory.mktemp("browser")
     report = folder / "report.html"
-    built = subprocess.run([sys.executable, "-m", "affinity.cli", "report", "-q", "-o", str(report)],
-                           capture_output=True, text=True, timeout=300)
+    built = run("report", "-q", "-o", str(report))
     assert built.returncode == 0, built.stderr
     browser = DevTools(folder / "profile")
     try:
@@ -114,11 +113,9 @@ def makehuman_report(tmp_path_factory):
         pytest.skip("../shared/meshes is absent")
     folder = tmp_path_factory.mktemp("makehuman")
     report = folder / "report.html"
-    built = subprocess.run([sys.executable, "-m", "affinity.cli", "report", "-q", str(MAKEHUMAN), "-o", str(report)],
-                           capture_output=True, text=True, timeout=600)
+    built = run("report", "-q", str(MAKEHUMAN), "-o", str(report))
     assert built.returncode == 0, built.stderr
-    lint = subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--format", "json", str(MAKEHUMAN)],
-                          capture_output=True, text=True, timeout=300)
+    lint = run("check", "--format", "json", str(MAKEHUMAN))
     findings = json.loads(lint.stdout)["findings"]
     browser = DevTools(folder / "profile")
     try:

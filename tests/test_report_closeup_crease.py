@@ -4,8 +4,6 @@ reversed, each uv or colour close-up's split and exact panels differ by at least
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -15,6 +13,8 @@ from helpers.corpus import SHARED_MESHES
 
 from affinity.draw.shading import FLAG_COLOUR
 from affinity.rules import RULES
+
+pytestmark = pytest.mark.slow  # a report of every shared mesh
 
 MESHES = sorted(SHARED_MESHES.glob("*.obj")) if SHARED_MESHES.is_dir() else []
 #: Rules whose close-up shows a crease of the attribute (uv, colours), from the registry.
@@ -51,14 +51,12 @@ def _reversed_copy(source: Path, folder: Path) -> Path:
 
 @pytest.mark.parametrize("mesh", [*MESHES, "reversed spot_control_mesh.obj"],
                          ids=lambda mesh: getattr(mesh, "name", mesh))
-def test_closeups_show_a_crease_at_least_3_pixels_across(mesh, tmp_path):
+def test_closeups_show_a_crease_at_least_3_pixels_across(mesh, tmp_path, report_of):
     if not MESHES:
         pytest.skip("../shared/meshes is absent")
     if isinstance(mesh, str):
         mesh = _reversed_copy(SHARED_MESHES / "spot_control_mesh.obj", tmp_path)
-    report = tmp_path / "report.html"
-    built = subprocess.run([sys.executable, "-m", "affinity.cli", "report", "-q", str(mesh), "-o", str(report)],
-                           capture_output=True, text=True, timeout=600)
+    built, report = report_of(mesh)
     assert built.returncode == 0, built.stderr
     parser = Closeups()
     parser.feed(report.read_text(encoding="utf-8"))

@@ -3,11 +3,10 @@
 from __future__ import annotations
 
 import re
-import subprocess
-import sys
 
 import numpy as np
 import pytest
+from helpers.cli import run
 from helpers.corpus import ABSENT, SHARED_MESHES, shared_mesh_paths
 from helpers.quads import UNIT_UV, quad_obj, trapezoid
 
@@ -454,8 +453,7 @@ def test_two_separated_flagged_patches_give_two_closeups_each_outlined(tmp_path)
     from html.parser import HTMLParser
 
     write_obj(grid_mesh(12, bent=[(2, 2), (9, 9)]), tmp_path / "two.obj")
-    result = subprocess.run([sys.executable, "-m", "affinity.cli", "report", "-q", "two.obj", "-o", "out.html"],
-                            capture_output=True, text=True, cwd=tmp_path, timeout=300)
+    result = run("report", "-q", "two.obj", "-o", "out.html", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
 
     class Figures(HTMLParser):
@@ -556,6 +554,7 @@ def test_the_car_with_up_z_is_seen_from_the_side():
 
 
 @needs_meshes
+@pytest.mark.slow  # a report of every shared mesh
 def test_every_shared_mesh_with_flags_gets_closeups():
     from affinity.pipeline.check import load_and_check
     from affinity.report.build import ReportOptions, collect_mesh
@@ -586,13 +585,12 @@ def test_a_pixel_is_stiff_where_the_catalogue_says_the_coordinates_are_ill_condi
     assert stiff.condition > STIFF_CONDITION and stiff.stiff
 
 
+@pytest.mark.slow  # several reports
 def test_report_options_max_views_and_a_bad_texture(tmp_path):
     write_obj(grid_mesh(6, bent=[(1, 1), (4, 4)]), tmp_path / "two.obj")
 
     def report(*args):
-        return subprocess.run([sys.executable, "-m", "affinity.cli", "report", "-q", "two.obj", "-o", "out.html",
-                               *args],
-                              capture_output=True, text=True, cwd=tmp_path, timeout=300)
+        return run("report", "-q", "two.obj", "-o", "out.html", *args, cwd=tmp_path)
 
     done = report("--max-views", "1", "--size", "200x150", "--up", "z")
     assert done.returncode == 0, done.stderr

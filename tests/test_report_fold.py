@@ -4,11 +4,9 @@ Decoded from the panels (the synthetic fold) and from the page's own PNGs (the s
 
 from __future__ import annotations
 
-import subprocess
-import sys
-
 import numpy as np
 import pytest
+from helpers.cli import run
 from helpers.closeup_panels import Closeups, decode_panel
 from helpers.corpus import SHARED_MESHES
 
@@ -17,6 +15,8 @@ from affinity.draw.shading import FLAG_COLOUR
 from affinity.loaders.objwriter import write_obj
 from affinity.mesh import mesh_from_polygons
 from affinity.rules import RULES
+
+pytestmark = pytest.mark.slow  # reports of shared meshes
 
 FOLD_RULES = tuple(code for code, rule in RULES.items() if rule.folding)
 #: A step of this many 1/255 is plainly visible (the uv and colour rules' visibility threshold).
@@ -76,8 +76,7 @@ def test_every_fold_closeup_of_a_shared_mesh_shows_the_step(name, tmp_path):
     if not SHARED_MESHES.is_dir():
         pytest.skip("../shared/meshes is absent")
     report = tmp_path / "report.html"
-    built = subprocess.run([sys.executable, "-m", "affinity.cli", "report", "-q", str(SHARED_MESHES / name),
-                            "--max-views", "8", "-o", str(report)], capture_output=True, text=True, timeout=600)
+    built = run("report", "-q", str(SHARED_MESHES / name), "--max-views", "8", "-o", str(report))
     assert built.returncode == 0, built.stderr
     parser = Closeups()
     parser.feed(report.read_text(encoding="utf-8"))

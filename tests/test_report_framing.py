@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+from helpers.cli import run
 
 from affinity.loaders import load
 from affinity.mesh import mesh_from_polygons
@@ -37,10 +38,6 @@ def test_the_car_lies_on_z_and_the_figure_stands_on_y(shared_meshes):
 
 
 def test_help_says_the_default_guesses():
-    import subprocess
-    import sys
-
     for command in ("render", "report"):
-        done = subprocess.run([sys.executable, "-m", "affinity.cli", command, "--help"], capture_output=True,
-                              text=True, timeout=60)
+        done = run(command, "--help")
         assert "guessed" in " ".join(done.stdout.split()), command

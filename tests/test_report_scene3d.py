@@ -6,11 +6,10 @@ from __future__ import annotations
 import base64
 import io
 import json
-import subprocess
-import sys
 
 import numpy as np
 import pytest
+from helpers.cli import run
 from helpers.corpus import SHARED_MESHES
 
 from affinity.mesh import mesh_from_polygons
@@ -87,8 +86,7 @@ def test_view_data_rebuilds_spot_and_levels_agree_with_the_lint(tmp_path):
             continue
         np.testing.assert_allclose(drawn[:, 0], np.broadcast_to(polygon[0], drawn[:, 0].shape), atol=1e-6)
         np.testing.assert_allclose(np.concatenate([drawn[:1, 1], drawn[:, 2]]), polygon[1:], atol=1e-6)
-    lint = json.loads(subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--format", "json", str(SPOT)],
-                                     capture_output=True, text=True, timeout=120).stdout)
+    lint = json.loads(run("check", "--format", "json", str(SPOT)).stdout)
     order = ["error", "warning", "info"]
     worst = {}
     for finding in lint["findings"]:

@@ -9,29 +9,23 @@ from __future__ import annotations
 
 import json
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 from helpers.chromium import CHROMIUM, WEBGL_FLAGS, DevTools, evaluate, open_page
+from helpers.cli import run
 from helpers.usd_studio import studio_asset
 
 pytest.importorskip("pxr", reason="needs the usd extra (usd-core)")
-
-
-def _run(*args: str, cwd: Path) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "affinity.cli", *args], capture_output=True, text=True,
-                          timeout=600, cwd=cwd)
 
 
 @pytest.fixture(scope="module")
 def studio_report(tmp_path_factory) -> tuple[Path, dict]:
     folder = tmp_path_factory.mktemp("studio")
     studio_asset(folder)
-    built = _run("report", "-q", "set.usda", "-o", "report.html", cwd=folder)
+    built = run("report", "-q", "set.usda", "-o", "report.html", cwd=folder)
     assert built.returncode == 0, built.stderr
-    checked = _run("check", "--no-cache", "--isolated", "--format", "json", "set.usda", cwd=folder)
+    checked = run("check", "--no-cache", "--isolated", "--format", "json", "set.usda", cwd=folder)
     return folder / "report.html", json.loads(checked.stdout)
 
 
@@ -81,9 +75,9 @@ def test_a_report_over_the_stage_and_its_geometry_layer_gives_the_mesh_once(tmp_
     """As ``affinity check`` does over the same files: the set (two referencing prims) has the findings, the
     geometry layer none."""
     studio_asset(tmp_path)
-    built = _run("report", "-q", "set.usda", "assets/Piece/Piece_geom.usd", "-o", "report.html", cwd=tmp_path)
+    built = run("report", "-q", "set.usda", "assets/Piece/Piece_geom.usd", "-o", "report.html", cwd=tmp_path)
     assert built.returncode == 0, built.stderr
-    checked = json.loads(_run("check", "--no-cache", "--isolated", "--format", "json", "set.usda",
+    checked = json.loads(run("check", "--no-cache", "--isolated", "--format", "json", "set.usda",
                               "assets/Piece/Piece_geom.usd", cwd=tmp_path).stdout)
     assert {f["path"] for f in checked["findings"]} == {"set.usda"}
     page = (tmp_path / "report.html").read_text()

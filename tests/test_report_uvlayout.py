@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
+from helpers.cli import run
 from helpers.quads import UNIT_UV, quad_obj, trapezoid
 
 from affinity.loaders import load
@@ -44,12 +46,11 @@ def test_piled_up_distinct_quads_stay_within_the_budget_and_flagged_ones_are_dra
     assert np.allclose(layout.image[40, 20], OVERLAY_TINT)  # drawn over the others
 
 
+@pytest.mark.slow  # two reports of 576 flagged faces
 def test_place_faces_caps_every_closeup_and_no_two_share_a_face(tmp_path):
     """``--place-faces``: one connected group of 576 flagged faces is cut into places of at most N faces. The
     defect grows with y (a part repeating another's value within a tenth gets no close-up of its own)."""
     import re
-    import subprocess
-    import sys
 
     n = 24
     x, y = np.meshgrid(np.arange(n + 1.0), np.arange(n + 1.0))
@@ -62,8 +63,7 @@ def test_place_faces_caps_every_closeup_and_no_two_share_a_face(tmp_path):
                     + "".join("f " + " ".join(f"{k}/{k}" for k in quad) + "\n" for quad in quads.tolist()))
     for most in (64, 10):
         html = tmp_path / f"report{most}.html"
-        done = subprocess.run([sys.executable, "-m", "affinity.cli", "report", "-q", str(path), "-o", str(html),
-                               "--place-faces", str(most)], capture_output=True, text=True, timeout=300)
+        done = run("report", "-q", str(path), "-o", str(html), "--place-faces", str(most))
         assert done.returncode == 0, done.stderr
         places = [set(map(int, found.split(","))) for found in re.findall(r'data-place="([^"]*)"', html.read_text())]
         assert len(places) >= 2 and all(len(place) <= most for place in places)
@@ -78,8 +78,6 @@ def test_the_layout_marks_only_the_faces_the_uv_rules_flag(tmp_path):
     import io
     import json
     import re
-    import subprocess
-    import sys
 
     from PIL import Image
 
@@ -96,8 +94,7 @@ def test_the_layout_marks_only_the_faces_the_uv_rules_flag(tmp_path):
     path.write_text("\n".join(lines) + "\n")
 
     def cli(*args):
-        return subprocess.run([sys.executable, "-m", "affinity.cli", *args], capture_output=True, text=True,
-                              timeout=300, cwd=tmp_path)
+        return run(*args, cwd=tmp_path)
 
     findings = json.loads(cli("check", "--format", "json", str(path)).stdout)["findings"]
     faces = {code: {f["face"] for f in findings if f["code"] == code} for code in ("Q101", "Q102")}

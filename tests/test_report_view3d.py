@@ -11,16 +11,17 @@ from __future__ import annotations
 import base64
 import io
 import json
-import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 from helpers.chromium import CHROMIUM, WEBGL_FLAGS, DevTools, evaluate, open_page
+from helpers.cli import run
 from helpers.corpus import SHARED_MESHES
 
-pytestmark = pytest.mark.skipif(CHROMIUM is None, reason="no chromium installed")
+pytestmark = [pytest.mark.skipif(CHROMIUM is None, reason="no chromium installed"),
+              pytest.mark.slow]  # a browser draws the 3-D view of reports of the shared meshes
 
 SPOT = SHARED_MESHES / "textured" / "spot_control_mesh_textured.obj"
 MAKEHUMAN = SHARED_MESHES / "makehuman_base_hm08.obj"
@@ -33,15 +34,13 @@ FACE_PIXELS, CHANGED_SHARE, CHANGED_STEP = 300, 0.01, 8
 
 def _report(folder: Path, *paths: Path) -> Path:
     report = folder / "report.html"
-    built = subprocess.run([sys.executable, "-m", "affinity.cli", "report", "-q", *map(str, paths), "-o", str(report)],
-                           capture_output=True, text=True, timeout=600)
+    built = run("report", "-q", *map(str, paths), "-o", str(report))
     assert built.returncode == 0, built.stderr
     return report
 
 
 def _lint(*paths: Path) -> dict:
-    checked = subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--format", "json", *map(str, paths)],
-                             capture_output=True, text=True, timeout=300)
+    checked = run("check", "--format", "json", *map(str, paths))
     return json.loads(checked.stdout)
 
 

@@ -11,14 +11,15 @@ from __future__ import annotations
 import base64
 import io
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers.cli import run
 
 from affinity.loaders import load
+
+pytestmark = pytest.mark.slow  # a report of every shared mesh
 
 #: The pixels a close-up's place and its worst face must each cover, and the share of a uv / colour close-up
 #: where split and exact differ.
@@ -42,11 +43,15 @@ def left_handed_copy(source: Path, target: Path) -> None:
 
 def report_figures(mesh: Path, html: Path) -> list[dict]:
     """Run ``affinity report`` on ``mesh``; each close-up figure's data attributes and decoded panels."""
+    done = run("report", "-q", str(mesh), "-o", str(html))
+    assert done.returncode == 0, done.stderr
+    return page_figures(html)
+
+
+def page_figures(html: Path) -> list[dict]:
+    """Each close-up figure of the report page ``html``: its data attributes and decoded panels."""
     from PIL import Image
 
-    done = subprocess.run([sys.executable, "-m", "affinity.cli", "report", "-q", str(mesh), "-o", str(html)],
-                          capture_output=True, text=True, timeout=600)
-    assert done.returncode == 0, done.stderr
     figures = []
     for match in FIGURE.finditer(html.read_text(encoding="utf-8")):
         figure = dict(ATTRIBUTE.findall(match["attrs"]))
@@ -114,6 +119,8 @@ def test_a_left_handed_mesh_is_seen_from_outside(shared_meshes, tmp_path):
                                   "tinyobjloader_cube_vertexcol.obj", "gen_uv_sphere_64x32.obj",
                                   "osd_catmark_nonquads.obj",
                                   "makehuman_base_hm08.obj", "gen_spot_cc4.obj"])
-def test_every_closeup_of_a_shared_mesh_shows_its_place(shared_meshes, tmp_path, name):
+def test_every_closeup_of_a_shared_mesh_shows_its_place(shared_meshes, report_of, name):
     path = shared_meshes / name
-    check_figures(path, report_figures(path, tmp_path / "report.html"))
+    done, page = report_of(path)
+    assert done.returncode == 0, done.stderr
+    check_figures(path, page_figures(page))

@@ -1,6 +1,6 @@
 """Both halves of every rule page, as ruff keeps them: the *Example* that triggers the rule and the
 *Use instead* that fixes it the way *How to fix* says. Each is linted by ``affinity check`` run as a user
-runs it (a subprocess, every rule selected) in a folder holding that one file.
+runs it (``helpers.cli.run``, every rule selected) in a folder holding that one file.
 
 The example's printed lines of Q101-Q902 are compared in ``test_rule_registry.py``; Q901 (not a lint rule,
 its line goes to stderr) is compared here.

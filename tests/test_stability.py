@@ -9,6 +9,7 @@ from pathlib import Path
 import mpmath
 import numpy as np
 import pytest
+from helpers.cli import run as run_affinity
 
 from affinity.stability import condition as condition_module
 from affinity.stability import reference, table
@@ -193,8 +194,7 @@ def test_csv_round_trip_and_markdown(rows64):
 
 def test_command_writes_the_table_and_exits_0(tmp_path):
     out = tmp_path / "stability"
-    result = subprocess.run([sys.executable, "-m", "affinity.cli", "stability", "-o", str(out)],
-                            check=False, capture_output=True, text=True, cwd=tmp_path, timeout=120)
+    result = run_affinity("stability", "-o", str(out), cwd=tmp_path)
     assert result.returncode == 0, result.stderr
     assert result.stderr == ""
     n = len(catalogue())
@@ -220,8 +220,7 @@ def test_command_exits_1_when_a_float64_case_fails(tmp_path, monkeypatch, capsys
 def test_command_reports_an_unwritable_folder(tmp_path):
     blocker = tmp_path / "file"
     blocker.write_text("")
-    result = subprocess.run([sys.executable, "-m", "affinity.cli", "stability", "-o", str(blocker / "x")],
-                            check=False, capture_output=True, text=True, timeout=60)
+    result = run_affinity("stability", "-o", str(blocker / "x"))
     assert result.returncode == 2
     assert "cannot create" in result.stderr and "Traceback" not in result.stderr
 
@@ -237,9 +236,6 @@ def test_committed_table_is_current(rows64):
 
 def test_reading_a_committed_table_needs_no_mpmath(tmp_path):
     """The report reads stability.csv; mpmath is for computing references, not for reading rows."""
-    import subprocess
-    import sys
-
     from affinity.stability import table
 
     row = Row("needle", "needles", "mean_value", False, "float64", 3, 1e-17, 1e-14, 1e-3, 0.0, 0.0, 0.0, "pass")

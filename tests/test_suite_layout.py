@@ -1,9 +1,11 @@
 """The test suite's own layout: shared helpers live in ``tests/helpers/``, no test module imports another,
-and the path of the real meshes is spelled in one place (``helpers.corpus``)."""
+the path of the real meshes is spelled in one place (``helpers.corpus``), and the command line runs in the
+test's process except in the modules that test the process itself."""
 
 from __future__ import annotations
 
 import ast
+import itertools
 from pathlib import Path
 
 import pytest
@@ -56,3 +58,45 @@ def test_the_shared_meshes_path_is_spelled_once():
     spelled = [path.relative_to(TESTS).as_posix() for path in TESTS.rglob("*.py")
                if spelling in path.read_text(encoding="utf-8")]
     assert spelled == ["helpers/corpus.py"]
+
+
+#: The modules that test the process boundary itself and start ``python -m affinity.cli`` on their own, and
+#: why. Every other module runs the command line through ``helpers.cli.run`` (in the test's process: about
+#: 0.7 s of start-up less a call) or, where the boundary matters to one test, ``helpers.cli.run_process``.
+SPAWNS_ITS_OWN_PROCESS = {
+    "test_blender.py": "the check runs beside Blender's own Python",
+    "test_broken_inputs.py": "a link to the process's own stdout, read as bytes",
+    "test_cluster.py": "a Dask cluster and the environment it is named by",
+    "test_farm.py": "journals that survive a killed run",
+    "test_fuzz.py": "a time limit on each batch of mutated files",
+    "test_huge_values.py": "the interpreter's own -W error",
+    "test_merge_untrusted.py": "a time limit on reads that would block",
+    "test_pathological_inputs.py": "a time limit on reads that would block",
+    "test_signals.py": "signals sent to the running command",
+    "test_worker_loss.py": "-j worker processes that die",
+}
+
+
+def spawned_cli_lines(path: Path) -> list[int]:
+    """The lines where ``path`` spells an argument list ``[..., "-m", "affinity.cli", ...]``."""
+    lines = []
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, (ast.List, ast.Tuple)):
+            words = [element.value if isinstance(element, ast.Constant) else None for element in node.elts]
+            if any(pair == ("-m", ".".join(["affinity", "cli"])) for pair in itertools.pairwise(words)):
+                lines.append(node.lineno)
+    return lines
+
+
+def test_the_check_sees_a_module_spawning_the_command_line(tmp_path):
+    module = tmp_path / "test_x.py"
+    module.write_text("import subprocess, sys\n\ndef test_a():\n"
+                      "    subprocess.run([sys.executable, '-m', 'affinity.cli', 'check'])\n")
+    assert spawned_cli_lines(module) == [4]
+
+
+def test_the_command_line_runs_in_the_tests_process_but_where_the_process_is_tested():
+    spawning = {path.name for path in TEST_MODULES if spawned_cli_lines(path)}
+    assert spawning <= set(SPAWNS_ITS_OWN_PROCESS), (
+        f"{sorted(spawning - set(SPAWNS_ITS_OWN_PROCESS))} start python -m affinity.cli: use helpers.cli.run, "
+        "or helpers.cli.run_process for a test of the process boundary")

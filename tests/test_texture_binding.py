@@ -4,12 +4,12 @@ unit"): OBJ/MTL maps with -s/-o, USD UsdPreviewSurface, a MaterialX document ref
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers.cli import run
+from helpers.usd_stages import looks, usd_quads
 
 from affinity.loaders import load
 from affinity.textures.binding import bound_textures, texel_grid
@@ -23,23 +23,6 @@ def picture(path: Path, size, colour=(200, 120, 40)) -> None:
     from PIL import Image
 
     Image.new("RGB", size, colour).save(path)
-
-
-def usd_quads(materials: list[str | None], uv_offsets: list[tuple[float, float]] | None = None) -> str:
-    """usda text of one trapezoid mesh prim per entry, bound to ``/Looks/<name>`` (None: unbound), its uv the
-    unit square moved by ``uv_offsets``."""
-    prims = []
-    for k, material in enumerate(materials):
-        du, dv = (uv_offsets or [(0, 0)] * len(materials))[k]
-        uv = ", ".join(f"({u + du}, {v + dv})" for u, v in [(0, 0), (1, 0), (1, 1), (0, 1)])
-        binding = f"    rel material:binding = </Looks/{material}>\n" if material else ""
-        prims.append(
-            f'def Mesh "Quad{k}" (\n    prepend apiSchemas = ["MaterialBindingAPI"]\n)\n{{\n'
-            "    int[] faceVertexCounts = [4]\n    int[] faceVertexIndices = [0, 1, 2, 3]\n"
-            f"    point3f[] points = [({-1 + 3 * k}, 0, 0), ({1 + 3 * k}, 0, 0), ({0.5 + 3 * k}, 1, 0), "
-            f"({-0.5 + 3 * k}, 1, 0)]\n"
-            f'    texCoord2f[] primvars:st = [{uv}] (interpolation = "faceVarying")\n{binding}}}\n')
-    return "#usda 1.0\n" + "".join(prims)
 
 
 def preview_material(name: str, textures: dict[str, str], varname: str = "st") -> str:
@@ -58,10 +41,6 @@ def preview_material(name: str, textures: dict[str, str], varname: str = "st") -
             '        def Shader "Reader"\n        {\n            uniform token info:id = "UsdPrimvarReader_float2"\n'
             f'            string inputs:varname = "{varname}"\n            float2 outputs:result\n        }}\n'
             "    }\n")
-
-
-def looks(*materials: str) -> str:
-    return 'def Scope "Looks"\n{\n' + "".join(materials) + "}\n"
 
 
 def per_face(mesh) -> dict[int, list[tuple[str, str]]]:
@@ -187,8 +166,7 @@ def test_obj_udim_scale_and_offset(tmp_path):
 
 
 def check(path: Path) -> dict:
-    result = subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--no-cache", "--format", "json",
-                             "--select", "Q101", str(path)], capture_output=True, text=True)
+    result = run("check", "--no-cache", "--format", "json", "--select", "Q101", str(path))
     assert result.returncode in (0, 1), result.stderr
     return json.loads(result.stdout)
 
@@ -231,11 +209,10 @@ def test_the_result_cache_follows_usd_and_materialx_textures(tmp_path):
     assert [Path(p).name for p in named_files(str(stage))] == ["paint.1001.png", "paint.1002.png"]
     assert [Path(p).name for p in named_files(str(tmp_path / "look.mtlx"))] == ["wood_base.png",
                                                                                   "wood_normal.png"]
-    env = {**__import__("os").environ, "AFFINITY_CACHE_DIR": str(tmp_path / "cache")}
-
     def value() -> float:
-        result = subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--format", "json", "--select",
-                                 "Q101", str(stage)], capture_output=True, text=True, env=env)
+        with pytest.MonkeyPatch.context() as patch:
+            patch.setenv("AFFINITY_CACHE_DIR", str(tmp_path / "cache"))
+            result = run("check", "--format", "json", "--select", "Q101", str(stage))
         return json.loads(result.stdout)["findings"][0]["value"]
 
     assert value() == pytest.approx(0.0, abs=0.01)  # a flat tile hides the crease

@@ -12,6 +12,7 @@ import zlib
 from pathlib import Path
 
 import pytest
+from helpers.cli import run
 
 TRAPEZOID = "v -1 0 0\nv 1 0 0\nv 0.5 1 0\nv -0.5 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n"
 
@@ -34,10 +35,6 @@ def two_meshes(tmp_path) -> Path:
     (tmp_path / "huge.obj").write_text("mtllib huge.mtl\nusemtl m\n" + TRAPEZOID)
     (tmp_path / "plain.obj").write_text(TRAPEZOID)
     return tmp_path
-
-
-def run(*args, cwd=None) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "affinity.cli", *args], capture_output=True, text=True, cwd=cwd)
 
 
 def test_a_header_of_a_second_library_is_read_and_its_size_refused(tmp_path, monkeypatch):
@@ -80,6 +77,7 @@ def test_render_falls_back_to_the_checker_with_a_warning(two_meshes, tmp_path):
     assert (tmp_path / "out.png").exists()
 
 
+@pytest.mark.slow  # a report in a process of its own under a memory limit
 def test_one_huge_texture_never_loses_the_other_mesh_of_a_report(two_meshes, tmp_path):
     """The report of both meshes is written, each mesh in it; the huge one's close-ups draw the line pattern
     and say why, and the process stays far from what decoding 10^10 pixels would take."""

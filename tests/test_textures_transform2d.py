@@ -5,12 +5,11 @@ translate: the UsdPreviewSurface specification), on hand-built stages."""
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers.cli import run
 
 pytest.importorskip("pxr")
 
@@ -94,8 +93,7 @@ def visible_finding(stage: Path) -> dict:
     """Q101's finding on ``stage``, its C measured to the end (``visible-error`` past any colour difference, so
     no value is a lower bound)."""
     (stage.parent / "affinity.toml").write_text("visible-error = 300\n")
-    result = subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--no-cache", "--format", "json",
-                             "--select", "Q101", str(stage)], capture_output=True, text=True, cwd=stage.parent)
+    result = run("check", "--no-cache", "--format", "json", "--select", "Q101", str(stage), cwd=stage.parent)
     assert result.returncode in (0, 1), result.stderr
     [finding] = json.loads(result.stdout)["findings"]
     return finding

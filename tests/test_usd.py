@@ -79,7 +79,7 @@ FACES = [
 
 
 def check(*args: str):
-    """``affinity check ARGS`` in a subprocess, from the repository root."""
+    """``affinity check ARGS`` from the repository root."""
     return run("check", *args, cwd=ROOT)
 
 

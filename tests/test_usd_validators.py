@@ -16,13 +16,13 @@ import re
 import shutil
 import subprocess
 import sys
-import textwrap
 from pathlib import Path
 
 import numpy as np
 import pytest
 from helpers.cli import run
 from helpers.usd_stages import define_mesh, flagged_stage, referenced_stage
+from helpers.usd_validation import validate
 
 pytest.importorskip("pxr", reason="needs the usd extra (usd-core)")
 
@@ -32,45 +32,6 @@ LEVELS = {"Error": "error", "Warn": "warning", "Info": "info"}
 
 #: Validates the stage given on the command line, or applies the fixers of its errors with the
 #: stage's root layer as edit target first (--fix), and prints its errors as JSON lines.
-VALIDATE = textwrap.dedent('''
-    import json, sys
-    from pxr import Usd, UsdValidation
-    stage = Usd.Stage.Open(sys.argv[1])
-    context = UsdValidation.ValidationContext(["quad-affinity"], True)
-    errors = context.Validate(stage)
-    if "--fix" in sys.argv:
-        target = Usd.EditTarget(stage.GetRootLayer())
-        for error in errors:
-            for fixer in error.GetFixers():
-                if fixer.CanApplyFix(error, target):
-                    assert fixer.ApplyFix(error, target), error.GetMessage()
-        errors = context.Validate(stage)
-    for error in errors:
-        print(json.dumps({
-            "validator": error.GetValidator().GetMetadata().name, "name": error.GetName(),
-            "type": str(error.GetType()).rsplit(".", 1)[-1], "message": error.GetMessage(),
-            "prims": [str(site.GetPrim().GetPath()) for site in error.GetSites() if site.GetPrim()],
-            "layers": [site.GetLayer().realPath for site in error.GetSites() if site.GetLayer()],
-            "fixers": [fixer.name for fixer in error.GetFixers()]}))
-''')
-
-
-def plugin_env() -> dict:
-    """The environment of a USD application told about the plug-in by ``affinity usd-plugin``."""
-    result = run("usd-plugin")
-    assert result.returncode == 0, result.stderr
-    folder = result.stdout.strip()
-    return {**os.environ, "PXR_PLUGINPATH_NAME": os.pathsep.join(filter(None, [folder,
-                                                                              os.environ.get("PXR_PLUGINPATH_NAME")]))}
-
-
-def validate(stage: Path, *flags: str) -> list[dict]:
-    result = subprocess.run([sys.executable, "-c", VALIDATE, str(stage), *flags], capture_output=True, text=True,
-                            env=plugin_env(), timeout=300, cwd=stage.parent)
-    assert result.returncode == 0, result.stderr
-    return [json.loads(line) for line in result.stdout.splitlines()]
-
-
 def from_message(message: str) -> tuple:
     """(prim, face, code) of a finding's message."""
     match = FINDING.match(message)

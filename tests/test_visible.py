@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers.cli import run
 from helpers.corpus import SHARED_MESHES
 
 TEXTURED = SHARED_MESHES / "textured"
@@ -97,12 +98,12 @@ def dense_c(image: np.ndarray, p: np.ndarray, uv: np.ndarray) -> float:
 
 
 def check_json(*args) -> dict:
-    result = subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--format", "json", "--no-cache", *args],
-                            capture_output=True, text=True)
+    result = run("check", "--format", "json", "--no-cache", *args)
     assert result.returncode in (0, 1), result.stderr
     return json.loads(result.stdout)
 
 
+@pytest.mark.slow  # a dense reading of Spot's texture
 @pytest.mark.skipif(not SPOT.exists(), reason="../shared/meshes/textured is not in this checkout")
 def test_spot_c_matches_a_dense_independent_reading():
     """Every Q101 finding on Spot with its own texture: C within 1/255 of the dense reading, or a correct
@@ -138,8 +139,7 @@ def test_spot_c_matches_a_dense_independent_reading():
 
 @pytest.mark.skipif(not SPOT.exists(), reason="../shared/meshes/textured is not in this checkout")
 def test_spot_text_output_names_the_texture_and_marks_bounds():
-    result = subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--no-cache", "--select", "Q101",
-                             "--verbose", str(SPOT)], capture_output=True, text=True)
+    result = run("check", "--no-cache", "--select", "Q101", "--verbose", str(SPOT))
     lines = [line for line in result.stdout.splitlines() if " Q101 " in line]
     assert lines and all("base colour texture spot_texture.png" in line for line in lines)
     assert any("(>=" in line and "vs 2/255)" in line for line in lines)
@@ -195,8 +195,7 @@ def test_the_visible_reading_survives_the_cache_and_reaches_sarif(tmp_path):
     again = report_from_bytes(report_to_bytes(report))
     assert file_findings(again)[0] == file_findings(report)[0]
     assert again.hits[0].visible.roles == ["base colour"]
-    result = subprocess.run([sys.executable, "-m", "affinity.cli", "check", "--no-cache", "--format", "sarif",
-                             "--select", "Q101", str(SPOT)], capture_output=True, text=True)
+    result = run("check", "--no-cache", "--format", "sarif", "--select", "Q101", str(SPOT))
     properties = [r["properties"] for r in json.loads(result.stdout)["runs"][0]["results"]]
     assert all(p["texture"] == "spot_texture.png" and p["role"] == "base colour" and p["shift"] >= 0.5
                for p in properties)

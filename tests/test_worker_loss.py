@@ -22,7 +22,7 @@ from pathlib import Path
 
 import pytest
 from helpers.cli import SQUARE, TRAPEZOID, write
-from test_signals import alive, big_meshes, children, start, wait_for  # noqa: F401  (big_meshes: a fixture)
+from helpers.processes import alive, children, start, wait_for
 
 from affinity.pipeline import check as pipeline_check
 from affinity.pipeline.check import WORKER_DIED, check_files
@@ -102,7 +102,7 @@ def test_check_j2_with_a_dying_worker_exits_2_with_every_other_file(tmp_path):
 
 
 @pytest.mark.slow
-def test_sigterm_to_check_j2_leaves_no_process_in_20_trials(big_meshes, tmp_path):  # noqa: F811
+def test_sigterm_to_check_j2_leaves_no_process_in_20_trials(big_meshes, tmp_path):
     """SIGTERM at 20 moments of a ``check -j 2`` run (while the workers check, and while they send their
     results): the run and both workers are gone 5 s later, every time."""
     rng = random.Random(53)

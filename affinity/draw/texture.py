@@ -20,7 +20,6 @@ __all__ = ["TextureError", "checker", "load_image", "sample_bilinear", "sample_m
 CHECKS = 32
 
 
-@functools.lru_cache(maxsize=4)
 def painted_texture(mesh) -> str | None:
     """The image file a render paints the whole mesh with, the renderer taking one texture: the ``map_Kd``
     of the first material that has one, or None. Only renders paint one image; everything that measures
@@ -31,6 +30,7 @@ def painted_texture(mesh) -> str | None:
     return next(iter(mesh.material_textures.values()), None)
 
 
+@functools.lru_cache(maxsize=4)
 def checker(size: int = 1024, checks: int = CHECKS) -> np.ndarray:
     """A checker with thin grid lines, so a bent diagonal stands out.
 

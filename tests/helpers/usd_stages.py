@@ -65,3 +65,24 @@ def referenced_stage(folder: Path, prims=("A", "B", "C", "D"), override_st: dict
             UsdGeom.PrimvarsAPI(knight).GetPrimvar("st").Set(override_st[name])
     stage.GetRootLayer().Save()
     return folder / "set.usda"
+
+
+def usd_quads(materials: list[str | None], uv_offsets: list[tuple[float, float]] | None = None) -> str:
+    """usda text of one trapezoid mesh prim per entry, bound to ``/Looks/<name>`` (None: unbound), its uv the
+    unit square moved by ``uv_offsets``."""
+    prims = []
+    for k, material in enumerate(materials):
+        du, dv = (uv_offsets or [(0, 0)] * len(materials))[k]
+        uv = ", ".join(f"({u + du}, {v + dv})" for u, v in [(0, 0), (1, 0), (1, 1), (0, 1)])
+        binding = f"    rel material:binding = </Looks/{material}>\n" if material else ""
+        prims.append(
+            f'def Mesh "Quad{k}" (\n    prepend apiSchemas = ["MaterialBindingAPI"]\n)\n{{\n'
+            "    int[] faceVertexCounts = [4]\n    int[] faceVertexIndices = [0, 1, 2, 3]\n"
+            f"    point3f[] points = [({-1 + 3 * k}, 0, 0), ({1 + 3 * k}, 0, 0), ({0.5 + 3 * k}, 1, 0), "
+            f"({-0.5 + 3 * k}, 1, 0)]\n"
+            f'    texCoord2f[] primvars:st = [{uv}] (interpolation = "faceVarying")\n{binding}}}\n')
+    return "#usda 1.0\n" + "".join(prims)
+
+
+def looks(*materials: str) -> str:
+    return 'def Scope "Looks"\n{\n' + "".join(materials) + "}\n"

@@ -25,9 +25,11 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "tests"))
+from helpers.corpus import SHARED_MESHES as SHARED  # noqa: E402  (the one spelling of the folder)
+
 ORACLE = ROOT / "tests" / "oracle" / "osd_refine"
 OUT = ROOT / "tests" / "data" / "subdivision"
-SHARED = ROOT.parent / "shared" / "meshes"
 FVAR_RULES = ("none", "cornersOnly", "cornersPlus1", "cornersPlus2", "boundaries", "all")
 BOUNDARY_RULES = ("none", "edgeOnly", "edgeAndCorner")
 #: Mesh -> (path, levels, whether it has a boundary, the oracle's extra options, limit samples a face).
