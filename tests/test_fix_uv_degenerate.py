@@ -12,6 +12,7 @@ import collections
 import json
 
 import numpy as np
+import pytest
 from helpers.cli import run, write
 
 from affinity.fix import FixSettings, plan_fix
@@ -68,3 +69,73 @@ def test_the_recheck_counts_a_cut_neighbour_whose_pieces_multiply_its_finding(tm
     kept = np.flatnonzero(refined.source == 1)
     assert len(kept) == 1 and not refined.added[kept[0]]
 
+
+
+GEOM = """#usda 1.0
+(
+    defaultPrim = "Pair"
+)
+
+def Mesh "Pair"
+{
+    int[] faceVertexCounts = [4, 4]
+    int[] faceVertexIndices = [0, 1, 4, 3, 1, 2, 5, 4]
+    point3f[] points = [(0, 0, 0), (1, 0, 0), (2, 0, 0), (0, 1, 0), (1, 1, 0), (2, 1, 0)]
+    texCoord2f[] primvars:st = [(0.5, 0), (0.75, 0), (0.74, 0.25), (0.51, 0.25), (0.8, 0.5), (0.9, 0.5), (0.9, 0.5),
+        (0.8, 0.5)] (
+        interpolation = "faceVarying"
+    )
+    uniform token subdivisionScheme = "none"
+}
+"""
+
+STAGE = """#usda 1.0
+(
+    defaultPrim = "Set"
+)
+
+def Xform "Set"
+{
+    def Mesh "A" (
+        references = @./pair.usda@
+    )
+    {
+    }
+
+    def Mesh "B" (
+        references = @./pair.usda@
+    )
+    {
+        double3 xformOp:translate = (5, 0, 0)
+        uniform token[] xformOpOrder = ["xformOp:translate"]
+    }
+}
+"""
+
+
+def test_two_prims_of_one_mesh_fixed_once_keep_their_one_q301(tmp_path):
+    """The same pair authored once and referenced by two prims (the chess set's knights in miniature): the
+    fixed stage, as usd-core composes it, has no more Q301 than the input, and both prims read the uv-degenerate
+    quad as authored (the class both inherit was not cut there)."""
+    pytest.importorskip("pxr", reason="needs the usd extra (usd-core)")
+    from pxr import Usd, UsdGeom
+
+    write(tmp_path, "pair.usda", GEOM)
+    stage = write(tmp_path, "set.usda", STAGE)
+    before = codes(stage)
+    assert before["Q301"] >= 1 and before["Q101"] >= 1
+    fixed = run("fix", "--format", "json", "--isolated", str(stage))
+    assert fixed.returncode == 0, fixed.stdout + fixed.stderr
+    entry = json.loads(fixed.stdout)["files"][0]
+    assert {r["prim"] for r in entry["refine"]} == {"/Set/A", "/Set/B"} and entry["transitions"] == []
+    after = codes(tmp_path / "set.fixed.usda")
+    assert after["Q301"] == before["Q301"] and after["Q101"] == 0
+    composed = Usd.Stage.Open(str(tmp_path / "set.fixed.usda"))
+    for prim in ("/Set/A", "/Set/B"):
+        mesh = UsdGeom.Mesh(composed.GetPrimAtPath(prim))
+        counts = np.array(mesh.GetFaceVertexCountsAttr().Get())
+        assert len(counts) > 2 and (counts == 4).all()
+        points = np.array(mesh.GetPointsAttr().Get())
+        indices = np.array(mesh.GetFaceVertexIndicesAttr().Get()).reshape(-1, 4)
+        # the face on the original corners (1, 0, 0), (2, 0, 0), (2, 1, 0), (1, 1, 0), uncut
+        assert [p.tolist() for p in points[indices]].count([[1, 0, 0], [2, 0, 0], [2, 1, 0], [1, 1, 0]]) == 1
