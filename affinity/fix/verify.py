@@ -8,7 +8,10 @@ are read from it, each on the input's faces (a new face counts for the face it r
 * the faces a scored rule (Q101-Q103) still flags at the fix level, other than those the plan
   already leaves: the prediction missed them (``still-flagged``);
 * findings of every other rule at warning or above on new faces whose input face had no finding
-  of that rule: a fix that adds them is not written unless allowed (``--allow-new-findings``).
+  of that rule, or that a neighbour cut to meet a refinement (a transition face) had once and its
+  pieces have more than once: a fix that adds them is not written unless allowed
+  (``--allow-new-findings``). The pieces of a refined quad may keep its own finding (a bent quad
+  refined under ``--refine-nonplanar``).
 """
 
 from __future__ import annotations
@@ -38,7 +41,7 @@ def verify(mesh: Mesh, plan, fix, baseline: dict) -> tuple[np.ndarray, list[dict
     flagged : (s,) int64 input faces, ascending, whose faces in the result a scored rule flags at the fix
         level, the plan's left faces excepted
     new : ``{"code": CODE, "face": F}`` per input face F whose new faces have a finding of rule CODE (at
-        warning or above) that F had not
+        warning or above) that F had not, or more than one where F is a transition face that had it
     """
     from ..lint import scored_codes
     from .plan import LEVEL_ORDER
@@ -55,7 +58,9 @@ def verify(mesh: Mesh, plan, fix, baseline: dict) -> tuple[np.ndarray, list[dict
             flagged.append(source[faces[np.isin(levels, lowest)]])
             continue
         added = faces[refined.added[faces] & np.isin(levels, ("warning", "error"))]
-        fresh = np.setdiff1d(source[added], baseline.get(h.code, np.zeros(0, np.int64)))
+        replaced, pieces = np.unique(source[added], return_counts=True)
+        had = np.isin(replaced, baseline.get(h.code, np.zeros(0, np.int64)))
+        fresh = replaced[~had | ((pieces > 1) & np.isin(replaced, plan.transition_faces))]
         new += [{"code": h.code, "face": int(face)} for face in fresh.tolist()]
     found = np.unique(np.concatenate(flagged or [np.zeros(0, np.int64)]))
     return np.setdiff1d(found, plan.left_faces), new

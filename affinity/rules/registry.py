@@ -131,7 +131,8 @@ class Rule:
         (``"degenerate"``); "": fix does not look at this rule
     fix_precedence : where several ``fix_leaves`` rules flag one quad, the lowest precedence names the reason
     fix_uncut : a quad this rule flags is never cut to meet a refined neighbour (a cut of its bilinear patch
-        would fold): it keeps its line and the neighbour's refinement closes to it
+        would fold, or each of its pieces would carry the finding again: a uv-degenerate quad's pieces are all
+        uv-degenerate): it keeps its line and the neighbour's refinement closes to it
     scope : the faces a check's context holds: ``"quad"``, a batch of the mesh's quads
         (:class:`affinity.lint.QuadBatch`); ``"mesh"``, the file itself as face -1
         (:class:`affinity.lint.WholeMesh`: Q205, Q902)

@@ -25,7 +25,7 @@ def collapsed_uv(quads) -> np.ndarray:
 
 @rule(code=UV_DEGENERATE, name="uv-degenerate", unit="relative area", default_threshold=1e-9, flags="at-or-below",
       worst="lowest", attribute="texcoords", family=UV_LAYOUT, masks=("texcoords",), unmeasurable=collapsed_uv,
-      cause="the texture smears over it", fix_leaves="uv-degenerate", fix_precedence=3)
+      cause="the texture smears over it", fix_leaves="uv-degenerate", fix_precedence=3, fix_uncut=True)
 def uv_degenerate(quads) -> Measured:
     """Zero area in texture space.
 
