@@ -98,6 +98,9 @@ DIFFERENCE_REACH = 1.0
 WIDEST_LINES = 40.0
 #: The error map's largest value on the place agrees with the finding's when within this fraction of it.
 SCALE_AGREES = 0.1
+#: ... unless its corners lie farther than this fraction of its diagonal off their plane (then the caption says
+#: the error map holds parallax too).
+BENT = 0.05
 
 
 # -- Framing ---------------------------------------------------------------------------------------------------
@@ -479,6 +482,7 @@ class Closeup:
     images : method -> (S, S, 3) float RGB, the place outlined in the flag colour
     difference : (S, S, 3) float32, ``|split - exact|`` times ``difference_gain`` (None without an attribute)
     zoom : on-screen pixels per texel on the worst face's crease (uv), NaN where not measured
+    crease : the caption's words on the crease framed: where, its shift, the zoom, the error map against the finding
     error : (S, S) float64 split error against exact in ``unit`` (None without an attribute or exact)
     covered : (S, S) bool, the pixels where split and exact show the same face
     own : (S, S) bool, the pixels where the split picture shows the place's faces
@@ -509,6 +513,7 @@ class Closeup:
     difference: np.ndarray | None = None
     difference_gain: float = 1.0
     zoom: float = float("nan")
+    crease: str = ""
 
     @property
     def place_pixels(self) -> int:
@@ -740,9 +745,14 @@ def _scale_words(place, largest: float, unit: str, defect) -> str:
     said = f"The error map's largest on face {place.worst}, {largest:.3g} {unit}, "
     if abs(largest - value) <= SCALE_AGREES * value:
         return said + f"is within {SCALE_AGREES:.0%} of the finding's shift, {value:.3g} {unit}."
-    if abs(defect.shift - value) <= SCALE_AGREES * value:
-        return said + (f"is off the finding's {value:.3g} {unit} (the quad's crease sampled densely: "
-                       f"{defect.shift:.3g}): the pixels sample the quad more coarsely than the finding.")
+    if defect.folded:
+        return said + (f"is off the finding's {value:.3g} {unit}: the quad has a reflex or repeated corner, where "
+                       "the finding's closed form bounds the crease and the split draws one triangle outside the "
+                       "quad or none.")
+    if defect.bend > BENT:
+        return said + (f"is off the finding's {value:.3g} {unit}: the quad bends {defect.bend:.0%} of its diagonal "
+                       "off its plane, so on screen the split's triangles and the exact patch lie apart and the "
+                       "error map adds their parallax to the shift.")
     return said + (f"is off the finding's {value:.3g} {unit}: the quad's crease, sampled densely, is "
                    f"{defect.shift:.3g} along the diagonal drawn.")
 
@@ -768,7 +778,7 @@ def closeup(mesh: Mesh, place, settings: Settings, size: int = CLOSEUP_SIZE, pix
     drawn_mesh = mesh
     if defect is not None:
         camera, pixels_per_unit = defect_camera(view.camera, defect, size)
-        view = replace(view, camera=camera)
+        view = replace(view, camera=camera, up="xyz"[int(np.argmin(np.abs(np.subtract(camera[0], camera[1]))))])
         if defect.across:  # the finding's crease is the split along 1-3: the renderer draws 0-2, so turn the quad
             drawn_mesh = turned_face(mesh, place.worst)
         pixels_per_texel = pixels_per_unit * defect.texel
@@ -788,22 +798,22 @@ def closeup(mesh: Mesh, place, settings: Settings, size: int = CLOSEUP_SIZE, pix
                    f"from every side tried (fewer than {PLACE_FLOOR * size * size:.0f}), so it is not drawn")
     framed = ("the place's faces and their neighbours" if len(framed_faces) > 1
               else f"face {place.worst} and its neighbours")
-    difference, difference_gain, zoom = None, 1.0, float("nan")
+    difference, difference_gain, zoom, crease = None, 1.0, float("nan"), ""
     if errors.error is not None:
         difference, difference_gain = difference_panel(panels.plain["split"], panels.plain["exact"],
                                                        errors.covered, panels.own)
     if defect is not None:
-        framed = (f"the point of face {place.worst} where split and exact differ most "
+        crease = (f"Centred on the point of face {place.worst} where split and exact differ most "
                   f"({defect.shift:.3g} {errors.unit}, the split along {'1-3' if defect.across else '0-2'})")
         if paint.show == "uv":
             zoom = _zoom(panels, texture_size)
-            framed += f", 1 texel = {zoom:.2g} px"
+            crease += f", 1 texel = {zoom:.2g} px"
         # the worst face's pixels but its edge, where a pixel of one face's split meets the other's patch
         worst = errors.covered & _shrunk(panels.frames["split"][1] == np.searchsorted(view.drawn, place.worst), 1)
         if errors.error is not None and worst.any():
-            framed += ". " + _scale_words(place, float(errors.error[worst].max()), errors.unit, defect).rstrip(".")
+            crease += ". " + _scale_words(place, float(errors.error[worst].max()), errors.unit, defect)
     return Closeup(place=place, show=paint.show, texture=paint.label, framed=framed, images=panels.images,
                    error=errors.error, covered=errors.covered, own=panels.own, unit=errors.unit, view=view,
                    dropped=dropped, amplified=errors.amplified, gain=errors.gain, amplified_label=errors.label,
                    amplified_note=errors.note, seen=panels.seen, difference=difference,
-                   difference_gain=difference_gain, zoom=zoom)
+                   difference_gain=difference_gain, zoom=zoom, crease=crease)

@@ -12,7 +12,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-#: Samples per side of the (s, t) grid the crease is sought on.
+#: Samples per side of the (s, t) grid the crease is sought on (then again around the best one).
 SAMPLES = 49
 #: For uv, a close-up shows this many pixels per texel (a shift of k texels spans 8 k pixels) ...
 PIXELS_PER_TEXEL = 8.0
@@ -29,7 +29,9 @@ class Defect:
     shift : the largest difference, in the rule's unit (texels for uv, 1/255 for colours)
     texel : the world length of one texel there (sqrt of the area ratio; NaN without uv)
     diagonal : the world length of the quad's diagonal 0-2
-    long_axis : (3,) float64 unit vector along the quad's longer diagonal
+    normal : (3,) float64 unit normal of the quad's best-fit plane
+    bend : how far the corners lie off their best-fit plane, as a fraction of the longer diagonal
+    folded : whether a corner is reflex or repeats (in the plane), where the finding's closed form is a bound
     across : whether this is the split along 1-3 (the corners taken from corner 1 on: :func:`turned_face`)
     """
 
@@ -38,7 +40,9 @@ class Defect:
     shift: float
     texel: float
     diagonal: float
-    long_axis: np.ndarray
+    normal: np.ndarray
+    bend: float = 0.0
+    folded: bool = False
     across: bool = False
 
 
@@ -48,22 +52,28 @@ def _bilinear(corners: np.ndarray, s: np.ndarray, t: np.ndarray) -> np.ndarray:
     return weights @ corners
 
 
-def split_attribute(plane: np.ndarray, attrs: np.ndarray, points: np.ndarray) -> np.ndarray:
+def split_attribute(plane: np.ndarray, attrs: np.ndarray, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(N, K) the split's attribute at ``points`` (N, 2): barycentric in triangle (0, 1, 2) or (0, 2, 3) of the
-    quad's in-plane corners ``plane`` (4, 2), whichever side of diagonal 0-2 the point lies on; ``attrs`` (4, K)."""
+    quad's in-plane corners ``plane`` (4, 2), whichever side of diagonal 0-2 the point lies on; ``attrs`` (4, K);
+    and (N,) bool, whether the point lies in that triangle (a reflex corner's triangle leaves part of the quad
+    uncovered: the split draws nothing there)."""
     def cross(a, b):
         return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
 
     along = plane[2] - plane[0]
     side = np.sign(cross(along, points - plane[0]))
-    other = np.where(side[:, None] == np.sign(cross(along, plane[1] - plane[0])), 1, 3)  # (N, 1) third corner
+    # A point on the diagonal belongs to either triangle: take one with area (a repeated corner leaves one without)
+    past_3 = (side == np.sign(cross(along, plane[3] - plane[0]))) & (side != 0)
+    past_3 |= (side == 0) & (cross(along, plane[1] - plane[0]) == 0)
+    other = np.where(past_3, 3, 1)[:, None]  # (N, 1) the third corner
     third = plane[other[:, 0]]
     area = cross(along, third - plane[0])
-    area = np.where(np.abs(area) > 0, area, 1.0)
+    area = np.where(np.abs(area) > 0, area, np.inf)  # no triangle: the point gets corner 0's value
     w2 = cross(points - plane[0], third - plane[0]) / area  # weight of corner 2
     w3 = cross(along, points - plane[0]) / area  # weight of the third corner
     w0 = 1 - w2 - w3
-    return w0[:, None] * attrs[0] + w2[:, None] * attrs[2] + w3[:, None] * attrs[other[:, 0]]
+    inside = (np.minimum(np.minimum(w0, w2), w3) >= -1e-9) & np.isfinite(area)
+    return w0[:, None] * attrs[0] + w2[:, None] * attrs[2] + w3[:, None] * attrs[other[:, 0]], inside
 
 
 def quad_defect(corners: np.ndarray, attrs: np.ndarray, scale: np.ndarray, uv_texels: np.ndarray | None = None
@@ -80,14 +90,20 @@ def quad_defect(corners: np.ndarray, attrs: np.ndarray, scale: np.ndarray, uv_te
     The split's attribute at each sample is barycentric in its triangle of the quad's corners projected on
     the quad's best-fit plane; the exact one the bilinear P(s, t) (Bloomenthal 2022, eq. 1).
     """
-    s, t = (g.ravel() for g in np.meshgrid(np.linspace(0, 1, SAMPLES), np.linspace(0, 1, SAMPLES)))
     centre = corners.mean(axis=0)
     _, _, axes = np.linalg.svd(corners - centre)
     plane = (corners - centre) @ axes[:2].T  # (4, 2)
-    exact = _bilinear(attrs, s, t)
-    split = split_attribute(plane, attrs, _bilinear(plane, s, t))
-    difference = np.linalg.norm((split - exact) * scale, axis=1)
-    k = int(np.argmax(difference))
+    step = 1.0 / (SAMPLES - 1)
+    low, high = np.zeros(2), np.ones(2)
+    for _ in range(2):  # the grid, then a grid as fine again around its best sample
+        s, t = (g.ravel() for g in np.meshgrid(np.linspace(low[0], high[0], SAMPLES),
+                                               np.linspace(low[1], high[1], SAMPLES)))
+        exact = _bilinear(attrs, s, t)
+        split, inside = split_attribute(plane, attrs, _bilinear(plane, s, t))
+        difference = np.where(inside, np.linalg.norm((split - exact) * scale, axis=1), 0.0)
+        k = int(np.argmax(difference))
+        low, high = np.maximum([s[k] - step, t[k] - step], 0), np.minimum([s[k] + step, t[k] + step], 1)
+        step *= 2 / (SAMPLES - 1)
     st = np.array([s[k], t[k]])
     point = _bilinear(corners, s[k:k + 1], t[k:k + 1])[0]
     texel = np.nan
@@ -95,10 +111,12 @@ def quad_defect(corners: np.ndarray, attrs: np.ndarray, scale: np.ndarray, uv_te
         uv_area = abs(_area(uv_texels))
         if uv_area > 0:
             texel = float(np.sqrt(abs(_area(plane)) / uv_area))
-    diagonals = corners[[2, 3]] - corners[[0, 1]]
-    lengths = np.linalg.norm(diagonals, axis=1)
-    long_axis = diagonals[int(np.argmax(lengths))] / max(float(lengths.max()), 1e-300)
-    return Defect(point, st, float(difference[k]), texel, float(lengths[0]), long_axis)
+    lengths = np.linalg.norm(corners[[2, 3]] - corners[[0, 1]], axis=1)
+    bend = float(np.ptp((corners - centre) @ axes[2]) / max(float(lengths.max()), 1e-300))
+    edges = np.roll(plane, -1, axis=0) - plane
+    turns = edges[:, 0] * np.roll(edges, -1, axis=0)[:, 1] - edges[:, 1] * np.roll(edges, -1, axis=0)[:, 0]
+    folded = bool((np.sign(turns) != np.sign(_area(plane))).any())
+    return Defect(point, st, float(difference[k]), texel, float(lengths[0]), axes[2], bend, folded)
 
 
 def _area(polygon: np.ndarray) -> float:
@@ -108,8 +126,11 @@ def _area(polygon: np.ndarray) -> float:
 
 
 def defect_camera(camera: tuple, defect: Defect, size: int) -> tuple[tuple, float]:
-    """``camera`` ``(eye, target, fov)`` re-aimed at ``defect.point`` along the same direction, and its
-    pixels per world unit at the target.
+    """``camera`` ``(eye, target, fov)`` re-aimed at ``defect.point`` along the quad's normal (on the side the
+    camera was), and its pixels per world unit at the target.
+
+    Seen straight on, the split's triangles and the exact patch of a quad off its plane meet each pixel's ray at
+    points that differ along the normal only, so the error map holds the shift without parallax.
 
     The distance gives ``PIXELS_PER_TEXEL`` pixels per texel where the quad has uv, but zooms in no further than
     a diagonal of ``DIAGONAL_PANELS`` panels (``size`` pixels) and zooms out no further than ``camera`` did.
@@ -117,7 +138,7 @@ def defect_camera(camera: tuple, defect: Defect, size: int) -> tuple[tuple, floa
     eye, target, fov = camera
     direction = np.subtract(eye, target)
     current = float(np.linalg.norm(direction))
-    direction = direction / current
+    direction = defect.normal if direction @ defect.normal >= 0 else -defect.normal
     span = 2 * np.tan(np.radians(fov) / 2)  # world height at distance 1
 
     def distance(pixels_per_unit: float) -> float:
