@@ -767,12 +767,13 @@ def closeup(mesh: Mesh, place, settings: Settings, size: int = CLOSEUP_SIZE, pix
     at the defect's scale (:func:`affinity.draw.defect.defect_camera`); without a texture its lines are spaced
     at twice the shift, so the kink at the diagonal is larger than the spacing."""
     from .defect import defect_camera, face_defect, turned_face
-    from .texture import LINE_SPACING
+    from .texture import LINE_SPACING, load_image
 
     view, framed_faces = framed_view(mesh, place.faces, place.worst)
     paint = _paint(mesh, place.code, texture)
     texture_size = _texture_size(paint, settings)
-    defect = (face_defect(mesh, place.worst, paint.show, texture_size, settings.diagonal)
+    defect = (face_defect(mesh, place.worst, paint.show, texture_size, settings.diagonal,
+                          load_image(paint.image_file) if paint.image_file and paint.show == "uv" else None)
               if RULES[place.code].scored else None)
     line_footprint = None
     drawn_mesh = mesh

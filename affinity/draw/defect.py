@@ -76,8 +76,8 @@ def split_attribute(plane: np.ndarray, attrs: np.ndarray, points: np.ndarray) ->
     return w0[:, None] * attrs[0] + w2[:, None] * attrs[2] + w3[:, None] * attrs[other[:, 0]], inside
 
 
-def quad_defect(corners: np.ndarray, attrs: np.ndarray, scale: np.ndarray, uv_texels: np.ndarray | None = None
-                ) -> Defect:
+def quad_defect(corners: np.ndarray, attrs: np.ndarray, scale: np.ndarray, uv_texels: np.ndarray | None = None,
+                image: np.ndarray | None = None) -> Defect:
     """The :class:`Defect` of one quad.
 
     Parameters
@@ -86,6 +86,9 @@ def quad_defect(corners: np.ndarray, attrs: np.ndarray, scale: np.ndarray, uv_te
     attrs : (4, K) float64 attribute at the corners (uv, colours)
     scale : (K,) float64, the attribute's unit per component (texture width, height for uv; 255 for colours)
     uv_texels : (4, 2) float64 uv in texels, for the texel's world length (None: NaN)
+    image : (H, W, 3) the texture ``attrs`` (uv) read, or None. With it the point is where the two *look* most
+        different (the texture sampled bilinearly through split and exact uv, the largest channel difference),
+        since a large shift over a flat stretch of texture shows nothing; ``shift`` stays the quad's largest.
 
     The split's attribute at each sample is barycentric in its triangle of the quad's corners projected on
     the quad's best-fit plane; the exact one the bilinear P(s, t) (Bloomenthal 2022, eq. 1).
@@ -93,19 +96,23 @@ def quad_defect(corners: np.ndarray, attrs: np.ndarray, scale: np.ndarray, uv_te
     centre = corners.mean(axis=0)
     _, _, axes = np.linalg.svd(corners - centre)
     plane = (corners - centre) @ axes[:2].T  # (4, 2)
-    step = 1.0 / (SAMPLES - 1)
-    low, high = np.zeros(2), np.ones(2)
-    for _ in range(2):  # the grid, then a grid as fine again around its best sample
-        s, t = (g.ravel() for g in np.meshgrid(np.linspace(low[0], high[0], SAMPLES),
-                                               np.linspace(low[1], high[1], SAMPLES)))
+
+    def difference(s: np.ndarray, t: np.ndarray, through_image: bool = False) -> np.ndarray:
         exact = _bilinear(attrs, s, t)
         split, inside = split_attribute(plane, attrs, _bilinear(plane, s, t))
-        difference = np.where(inside, np.linalg.norm((split - exact) * scale, axis=1), 0.0)
-        k = int(np.argmax(difference))
-        low, high = np.maximum([s[k] - step, t[k] - step], 0), np.minimum([s[k] + step, t[k] + step], 1)
-        step *= 2 / (SAMPLES - 1)
-    st = np.array([s[k], t[k]])
-    point = _bilinear(corners, s[k:k + 1], t[k:k + 1])[0]
+        if through_image:
+            from ..textures.filtering import sample_bilinear
+
+            apart = np.abs(sample_bilinear(image, split) - sample_bilinear(image, exact)).max(axis=1)
+        else:
+            apart = np.linalg.norm((split - exact) * scale, axis=1)
+        return np.where(inside, apart, 0.0)
+
+    st, shift = _largest(difference)
+    if image is not None:
+        seen_at, seen = _largest(lambda s, t: difference(s, t, True))
+        st = seen_at if seen > 0 else st
+    point = _bilinear(corners, st[:1], st[1:])[0]
     texel = np.nan
     if uv_texels is not None:
         uv_area = abs(_area(uv_texels))
@@ -116,7 +123,22 @@ def quad_defect(corners: np.ndarray, attrs: np.ndarray, scale: np.ndarray, uv_te
     edges = np.roll(plane, -1, axis=0) - plane
     turns = edges[:, 0] * np.roll(edges, -1, axis=0)[:, 1] - edges[:, 1] * np.roll(edges, -1, axis=0)[:, 0]
     folded = bool((np.sign(turns) != np.sign(_area(plane))).any())
-    return Defect(point, st, float(difference[k]), texel, float(lengths[0]), axes[2], bend, folded)
+    return Defect(point, st, shift, texel, float(lengths[0]), axes[2], bend, folded)
+
+
+def _largest(measure) -> tuple[np.ndarray, float]:
+    """(2,) (s, t) and the value of the largest of ``measure(s, t)`` ((N,) float64 of (N,) s and t) over a
+    ``SAMPLES`` x ``SAMPLES`` grid of the unit square, then over as fine a grid again around its best sample."""
+    step = 1.0 / (SAMPLES - 1)
+    low, high = np.zeros(2), np.ones(2)
+    for _ in range(2):
+        s, t = (g.ravel() for g in np.meshgrid(np.linspace(low[0], high[0], SAMPLES),
+                                               np.linspace(low[1], high[1], SAMPLES)))
+        values = measure(s, t)
+        k = int(np.argmax(values))
+        low, high = np.maximum([s[k] - step, t[k] - step], 0), np.minimum([s[k] + step, t[k] + step], 1)
+        step *= 2 / (SAMPLES - 1)
+    return np.array([s[k], t[k]]), float(values[k])
 
 
 def _area(polygon: np.ndarray) -> float:
@@ -151,12 +173,14 @@ def defect_camera(camera: tuple, defect: Defect, size: int) -> tuple[tuple, floa
     return (tuple(eye.tolist()), tuple(defect.point.tolist()), fov), size / (span * far)
 
 
-def face_defect(mesh, face: int, show: str, texture_size, diagonal: str = "02") -> Defect | None:
+def face_defect(mesh, face: int, show: str, texture_size, diagonal: str = "02",
+                image: np.ndarray | None = None) -> Defect | None:
     """The :class:`Defect` of ``mesh``'s quad ``face`` for the attribute ``show`` (``"uv"`` with the texture's
     ``texture_size`` (width, height) in texels, or ``"color"``); None for another face or attribute.
 
     ``diagonal`` is the check's setting: ``"02"``, ``"13"``, ``"shortest"`` (the shorter in 3-D) or ``"both"``
-    (the one whose crease is larger, the one the finding reads)."""
+    (the one whose crease is larger, the one the finding reads); ``image`` (H, W, 3) the texture the uv reads, if
+    it decodes (:func:`quad_defect`)."""
     if mesh.face_sizes[face] != 4:
         return None
     corners_at = np.arange(mesh.face_start[face], mesh.face_start[face] + 4)
@@ -164,15 +188,15 @@ def face_defect(mesh, face: int, show: str, texture_size, diagonal: str = "02") 
     if show == "uv" and mesh.texcoords is not None and (mesh.corner_texcoord[corners_at] >= 0).all():
         uv = mesh.texcoords[mesh.corner_texcoord[corners_at]]
         size = np.asarray(texture_size, dtype=np.float64)
-        attrs, scale, uv_texels = uv, size, uv * size
+        attrs, scale, uv_texels, look = uv, size, uv * size, image
     elif show == "color" and mesh.colors is not None:
-        attrs, scale, uv_texels = mesh.colors[mesh.corner_vertex[corners_at]], np.full(3, 255.0), None
+        attrs, scale, uv_texels, look = mesh.colors[mesh.corner_vertex[corners_at]], np.full(3, 255.0), None, None
     else:
         return None
     turned = [1, 2, 3, 0]
-    along = quad_defect(corners, attrs, scale, uv_texels)
+    along = quad_defect(corners, attrs, scale, uv_texels, look)
     across = replace(quad_defect(corners[turned], attrs[turned], scale, None if uv_texels is None
-                                 else uv_texels[turned]), across=True)
+                                 else uv_texels[turned], look), across=True)
     lengths = np.linalg.norm(corners[[2, 3]] - corners[[0, 1]], axis=1)
     pick = {"02": along, "13": across, "shortest": along if lengths[0] <= lengths[1] else across,
             "both": across if across.shift > along.shift else along}
