@@ -24,6 +24,10 @@ MESHES = {
     "makehuman": SHARED_MESHES / "makehuman_base_hm08.obj",
     "uv sphere": SHARED_MESHES / "gen_uv_sphere_64x32.obj",
 }
+#: Every other shared mesh with a Q101 or Q102 finding (``affinity check ../shared/meshes``).
+OTHERS = {name: SHARED_MESHES / name for name in (
+    "spot_control_mesh.obj", "gen_spot_cc4.obj", "gen_vase_revolution.obj", "osd_catmark_bishop.obj",
+    "osd_catmark_torus.obj", "tinyobjloader_cube_vertexcol.obj")}
 #: Close-ups tested per mesh (the worst places, as the report picks them); more under ``-m slow``.
 FAST, SLOW = 2, 6
 STEP, BLOCK, MOVE = 8, 5, 4
@@ -148,10 +152,15 @@ def test_closeups_show_the_crease_on_the_flagged_quad(mesh):
         _check(drawn, view)
 
 
+#: Known gaps: a folded quad (Spot's face 37 bends 112 degrees; one of Spot cc4's) whose lines do not move 4 px.
+FOLDED = pytest.mark.xfail(strict=True, reason="a sharply folded quad's crease is not framed yet (issue 57)")
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize("mesh", list(MESHES))
+@pytest.mark.parametrize("mesh", [*MESHES, *(pytest.param(name, marks=FOLDED) if name in (
+    "spot_control_mesh.obj", "gen_spot_cc4.obj") else name for name in OTHERS)])
 def test_every_closeup_of_a_report_shows_the_crease_on_the_flagged_quad(mesh):
-    for drawn, view in _closeups(MESHES[mesh], SLOW)[FAST:]:
+    for drawn, view in _closeups({**MESHES, **OTHERS}[mesh], SLOW)[FAST if mesh in MESHES else 0:]:
         _check(drawn, view)
 
 

@@ -726,15 +726,28 @@ def _area(mesh: Mesh, faces: np.ndarray) -> float:
     return float(np.linalg.norm(vector_areas(mesh, faces), axis=1).sum() / 2)
 
 
-def _zoom(panels: _Panels, texture_size: tuple) -> float:
-    """On-screen pixels per texel on the place's pixels of the exact panel: one over the median footprint of a
-    pixel in texels (the mean of its u and v steps); NaN where none is measured."""
+def _zoom(panels: _Panels, texture_size: tuple, face: int) -> float:
+    """On-screen pixels per texel on the pixels of ``face`` (an index into the drawn faces) in the exact panel:
+    one over the median footprint of a pixel in texels (the mean of its u and v steps); NaN where none is
+    measured."""
     from .texture import local_footprints
 
-    frame, _ = panels.frames["exact"]
-    steps = (local_footprints(frame.attrs) * np.asarray(texture_size, dtype=np.float64))[panels.own].mean(axis=-1)
+    frame, faces = panels.frames["exact"]
+    steps = (local_footprints(frame.attrs) * np.asarray(texture_size, dtype=np.float64))[faces == face].mean(axis=-1)
     steps = steps[np.isfinite(steps) & (steps > 0)]
     return float(1 / np.median(steps)) if len(steps) else float("nan")
+
+
+def _spaced_lines(mesh: Mesh, code: str, texture: str | None, shift: float, pixels_per_texel: float,
+                  texture_size: tuple) -> tuple[_Paint, float]:
+    """The line pattern spaced at twice the ``shift`` (texels), kept between ``LINE_SPACING`` and
+    ``WIDEST_LINES`` pixels at ``pixels_per_texel``: its :class:`_Paint` and footprint (uv per sixth of a
+    spacing, as :func:`affinity.draw.texture.line_colours` takes it)."""
+    from .texture import LINE_SPACING
+
+    texels = float(np.clip(2 * shift, LINE_SPACING / pixels_per_texel, WIDEST_LINES / pixels_per_texel))
+    paint = _paint(mesh, code, texture, f"{texels:.3g} texels" + (" (twice the shift)" if texels == 2 * shift else ""))
+    return paint, texels / float(np.sqrt(np.prod(texture_size))) / LINE_SPACING
 
 
 def _scale_words(place, largest: float, unit: str, defect) -> str:
@@ -767,7 +780,7 @@ def closeup(mesh: Mesh, place, settings: Settings, size: int = CLOSEUP_SIZE, pix
     at the defect's scale (:func:`affinity.draw.defect.defect_camera`); without a texture its lines are spaced
     at twice the shift, so the kink at the diagonal is larger than the spacing."""
     from .defect import defect_camera, face_defect, turned_face
-    from .texture import LINE_SPACING, load_image
+    from .texture import load_image
 
     view, framed_faces = framed_view(mesh, place.faces, place.worst)
     paint = _paint(mesh, place.code, texture)
@@ -784,12 +797,16 @@ def closeup(mesh: Mesh, place, settings: Settings, size: int = CLOSEUP_SIZE, pix
             drawn_mesh = turned_face(mesh, place.worst)
         pixels_per_texel = pixels_per_unit * defect.texel
         if paint.lines and defect.shift > 0 and pixels_per_texel > 0:
-            texels = float(np.clip(2 * defect.shift, LINE_SPACING / pixels_per_texel, WIDEST_LINES / pixels_per_texel))
-            line_footprint = texels / float(np.sqrt(np.prod(texture_size))) / LINE_SPACING
-            paint = _paint(mesh, place.code, texture, f"{texels:.3g} texels" + (
-                " (twice the shift)" if texels == 2 * defect.shift else ""))
+            paint, line_footprint = _spaced_lines(mesh, place.code, texture, defect.shift, pixels_per_texel,
+                                                  texture_size)
     panels = _panels(drawn_mesh, place.faces, place.worst, view, paint, settings, size, pixel_tolerance,
                      line_footprint)
+    if line_footprint is not None:  # a bent or folded quad's texel estimate can be far off: measure, redraw
+        measured = _zoom(panels, texture_size, int(np.searchsorted(view.drawn, place.worst)))
+        if np.isfinite(measured) and not 0.5 <= measured / pixels_per_texel <= 2:
+            paint, line_footprint = _spaced_lines(mesh, place.code, texture, defect.shift, measured, texture_size)
+            panels = _panels(drawn_mesh, place.faces, place.worst, view, paint, settings, size, pixel_tolerance,
+                             line_footprint)
     errors = _error_map(panels, paint, settings)
     place_pixels = int(panels.own.sum())
     sliver = _area(mesh, place.faces) < SLIVER_AREA * _area(mesh, view.ring)
@@ -807,7 +824,7 @@ def closeup(mesh: Mesh, place, settings: Settings, size: int = CLOSEUP_SIZE, pix
         crease = (f"Centred on the point of face {place.worst} where split and exact differ most "
                   f"({defect.shift:.3g} {errors.unit}, the split along {'1-3' if defect.across else '0-2'})")
         if paint.show == "uv":
-            zoom = _zoom(panels, texture_size)
+            zoom = _zoom(panels, texture_size, int(np.searchsorted(view.drawn, place.worst)))
             crease += f", 1 texel = {zoom:.2g} px"
         # the worst face's pixels but its edge, where a pixel of one face's split meets the other's patch
         worst = errors.covered & _shrunk(panels.frames["split"][1] == np.searchsorted(view.drawn, place.worst), 1)
