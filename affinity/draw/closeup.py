@@ -738,6 +738,11 @@ def _zoom(panels: _Panels, texture_size: tuple, face: int) -> float:
     return float(1 / np.median(steps)) if len(steps) else float("nan")
 
 
+def _face_pixels(panels: _Panels, view: CloseupView, face: int) -> int:
+    """The pixels mesh face ``face`` covers in the split panel of ``view``."""
+    return int((panels.frames["split"][1] == np.searchsorted(view.drawn, face)).sum())
+
+
 def _spaced_lines(mesh: Mesh, code: str, texture: str | None, shift: float, pixels_per_texel: float,
                   texture_size: tuple) -> tuple[_Paint, float]:
     """The line pattern spaced at twice the ``shift`` (texels), kept between ``LINE_SPACING`` and
@@ -783,6 +788,7 @@ def closeup(mesh: Mesh, place, settings: Settings, size: int = CLOSEUP_SIZE, pix
     from .texture import load_image
 
     view, framed_faces = framed_view(mesh, place.faces, place.worst)
+    place_view = view
     paint = _paint(mesh, place.code, texture)
     texture_size = _texture_size(paint, settings)
     defect = (face_defect(mesh, place.worst, paint.show, texture_size, settings.diagonal,
@@ -801,12 +807,10 @@ def closeup(mesh: Mesh, place, settings: Settings, size: int = CLOSEUP_SIZE, pix
                                                   texture_size)
     panels = _panels(drawn_mesh, place.faces, place.worst, view, paint, settings, size, pixel_tolerance,
                      line_footprint)
-    if line_footprint is not None:  # a bent or folded quad's texel estimate can be far off: measure, redraw
-        measured = _zoom(panels, texture_size, int(np.searchsorted(view.drawn, place.worst)))
-        if np.isfinite(measured) and not 0.5 <= measured / pixels_per_texel <= 2:
-            paint, line_footprint = _spaced_lines(mesh, place.code, texture, defect.shift, measured, texture_size)
-            panels = _panels(drawn_mesh, place.faces, place.worst, view, paint, settings, size, pixel_tolerance,
-                             line_footprint)
+    if defect is not None and _face_pixels(panels, view, place.worst) < SLIVER_PIXELS:
+        # Seen along its normal a sharply folded quad can hide itself: keep the framing on the place instead
+        view, paint, defect = place_view, _paint(mesh, place.code, texture), None
+        panels = _panels(mesh, place.faces, place.worst, view, paint, settings, size, pixel_tolerance)
     errors = _error_map(panels, paint, settings)
     place_pixels = int(panels.own.sum())
     sliver = _area(mesh, place.faces) < SLIVER_AREA * _area(mesh, view.ring)
