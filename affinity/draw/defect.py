@@ -1,9 +1,10 @@
 """Where a flagged quad's crease is: the point where the split and the exact attribute differ most.
 
-A close-up is framed on this point, at the defect's own scale (:func:`defect_camera`): the split (diagonal
-0-2, as the renderer draws it) against the quad's bilinear interpolation (Bloomenthal 2022, §2), sampled
-densely over the quad's parameters (s, t) rather than taken from the closed form, so a quad off its plane
-or with a reflex corner is measured as drawn.
+A close-up is framed on this point, at the defect's own scale (:func:`defect_camera`): the split (along the
+diagonal the finding reads; :func:`turned_face` lets the renderer, which splits along 0-2, draw a 1-3 split)
+against the quad's bilinear interpolation (Bloomenthal 2022, §2), sampled densely over the quad's parameters
+(s, t) rather than taken from the closed form, so a quad off its plane or with a reflex corner is measured as
+drawn. Through a decoded texture the point is where the two look most different instead.
 """
 
 from __future__ import annotations
@@ -24,7 +25,8 @@ DIAGONAL_PANELS = 2.0
 class Defect:
     """The crease of one quad.
 
-    point : (3,) float64, the surface point P(s, t) where split and exact differ most
+    point : (3,) float64, the surface point P(s, t) where split and exact differ most (through the texture
+        where one is given, :func:`quad_defect`)
     st : (2,) float64, its parameters
     shift : the largest difference, in the rule's unit (texels for uv, 1/255 for colours)
     texel : the world length of one texel there (sqrt of the area ratio; NaN without uv)
