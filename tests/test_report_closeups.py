@@ -157,7 +157,9 @@ def test_a_place_an_earlier_closeup_shows_gets_no_closeup_of_its_own(tmp_path):
         first = result.closeups[0]
         other = next(p for p in result.places if p is not first.place)
         assert (other.worst in first.seen) == (len(result.closeups) == 1)
-    assert counts == [1, 2]
+    # Far apart, each gets its own. Side by side, the first close-up is zoomed on its crease (issue 57): whether
+    # the neighbour still covers SEEN_PIXELS there decides, as asserted per case above.
+    assert counts[1] == 2
 
 
 def test_closeup_camera_looks_at_the_place_along_its_normal_and_fits_its_ring():
@@ -205,18 +207,20 @@ def test_a_long_place_is_framed_on_its_worst_face_and_a_compact_one_whole(tmp_pa
     first, share = _worst_face_share(tmp_path, [(15, c) for c in range(3, 27)])
     assert len(first.place.faces) == 24
     worst = divmod(first.place.worst, 30)
-    np.testing.assert_allclose(first.view.camera[1], [worst[1] + 0.5, worst[0] + 0.5, 0.0])
+    target = np.asarray(first.view.camera[1])  # on the worst quad (its crease, issue 57)
+    assert worst[1] <= target[0] <= worst[1] + 1 and worst[0] <= target[1] <= worst[0] + 1 and target[2] == 0
     radius = RING_RADII * np.sqrt(0.5)  # the ring reaches farther (1.5 sqrt 2) than twice the quad's own radius
     half = np.radians(CLOSEUP_FOV / 2)
     distance = radius / (FILL * np.sin(half))
     expected = (1 / (2 * np.tan(half) * distance)) ** 2 * np.cos(np.radians(TILT_DEGREES))
-    assert share == pytest.approx(expected, rel=0.15)
+    assert share >= expected * 0.85  # zoomed on the worst quad's crease (issue 57), it covers at least that
     assert first.framed == f"face {first.place.worst} and its neighbours"
 
     # A pair framed whole is sqrt(5) / sqrt(2) as wide as its worst quad's frame (twice its own radius, sqrt(5) / 2,
     # against twice the quad's): framed whole, around the pair's centre.
     pair, _ = _worst_face_share(tmp_path, [(15, 14), (15, 15)])
-    np.testing.assert_allclose(pair.view.camera[1], [15.0, 15.5, 0.0])
+    target = np.asarray(pair.view.camera[1])  # then zoomed on the worst quad's crease (issue 57)
+    assert 14 <= target[0] <= 16 and 15 <= target[1] <= 16 and target[2] == 0
     assert pair.framed == "the place's faces and their neighbours"
 
 
@@ -399,10 +403,10 @@ def test_amplified_uv_moves_the_split_s_texture_by_gain_times_its_error():
     np.testing.assert_array_equal(uv[~same], exact[~same])
 
 
-def test_a_sub_pixel_uv_crease_gets_an_amplified_panel_whose_lines_kink_more(tmp_path):
-    """One quad's corner uv pushed by 2 texels: the split's error is under a pixel in the close-up, and the
-    panel with the uv error amplified moves the lines at least half as much again (ink moved, summed)."""
-    from affinity.draw.shading import OVERLAY_TINT
+def test_a_sub_texel_uv_crease_is_zoomed_until_its_lines_move_by_pixels(tmp_path):
+    """One quad's corner uv pushed by 2 texels (a 0.71-texel crease): the close-up zooms on it (issue 57) to
+    8 px per texel, capped where the quad's diagonal spans two panels (145 texels: 3.3 px per texel), so the
+    split moves its lines by over 2 pixels and no amplified panel is needed."""
     from affinity.report.build import ReportOptions, collect_mesh
     from affinity.report.demo import MeshInput
     from affinity.settings import Settings
@@ -414,13 +418,10 @@ def test_a_sub_pixel_uv_crease_gets_an_amplified_panel_whose_lines_kink_more(tmp
     result = collect_mesh(MeshInput(str(tmp_path / "faint_uv.obj"), "faint_uv.obj"), Settings(),
                           options=ReportOptions(max_views=1))
     (view,) = result.closeups
-    assert view.place.code == "Q101" and view.gain > 1 and view.amplified_label == f"split, its uv error ×{view.gain:g}"
-    split, exact = view.images["split"], view.images["exact"]
-    inside = view.covered & ~(split == OVERLAY_TINT).all(axis=-1)
-    assert view.error.max() < 1.0  # texels, and a texel is about a pixel here
-    moved_true = np.abs(split - exact)[inside].sum()
-    moved_amplified = np.abs(view.amplified - exact)[inside].sum()
-    assert moved_true > 0 and moved_amplified > 1.5 * moved_true
+    assert view.place.code == "Q101" and view.gain == 1 and view.amplified is None
+    diagonal = np.hypot(1024 / 10, 1024 / 10)  # texels: the grid's quads are a tenth of the texture wide
+    assert view.zoom == pytest.approx(2 * 240 / diagonal, rel=0.1)
+    assert view.error[view.covered].max() * view.zoom > 2  # pixels
 
 
 def replace_uv(mesh, uv):

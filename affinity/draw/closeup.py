@@ -90,6 +90,17 @@ GAIN_STEPS = (1, 2, 5)
 #: A colour or normal crease whose largest change on the place is below this (of 1) is under one 8-bit step: the
 #: PNGs round it away, and amplified they show rounding noise, so the close-up has no amplified panel and says why.
 EIGHT_BIT_STEP = 1 / 255
+#: The difference panel draws |split - exact| times the gain (1, 2, 5 times a power of ten) that brings the
+#: place's largest change to at most this (of 1).
+DIFFERENCE_REACH = 1.0
+#: Without a texture the lines are spaced at twice the shift (in texels), but at least ``LINE_SPACING`` and at
+#: most this many pixels apart on screen, so a huge shift still leaves several lines crossing the panel.
+WIDEST_LINES = 40.0
+#: The error map's largest value on the place agrees with the finding's when within this fraction of it.
+SCALE_AGREES = 0.1
+#: ... unless its corners lie farther than this fraction of its diagonal off their plane (then the caption says
+#: the error map holds parallax too).
+BENT = 0.05
 
 
 # -- Framing ---------------------------------------------------------------------------------------------------
@@ -469,6 +480,9 @@ class Closeup:
     texture : what the panels are drawn with, in words
     framed : what the camera is framed on, in words
     images : method -> (S, S, 3) float RGB, the place outlined in the flag colour
+    difference : (S, S, 3) float32, ``|split - exact|`` times ``difference_gain`` (None without an attribute)
+    zoom : on-screen pixels per texel on the worst face's crease (uv), NaN where not measured
+    crease : the caption's words on the crease framed: where, its shift, the zoom, the error map against the finding
     error : (S, S) float64 split error against exact in ``unit`` (None without an attribute or exact)
     covered : (S, S) bool, the pixels where split and exact show the same face
     own : (S, S) bool, the pixels where the split picture shows the place's faces
@@ -496,6 +510,10 @@ class Closeup:
     amplified_label: str = ""
     amplified_note: str = ""
     seen: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    difference: np.ndarray | None = None
+    difference_gain: float = 1.0
+    zoom: float = float("nan")
+    crease: str = ""
 
     @property
     def place_pixels(self) -> int:
@@ -524,9 +542,9 @@ class _Paint:
     label: str
 
 
-def _paint(mesh: Mesh, code: str, texture: str | None) -> _Paint:
+def _paint(mesh: Mesh, code: str, texture: str | None, spacing: str | None = None) -> _Paint:
     """How a close-up of rule ``code``'s place on ``mesh`` is painted; ``texture`` is ``--texture``, overriding
-    map_Kd."""
+    map_Kd; ``spacing`` says how far apart the lines are (default ``LINE_SPACING`` pixels)."""
     from ..textures.decode import why_not_decoded
     from .texture import GLYPH_SPACING, LINE_SPACING, painted_texture
 
@@ -539,7 +557,7 @@ def _paint(mesh: Mesh, code: str, texture: str | None) -> _Paint:
     if show == "uv" and image_file:
         label = f"texture {os.path.basename(image_file)}" + ("" if texture else " (map_Kd)")
     elif lines:
-        label = f"lines of constant u (blue) and v (red) {LINE_SPACING:g} pixels apart" + (
+        label = f"lines of constant u (blue) and v (red) {spacing or f'{LINE_SPACING:g} pixels'} apart" + (
             f", and an upright F every {GLYPH_SPACING:g} pixels in uv: where it reads mirrored, so is the texture"
             if mirroring else "") + ("" if refused is None else f" (map_Kd {os.path.basename(path)} is not drawn: "
                                                                  f"{refused})")
@@ -588,8 +606,9 @@ class _Panels:
 
 
 def _panels(mesh: Mesh, faces: np.ndarray, worst: int, view: CloseupView, paint: _Paint, settings: Settings,
-            size: int, pixel_tolerance: float) -> _Panels:
-    """Split | hybrid | exact of ``view``, the place ``faces`` outlined; routed by ``settings``."""
+            size: int, pixel_tolerance: float, line_footprint: float | None = None) -> _Panels:
+    """Split | hybrid | exact of ``view``, the place ``faces`` outlined; routed by ``settings``; the line pattern
+    at ``line_footprint`` (uv per ``LINE_SPACING`` th of a line's spacing; None: the place's pixel footprint)."""
     from .drawing import RenderOptions, render_mesh
     from .shading import OVERLAY_TINT
     from .texture import glyph_footprints, line_colours, local_footprints, pixel_footprint
@@ -598,7 +617,8 @@ def _panels(mesh: Mesh, faces: np.ndarray, worst: int, view: CloseupView, paint:
     in_place = np.isin(view.drawn, faces)
     fold = paint.show == "fold"
     images, plain, frames = {}, {}, {}
-    own = edge_of_own = seen = footprint = glyphs = None
+    own = edge_of_own = seen = glyphs = None
+    footprint = line_footprint
     for method in CLOSEUP_METHODS:
         # With the line pattern, the render's own texture is replaced pixel by pixel: a 1-texel one costs nothing.
         # A fold's positions ride through the rasterizer as colours (scaled alike on every axis).
@@ -644,10 +664,16 @@ class _ErrorMap:
     note: str = ""
 
 
+def _texture_size(paint: _Paint, settings: Settings) -> tuple:
+    """(width, height) in texels of the texture the panels draw, else the texture-size setting's square."""
+    from ..loaders.imagesize import image_size
+
+    return (image_size(paint.image_file) if paint.image_file else None) or (settings.texture_size,) * 2
+
+
 def _error_map(panels: _Panels, paint: _Paint, settings: Settings) -> _ErrorMap:
     """The split's error against exact on the panels of an attribute (none for a fold or shading)."""
     from ..attributes import pixel_error
-    from ..loaders.imagesize import image_size
     from .shading import OVERLAY_TINT
     from .texture import line_colours, load_image, local_footprints, sample_bilinear
 
@@ -656,7 +682,7 @@ def _error_map(panels: _Panels, paint: _Paint, settings: Settings) -> _ErrorMap:
         return _ErrorMap()
     (split, split_face), (exact, exact_face) = panels.frames["split"], panels.frames["exact"]
     covered = (split_face >= 0) & (split_face == exact_face)
-    texture_size = (image_size(paint.image_file) if paint.image_file else None) or (settings.texture_size,) * 2
+    texture_size = _texture_size(paint, settings)
     error = np.zeros(covered.shape)
     error[covered] = pixel_error(split.attrs[covered], exact.attrs[covered], attribute.field, texture_size)
     code = next(code for code, rule in RULES.items() if rule.scored and rule.attribute == attribute.field)
@@ -685,19 +711,106 @@ def _error_map(panels: _Panels, paint: _Paint, settings: Settings) -> _ErrorMap:
     return _ErrorMap(error, covered, unit, amplified, gain, f"split, {what} ×{gain:g}")
 
 
+def difference_panel(split: np.ndarray, exact: np.ndarray, same: np.ndarray,
+                     place: np.ndarray | None = None) -> tuple[np.ndarray, float]:
+    """(S, S, 3) float32 ``|split - exact| * gain`` in [0, 1] where ``same`` (S, S) bool, black elsewhere, of the
+    panels ``split``, ``exact`` (S, S, 3) float RGB, and the gain (:func:`gain_for` of the largest change on the
+    ``place`` (S, S) bool, at ``DIFFERENCE_REACH``)."""
+    gain = gain_for(largest_change(split, exact, same, place), DIFFERENCE_REACH)
+    image = np.where(same[..., None], np.abs(split - exact) * gain, 0.0)
+    return np.clip(image, 0.0, 1.0).astype(np.float32), gain
+
+
 def _area(mesh: Mesh, faces: np.ndarray) -> float:
     """The total area of ``faces`` (F,) int64."""
     return float(np.linalg.norm(vector_areas(mesh, faces), axis=1).sum() / 2)
+
+
+def _zoom(panels: _Panels, texture_size: tuple, face: int) -> float:
+    """On-screen pixels per texel on the pixels of ``face`` (an index into the drawn faces) in the exact panel:
+    one over the median footprint of a pixel in texels (the mean of its u and v steps); NaN where none is
+    measured."""
+    from .texture import local_footprints
+
+    frame, faces = panels.frames["exact"]
+    steps = (local_footprints(frame.attrs) * np.asarray(texture_size, dtype=np.float64))[faces == face].mean(axis=-1)
+    steps = steps[np.isfinite(steps) & (steps > 0)]
+    return float(1 / np.median(steps)) if len(steps) else float("nan")
+
+
+def _face_pixels(panels: _Panels, view: CloseupView, face: int) -> int:
+    """The pixels mesh face ``face`` covers in the split panel of ``view``."""
+    return int((panels.frames["split"][1] == np.searchsorted(view.drawn, face)).sum())
+
+
+def _spaced_lines(mesh: Mesh, code: str, texture: str | None, shift: float, pixels_per_texel: float,
+                  texture_size: tuple) -> tuple[_Paint, float]:
+    """The line pattern spaced at twice the ``shift`` (texels), kept between ``LINE_SPACING`` and
+    ``WIDEST_LINES`` pixels at ``pixels_per_texel``: its :class:`_Paint` and footprint (uv per sixth of a
+    spacing, as :func:`affinity.draw.texture.line_colours` takes it)."""
+    from .texture import LINE_SPACING
+
+    texels = float(np.clip(2 * shift, LINE_SPACING / pixels_per_texel, WIDEST_LINES / pixels_per_texel))
+    paint = _paint(mesh, code, texture, f"{texels:.3g} texels" + (" (twice the shift)" if texels == 2 * shift else ""))
+    return paint, texels / float(np.sqrt(np.prod(texture_size))) / LINE_SPACING
+
+
+def _scale_words(place, largest: float, unit: str, defect) -> str:
+    """The caption's words on the error map's scale: the worst face's ``largest`` error in ``unit`` against the
+    finding's shift (``place.shift`` where the finding reads C, else ``place.value``): within ``SCALE_AGREES``
+    of it, or why not (``defect`` the quad's densely sampled crease)."""
+    value = place.shift if np.isfinite(place.shift) else place.value
+    said = f"The error map's largest on face {place.worst}, {largest:.3g} {unit}, "
+    if abs(largest - value) <= SCALE_AGREES * value:
+        return said + f"is within {SCALE_AGREES:.0%} of the finding's shift, {value:.3g} {unit}."
+    if defect.folded:
+        return said + (f"is off the finding's {value:.3g} {unit}: the quad has a reflex or repeated corner, where "
+                       "the finding's closed form bounds the crease and the split draws one triangle outside the "
+                       "quad or none.")
+    if defect.bend > BENT:
+        return said + (f"is off the finding's {value:.3g} {unit}: the quad bends {defect.bend:.0%} of its diagonal "
+                       "off its plane, so on screen the split's triangles and the exact patch lie apart and the "
+                       "error map adds their parallax to the shift.")
+    return said + (f"is off the finding's {value:.3g} {unit}: the quad's crease, sampled densely, is "
+                   f"{defect.shift:.3g} along the diagonal drawn.")
 
 
 def closeup(mesh: Mesh, place, settings: Settings, size: int = CLOSEUP_SIZE, pixel_tolerance: float = 0.5,
             texture: str | None = None) -> Closeup:
     """Frame, draw and measure one ``place`` (its rule ``code``, ``faces`` (P,) int64 and ``worst`` face; see the
     module docstring), the hybrid routed by ``settings`` (the caller's, resolved once); ``texture`` is
-    ``--texture``, overriding map_Kd."""
+    ``--texture``, overriding map_Kd.
+
+    A uv or colour close-up is then re-aimed at the worst quad's crease (:func:`affinity.draw.defect.face_defect`)
+    at the defect's scale (:func:`affinity.draw.defect.defect_camera`); without a texture its lines are spaced
+    at twice the shift, so the kink at the diagonal is larger than the spacing."""
+    from .defect import defect_camera, face_defect, turned_face
+    from .texture import load_image
+
     view, framed_faces = framed_view(mesh, place.faces, place.worst)
+    place_view = view
     paint = _paint(mesh, place.code, texture)
-    panels = _panels(mesh, place.faces, place.worst, view, paint, settings, size, pixel_tolerance)
+    texture_size = _texture_size(paint, settings)
+    defect = (face_defect(mesh, place.worst, paint.show, texture_size, settings.diagonal,
+                          load_image(paint.image_file) if paint.image_file and paint.show == "uv" else None)
+              if RULES[place.code].scored else None)
+    line_footprint = None
+    drawn_mesh = mesh
+    if defect is not None:
+        camera, pixels_per_unit = defect_camera(view.camera, defect, size)
+        view = replace(view, camera=camera, up="xyz"[int(np.argmin(np.abs(np.subtract(camera[0], camera[1]))))])
+        if defect.across:  # the finding's crease is the split along 1-3: the renderer draws 0-2, so turn the quad
+            drawn_mesh = turned_face(mesh, place.worst)
+        pixels_per_texel = pixels_per_unit * defect.texel
+        if paint.lines and defect.shift > 0 and pixels_per_texel > 0:
+            paint, line_footprint = _spaced_lines(mesh, place.code, texture, defect.shift, pixels_per_texel,
+                                                  texture_size)
+    panels = _panels(drawn_mesh, place.faces, place.worst, view, paint, settings, size, pixel_tolerance,
+                     line_footprint)
+    if defect is not None and _face_pixels(panels, view, place.worst) < SLIVER_PIXELS:
+        # Seen along its normal a sharply folded quad can hide itself: keep the framing on the place instead
+        view, paint, defect = place_view, _paint(mesh, place.code, texture), None
+        panels = _panels(mesh, place.faces, place.worst, view, paint, settings, size, pixel_tolerance)
     errors = _error_map(panels, paint, settings)
     place_pixels = int(panels.own.sum())
     sliver = _area(mesh, place.faces) < SLIVER_AREA * _area(mesh, view.ring)
@@ -707,7 +820,22 @@ def closeup(mesh: Mesh, place, settings: Settings, size: int = CLOSEUP_SIZE, pix
                    f"from every side tried (fewer than {PLACE_FLOOR * size * size:.0f}), so it is not drawn")
     framed = ("the place's faces and their neighbours" if len(framed_faces) > 1
               else f"face {place.worst} and its neighbours")
+    difference, difference_gain, zoom, crease = None, 1.0, float("nan"), ""
+    if errors.error is not None:
+        difference, difference_gain = difference_panel(panels.plain["split"], panels.plain["exact"],
+                                                       errors.covered, panels.own)
+    if defect is not None:
+        crease = (f"Centred on the point of face {place.worst} where split and exact differ most "
+                  f"({defect.shift:.3g} {errors.unit}, the split along {'1-3' if defect.across else '0-2'})")
+        if paint.show == "uv":
+            zoom = _zoom(panels, texture_size, int(np.searchsorted(view.drawn, place.worst)))
+            crease += f", 1 texel = {zoom:.2g} px"
+        # the worst face's pixels but its edge, where a pixel of one face's split meets the other's patch
+        worst = errors.covered & _shrunk(panels.frames["split"][1] == np.searchsorted(view.drawn, place.worst), 1)
+        if errors.error is not None and worst.any():
+            crease += ". " + _scale_words(place, float(errors.error[worst].max()), errors.unit, defect)
     return Closeup(place=place, show=paint.show, texture=paint.label, framed=framed, images=panels.images,
                    error=errors.error, covered=errors.covered, own=panels.own, unit=errors.unit, view=view,
                    dropped=dropped, amplified=errors.amplified, gain=errors.gain, amplified_label=errors.label,
-                   amplified_note=errors.note, seen=panels.seen)
+                   amplified_note=errors.note, seen=panels.seen, difference=difference,
+                   difference_gain=difference_gain, zoom=zoom, crease=crease)

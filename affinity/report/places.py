@@ -41,6 +41,7 @@ class Place:
     beyond : how far beyond the threshold it is, as a ratio >= 1 (inf at a zero value of a lowest-is-worst rule)
     level : the level of the worst face's finding (``error`` above the rule's visibility threshold)
     group : the group of neighbours it was carved from (numbered per rule; -1: a place of its own)
+    shift : where ``value`` is C (Q101 read through a texture), the worst face's shift in texels beside it; else NaN
     """
 
     code: str
@@ -51,6 +52,15 @@ class Place:
     beyond: float
     level: str
     group: int = -1
+    shift: float = float("nan")
+
+
+def read_shifts(hits: RuleHits) -> np.ndarray:
+    """(n,) float64: each finding's shift in texels where its value is C (the visible reading), else NaN."""
+    columns = hits.visible
+    if columns is None:
+        return np.full(len(hits.faces), np.nan)
+    return np.where((columns.picks >= 0) & np.isfinite(columns.shifts), columns.shifts, np.nan)
 
 
 def connected_components(n_items: int, a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -152,9 +162,10 @@ def places_of(mesh: Mesh, hits: RuleHits, limit: int = PLACE_FACES) -> list[Plac
     rule = RULES[hits.code]
     keep = hits.faces >= 0
     # Worst by each value against its own threshold (worst_key): C and the shift are not one unit.
-    faces, values, levels, key = hits.faces[keep], hits.values[keep], hits.levels()[keep], hits.worst_key()[keep]
+    faces, values, levels = hits.faces[keep], hits.values[keep], hits.levels()[keep]
+    key, shifts = hits.worst_key()[keep], read_shifts(hits)[keep]
     order = np.argsort(faces)
-    faces, values, levels, key = faces[order], values[order], levels[order], key[order]
+    faces, values, levels, key, shifts = faces[order], values[order], levels[order], key[order], shifts[order]
     centroids = face_centroids(mesh)
     places = []
     groups = group_faces(mesh, faces)
@@ -168,7 +179,7 @@ def places_of(mesh: Mesh, hits: RuleHits, limit: int = PLACE_FACES) -> list[Plac
             beyond = (hits.threshold / value if value > 0 else np.inf) if rule.worst == "lowest" else (
                 -key[members][k] if hits.ranked_by_ratio else np.inf)
         places.append(Place(hits.code, group, vals, int(group[k]), value, float(beyond), str(levels[members][k]),
-                            number))
+                            number, float(shifts[members][k])))
     places.sort(key=lambda p: (-p.beyond, p.worst))
     return places
 

@@ -420,12 +420,14 @@ def closeups_section(result: MeshResult) -> Section:
                      "bar": heat_bar(scale, f"split error against exact ({view.unit})")}
         amplified = (None if view.amplified is None
                      else {"src": image_uri(view.amplified), "label": view.amplified_label})
+        difference = (None if view.difference is None else {
+            "src": image_uri(view.difference), "label": f"|split − exact| ×{view.difference_gain:g}"})
         figures.append({
-            "amplified": amplified, "amplified_note": view.amplified_note,
+            "amplified": amplified, "difference": difference, "amplified_note": view.amplified_note,
             "face": place.worst, "code": place.code, "name": rule.name, "level": place.level,
             "value": _place_value_text(result, place, unit), "faces": len(place.faces),
             "line": int(mesh.face_line[place.worst]), "group": mesh.group_names[mesh.face_group[place.worst]],
-            "texture": view.texture, "framed": view.framed, "error": error,
+            "texture": view.texture, "framed": view.framed, "crease": view.crease, "error": error,
             "images": [(method, image_uri(image)) for method, image in view.images.items()],
             "camera": ",".join(f"{x:.9g}" for x in (*eye, *target, fov)),
             "up": view.view.up, "place": ",".join(map(str, place.faces.tolist())),
