@@ -129,10 +129,12 @@ def test_every_single_bit_flip_gives_the_fresh_result(filled, library, capsys, c
 
 def _magic_offsets(data: bytes) -> list[int]:
     """Where the stored report blobs start (their magic), in file order."""
-    found, start = [], data.find(b"QAR3")
+    from affinity.findings import _BLOB_MAGIC
+
+    found, start = [], data.find(_BLOB_MAGIC)
     while start >= 0:
         found.append(start)
-        start = data.find(b"QAR3", start + 1)
+        start = data.find(_BLOB_MAGIC, start + 1)
     return found
 
 

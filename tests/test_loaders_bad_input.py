@@ -133,7 +133,6 @@ def test_off_errors(tmp_path, content, line):
         (PLY_HEADER + "0 0 0\n1 0 0\n0 1 0\n3 0 1 5\n", 13),
         (PLY_HEADER + "0 0 0\n1 inf 0\n0 1 0\n3 0 1 2\n", 11),
         (PLY_HEADER + "0 0 0\n1 0 0\n0 1 0\n", 12),
-        (PLY_HEADER + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 2\n", 14),
         (PLY_HEADER + "0 0 0\n1 0\n0 1 0\n3 0 1 2\n", 11),
         (PLY_HEADER + "0 0 0\n1 0 0\n0 1 0\n4 0 1 2\n", 13),
         (PLY_HEADER + "0 0 0\n1 0 0\n0 1 0\n9 0 1 2\n", 13),

@@ -76,6 +76,8 @@ def _shard(text: str) -> Shard | AutoShard:
 
 def _resolved_shard(spec: Shard | AutoShard | None) -> Shard | None:
     """``--shard``'s shard: ``auto`` read from the farm's environment (a UsageError when it names none)."""
+    if spec is None:
+        return None  # the shards' module (and hashlib) stay off a plain check's path
     from ..shards.selection import AutoShard, shard_from_environment
 
     if not isinstance(spec, AutoShard):

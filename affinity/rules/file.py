@@ -131,6 +131,7 @@ def missing_resources(context) -> Measured:
     folder = os.path.dirname(mesh.path)
     texels = mesh.texcoords is not None and "Q101" in RULES
     fallback = f"; texels use texture-size {settings.texture_size}"
+    used = {mesh.material_names[m] for m in np.unique(mesh.face_material) if m >= 0}  # materials faces bind
     lines, details, seen = [], [], set()
     for resource in mesh.resources:
         role = ROLES.get(resource.role)
@@ -148,7 +149,8 @@ def missing_resources(context) -> Measured:
         else:
             shown = os.path.relpath(resource.path, folder) if folder else resource.path
             details.append(f"{role.statement} {printable(shown)} (in {printable(resource.library)}) {problem}"
-                           + (fallback if texels and role.texture == "base colour" else ""))
+                           + (fallback if texels and role.texture == "base colour" and resource.material in used
+                              else ""))
     n = len(lines)
     return Measured(np.zeros(n, dtype=np.int64), np.zeros(n), lines=np.array(lines, dtype=np.int64), details=details)
 
