@@ -140,6 +140,7 @@ def unshared_bytes(out: Path) -> int:
     return total
 
 
+@pytest.mark.slow  # the whole chess set: a minute or more
 def test_the_chess_set_fix_writes_each_authored_mesh_once(chess_set_fix):
     """One points spec per authored mesh refined; the layer at most half of one copy per referencing prim, and
     smaller than today's (which wrote a copy per prim, of a smaller refinement: Q101 read at 1024 texels)."""
@@ -149,6 +150,7 @@ def test_the_chess_set_fix_writes_each_authored_mesh_once(chess_set_fix):
     assert out.stat().st_size <= min(UNSHARED_BYTES, unshared_bytes(out) / 2)
 
 
+@pytest.mark.slow  # the whole chess set: a minute or more
 def test_every_instance_of_the_fixed_chess_set_reads_its_refined_mesh(chess_set_fix):
     from pxr import Sdf, Usd, UsdGeom
 
@@ -165,6 +167,7 @@ def test_every_instance_of_the_fixed_chess_set_reads_its_refined_mesh(chess_set_
     assert all(len(paths) == 1 for paths in by_source.values())
 
 
+@pytest.mark.slow  # the whole chess set: a minute or more
 def test_the_fixed_chess_set_adds_no_shape_finding_and_leaves_only_what_it_lists(chess_set_fix):
     before, entry, _, after = chess_set_fix
     assert all(shape_counts(after)[code] <= shape_counts(before)[code] for code in SHAPE_RULES), \

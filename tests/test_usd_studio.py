@@ -113,6 +113,7 @@ def chess_set_check(shared_meshes) -> tuple[dict, str]:
     return check_json(str(stage))
 
 
+@pytest.mark.slow  # the whole chess set: a minute or more
 def test_the_chess_set_reads_its_2048_textures_through_materialx(chess_set_check, shared_meshes):
     from PIL import Image
 
@@ -132,6 +133,7 @@ def test_the_chess_set_reads_its_2048_textures_through_materialx(chess_set_check
     assert set(sizes.values()) == {(2048, 2048)}
 
 
+@pytest.mark.slow  # the whole chess set: a minute or more
 def test_the_chess_set_says_each_uncomposable_look_once_and_nothing_raw(chess_set_check):
     _, stderr = chess_set_check
     assert not RAW_DIAGNOSTIC.search(stderr)
@@ -159,6 +161,7 @@ def chess_folder_check(shared_meshes) -> tuple[dict, str]:
     return check_json("--fail-on-skip", str(folder))
 
 
+@pytest.mark.slow  # the whole chess set: a minute or more
 def test_the_chess_set_folder_reports_each_authored_mesh_once(chess_folder_check, chess_set_check):
     """The truth is the stage alone: it composes every authored mesh, each once (its own sharing), so over the
     folder the findings per authored mesh (layer, prim in it) are the stage's, and their number the same."""
@@ -180,6 +183,7 @@ def test_the_chess_set_folder_reports_each_authored_mesh_once(chess_folder_check
                                                        "chess_set.usda"}, f
 
 
+@pytest.mark.slow  # the whole chess set: a minute or more
 def test_fail_on_skip_passes_the_chess_set_folder_as_without_it(chess_folder_check):
     """The run has errors (exit 1 without the flag); with it, no look layer is a skip, so still 1. Each look's
     uncomposable .mtlx is said once in the run, though four files compose it."""
