@@ -119,7 +119,7 @@ def severity(hits) -> np.ndarray:
     positive = (v > 0) & (t > 0)
     ratio[positive] = np.maximum(v[positive] / t[positive], t[positive] / v[positive])
     if hits.visible is not None:
-        read = (hits.visible.picks >= 0) & np.isfinite(hits.visible.shifts)
+        read = hits.visible.read()
         ratio[read] = v[read] / t[read]
     return ratio
 

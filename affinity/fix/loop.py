@@ -50,8 +50,9 @@ def plan_fix(mesh: Mesh, fix: FixSettings | None = None) -> FixPlan:
         still = np.union1d(still, flagged)
         earlier = reasons.copy()
         refined_now = reasons == ""
+        leaving = left_by_rule()
         for d in new:  # a refined quad whose pieces add a finding is left for that rule's reason
-            reasons[refined_now & (found.faces == d["face"])] = left_by_rule().get(d["code"], "still-flagged")
+            reasons[refined_now & (found.faces == d["face"])] = leaving.get(d["code"], "still-flagged")
         reasons[np.isin(found.faces, flagged) & refined_now] = "still-flagged"
         cut = np.intersect1d(np.union1d(flagged, adding), plan.transition_faces)
         if (reasons == earlier).all() and np.isin(cut, quiet).all():  # nothing left to change

@@ -151,22 +151,13 @@ class FixPlan:
         return len(self.refine_faces) == 0
 
 
-def rule_values(hits) -> np.ndarray:
-    """(n,) float64: the values of ``hits`` in their rule's own unit, the one a refinement's pieces are measured
-    in: the texel shift where Q101's visible reading replaced it by C (``visible.shifts``), never the colour
-    (design.md, "One findings table")."""
-    if hits.visible is None:
-        return hits.values
-    return np.where(np.isfinite(hits.visible.shifts), hits.visible.shifts, hits.values)
-
-
 def flagged_quads(mesh: Mesh, fix: FixSettings) -> tuple[dict, dict]:
     """The scored findings at or above the fix level and the faces each leaving rule flags.
 
     Returns
     -------
     scored : code -> (faces (n,) int64, values (n,) float64) of Q101-Q103 findings at the level, values
-        in the rule's measure (:func:`rule_values`)
+        in the rule's measure (:attr:`~affinity.findings.RuleHits.shifts`: Q101's shift, never C)
     leaving : code -> faces (n,) int64 of the findings of :func:`left_by_rule` and :func:`uncut_by_rule`
     """
     from ..findings import settle
@@ -182,7 +173,7 @@ def flagged_quads(mesh: Mesh, fix: FixSettings) -> tuple[dict, dict]:
     for h in hits:
         if h.code in removed:
             at_level = np.isin(h.levels(), LEVEL_ORDER[lowest:])
-            scored[h.code] = h.faces[at_level], rule_values(h)[at_level]
+            scored[h.code] = h.faces[at_level], h.shifts[at_level]
         else:
             leaving[h.code] = h.faces
     return scored, leaving

@@ -50,11 +50,11 @@ def verify(mesh: Mesh, plan, fix, baseline: dict) -> tuple[np.ndarray, list[dict
     source = refined.source
     inline = [(codes, np.flatnonzero(np.isin(source, faces))) for codes, faces in fix.inline]
     lowest = LEVEL_ORDER[LEVEL_ORDER.index(fix.level):]
-    flagged, new = [], []
+    flagged, new, scored = [], [], scored_codes()
     for h in checked(refined.mesh, fix, inline):
         on_face = h.faces >= 0
         faces, levels = h.faces[on_face], h.levels()[on_face]
-        if h.code in scored_codes():
+        if h.code in scored:
             flagged.append(source[faces[np.isin(levels, lowest)]])
             continue
         added = faces[refined.added[faces] & np.isin(levels, ("warning", "error"))]

@@ -88,14 +88,15 @@ def available_cpus() -> int:
 
 def auto_jobs(paths: list[str]) -> int:
     """Worker processes for ``paths`` when ``--jobs`` is not given: every CPU, if the files are big enough."""
+    return max(1, min(available_cpus(), 1 + sum(map(file_size, paths)) // BYTES_PER_WORKER))
 
-    def size(path: str) -> int:
-        try:
-            return os.path.getsize(path)
-        except OSError:
-            return 0
 
-    return max(1, min(available_cpus(), 1 + sum(map(size, paths)) // BYTES_PER_WORKER))
+def file_size(path: str) -> int:
+    """The size of the file at ``path`` in bytes, 0 where it cannot be seen (it is reported when checked)."""
+    try:
+        return os.path.getsize(path)
+    except OSError:
+        return 0
 
 
 def check_files(

@@ -154,13 +154,9 @@ def check_on_cluster(client, tasks: list[tuple[str, Settings]], check: Callable[
     """
     from distributed import as_completed
 
-    def size(path: str) -> int:
-        try:
-            return os.path.getsize(path)
-        except OSError:
-            return 0
+    from .check import file_size
 
-    planned = batches([size(path) for path, _ in tasks], len(client.scheduler_info()["workers"]), batch_seconds)
+    planned = batches([file_size(path) for path, _ in tasks], len(client.scheduler_info()["workers"]), batch_seconds)
     run = uuid.uuid4().hex[:12]
     futures = {}
     for rank, batch in enumerate(planned):

@@ -60,7 +60,7 @@ def read_shifts(hits: RuleHits) -> np.ndarray:
     columns = hits.visible
     if columns is None:
         return np.full(len(hits.faces), np.nan)
-    return np.where((columns.picks >= 0) & np.isfinite(columns.shifts), columns.shifts, np.nan)
+    return np.where(columns.read(), columns.shifts, np.nan)
 
 
 def connected_components(n_items: int, a: np.ndarray, b: np.ndarray) -> np.ndarray:
