@@ -252,8 +252,7 @@ def _overrides(args) -> dict:
     given = {
         "select": args.select, "ignore": args.ignore, "measure": args.measure,
         "diagonal": args.diagonal, "texture_size": args.texture_size,
-        "subdivision": getattr(args, "subdivision", None), "profile": getattr(args, "profile", None),
-        "fvar_interpolation": getattr(args, "fvar_interpolation", None),
+        "subdivision": args.subdivision, "profile": args.profile, "fvar_interpolation": args.fvar_interpolation,
     }
     return {"thresholds": thresholds, **{k: v for k, v in given.items() if v is not None}}
 
