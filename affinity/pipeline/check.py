@@ -17,6 +17,7 @@ from ..errors import MeshError, SkippedFile, internal_error
 from ..findings import FileReport
 from ..mesh import Mesh
 from ..settings import Settings
+from .files import file_size
 
 
 def check_file(path: str, settings: Settings, usd=None, source: bytes | None = None) -> FileReport:
@@ -90,13 +91,6 @@ def auto_jobs(paths: list[str]) -> int:
     """Worker processes for ``paths`` when ``--jobs`` is not given: every CPU, if the files are big enough."""
     return max(1, min(available_cpus(), 1 + sum(map(file_size, paths)) // BYTES_PER_WORKER))
 
-
-def file_size(path: str) -> int:
-    """The size of the file at ``path`` in bytes, 0 where it cannot be seen (it is reported when checked)."""
-    try:
-        return os.path.getsize(path)
-    except OSError:
-        return 0
 
 
 def check_files(

@@ -154,7 +154,7 @@ def check_on_cluster(client, tasks: list[tuple[str, Settings]], check: Callable[
     """
     from distributed import as_completed
 
-    from .check import file_size
+    from .files import file_size
 
     planned = batches([file_size(path) for path, _ in tasks], len(client.scheduler_info()["workers"]), batch_seconds)
     run = uuid.uuid4().hex[:12]

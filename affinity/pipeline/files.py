@@ -174,3 +174,11 @@ def once_each(files: list[str]) -> list[str]:
             seen.add(identity)
             kept.append(path)
     return kept
+
+
+def file_size(path: str) -> int:
+    """The size of the file at ``path`` in bytes, 0 where it cannot be seen (it is reported when checked)."""
+    try:
+        return os.path.getsize(path)
+    except OSError:
+        return 0
